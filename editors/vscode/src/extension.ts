@@ -1,0 +1,136 @@
+// VS Code client for the bt-lsp language server (BehaviorTree.CPP XML).
+
+import * as vscode from 'vscode';
+import { Executable, LanguageClient, LanguageClientOptions, ServerOptions } from 'vscode-languageclient/node';
+import { resolveServerCommand } from './serverCommand';
+
+const CLIENT_ID = 'btLsp'; // also the settings section; vscode-languageclient reads `btLsp.trace.server`
+const CLIENT_NAME = 'bt-lsp';
+
+let log: vscode.LogOutputChannel;
+let client: LanguageClient | undefined;
+// Start, stop and restart run one after another, in the order they were asked for.
+let queue: Promise<void> = Promise.resolve();
+
+function enqueue(work: () => Promise<void>): Promise<void> {
+  queue = queue.then(work, work);
+  return queue;
+}
+
+export function activate(context: vscode.ExtensionContext): Promise<void> {
+  log = vscode.window.createOutputChannel(CLIENT_NAME, { log: true });
+  context.subscriptions.push(
+    log,
+    vscode.commands.registerCommand('btLsp.restartServer', () => restart()),
+    vscode.commands.registerCommand('btLsp.showOutput', () => log.show()),
+    vscode.workspace.onDidChangeConfiguration((event) => {
+      if (event.affectsConfiguration('btLsp.server.command')) {
+        log.info('btLsp.server.command changed: restarting the server');
+        void restart();
+      }
+    }),
+  );
+  return enqueue(startClient);
+}
+
+export function deactivate(): Promise<void> {
+  return enqueue(stopClient);
+}
+
+function restart(): Promise<void> {
+  return enqueue(async () => {
+    await stopClient();
+    await startClient();
+  });
+}
+
+/** The `btLsp` settings the server understands, also sent as initializationOptions. */
+function serverSettings(): { debounceMs?: number; severity?: Record<string, string> } {
+  const config = vscode.workspace.getConfiguration('btLsp');
+  return {
+    debounceMs: config.get<number>('debounceMs'),
+    severity: config.get<Record<string, string>>('severity'),
+  };
+}
+
+async function startClient(): Promise<void> {
+  const resource = vscode.window.activeTextEditor?.document.uri ?? vscode.workspace.workspaceFolders?.[0]?.uri;
+  const { server, tried } = await resolveServerCommand(resource, log);
+  tried.forEach((line) => log.info(line));
+  if (!server) {
+    showInstallHelp('the bt-lsp language server was not found', tried);
+    return;
+  }
+
+  const argv = [server.command, ...server.args];
+  log.info(`Starting the server (${server.origin}): ${JSON.stringify(argv)}`);
+  // No `transport` here: with TransportKind.stdio the client would append `--stdio` to argv.
+  const executable: Executable = { command: server.command, args: server.args };
+  const serverOptions: ServerOptions = { run: executable, debug: executable };
+  const clientOptions: LanguageClientOptions = {
+    documentSelector: [
+      { scheme: 'file', language: 'xml' },
+      { scheme: 'untitled', language: 'xml' },
+    ],
+    outputChannel: log,
+    traceOutputChannel: log,
+    initializationOptions: serverSettings,
+    // The server reads the `btLsp` section through workspace/configuration; this makes the
+    // client send workspace/didChangeConfiguration when it changes.
+    synchronize: { configurationSection: CLIENT_ID },
+  };
+
+  const candidate = new LanguageClient(CLIENT_ID, CLIENT_NAME, serverOptions, clientOptions);
+  try {
+    await candidate.start();
+    client = candidate;
+    log.info('The server is running.');
+  } catch (error) {
+    log.error(`The server did not start: ${errorText(error)}`);
+    try {
+      await candidate.dispose(2000);
+    } catch {
+      // it never ran
+    }
+    showInstallHelp(`could not start ${JSON.stringify(argv)} (${server.origin}): ${errorText(error)}`, []);
+  }
+}
+
+async function stopClient(): Promise<void> {
+  const running = client;
+  client = undefined;
+  if (running) {
+    try {
+      await running.stop(2000);
+    } catch (error) {
+      log.warn(`Stopping the server: ${errorText(error)}`);
+    }
+  }
+}
+
+function errorText(error: unknown): string {
+  return error instanceof Error ? error.message : String(error);
+}
+
+/** Logs why the server is not running and shows a notification saying how to install it. */
+function showInstallHelp(reason: string, tried: string[]): void {
+  const help =
+    'Install the server with `pip install bt-lsp` (or from a checkout of its repository: ' +
+    '`pip install /path/to/bt-lsp`) into a Python whose scripts folder is on PATH or that is ' +
+    'selected in the Python extension, or set `btLsp.server.command` to the command that starts it, ' +
+    'e.g. ["/path/to/python", "-m", "bt_lsp", "serve"]. Then run "bt-lsp: Restart server".';
+  log.error(`${reason}. ${help}`);
+  if (tried.length > 0) {
+    log.error(`Tried:\n  ${tried.join('\n  ')}`);
+  }
+  const openSettings = 'Open Settings';
+  const showOutput = 'Show Output';
+  // Not awaited: the notification stays until the user closes it, and a restart must not wait for that.
+  void vscode.window.showErrorMessage(`bt-lsp: ${reason}. ${help}`, openSettings, showOutput).then((choice) => {
+    if (choice === openSettings) {
+      void vscode.commands.executeCommand('workbench.action.openSettings', 'btLsp.server.command');
+    } else if (choice === showOutput) {
+      log.show();
+    }
+  });
+}

@@ -1,0 +1,7 @@
+"""``python -m bt_lsp`` is the same as the ``bt-lsp`` command."""
+
+import sys
+
+from bt_lsp.cli import main
+
+sys.exit(main())

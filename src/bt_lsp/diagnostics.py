@@ -1,0 +1,113 @@
+"""Diagnostics of a document: lexical problems, XML structure, and the name rules.
+
+Further rule families (BehaviorTree.CPP semantics) add their findings through
+:data:`EXTRA_CHECKS`; each is a pure function of the document's model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
+
+from bt_lsp.codes import CODES, Severity
+from bt_lsp.model import Model, NameRef, Role
+from bt_lsp.names import NameKind, Violation, check_name
+from bt_lsp.scanner import Scan
+
+if TYPE_CHECKING:
+    from bt_lsp.document import Document
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """A finding over code-point offsets ``[start, end)`` of the document text."""
+
+    start: int
+    end: int
+    code: str
+    message: str
+    severity: Severity
+    data: Mapping[str, Any] | None = field(default=None, compare=True)
+
+    @property
+    def is_name_rule(self) -> bool:
+        return CODES[self.code].family == "names"
+
+
+def make(
+    start: int, end: int, code: str, message: str, data: Mapping[str, Any] | None = None
+) -> Diagnostic:
+    return Diagnostic(start, end, code, message, CODES[code].severity, data)
+
+
+@lru_cache(maxsize=65536)
+def _violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
+    return check_name(text, kind, declaration=declaration)
+
+
+def name_violations(ref: NameRef) -> tuple[Violation, ...]:
+    if ref.kind is None:
+        return ()
+    return _violations(ref.text, ref.kind, ref.role == Role.PORT_DECL)
+
+
+def name_diagnostics(model: Model) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    for ref in model.refs:
+        if ref.kind is None:
+            continue
+        for v in _violations(ref.text, ref.kind, ref.role == Role.PORT_DECL):
+            out.append(
+                make(
+                    ref.start,
+                    ref.end,
+                    v.code,
+                    v.message,
+                    {"name": ref.text, "kind": str(ref.kind), "role": str(ref.role)},
+                )
+            )
+    return out
+
+
+def lexical_diagnostics(scan: Scan) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    for start, tok in zip(scan.starts, scan.tokens, strict=True):
+        if tok.problems:
+            for p in tok.problems:
+                out.append(make(start + p.start, start + p.end, p.code, p.message))
+    return out
+
+
+Check = Callable[["Document"], Iterable[Diagnostic]]
+#: Rule families beyond names and syntax register here (see bt_lsp.semantics).
+EXTRA_CHECKS: list[Check] = []
+
+
+def compute(doc: Document) -> list[Diagnostic]:
+    model = doc.model
+    out = lexical_diagnostics(doc.scan)
+    out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
+    out.extend(name_diagnostics(model))
+    for check in EXTRA_CHECKS:
+        out.extend(check(doc))
+    out.sort(key=lambda d: (d.start, d.end, d.code))
+    return out
+
+
+def with_severities(
+    diags: Iterable[Diagnostic], overrides: Mapping[str, Severity | None]
+) -> list[Diagnostic]:
+    """Apply per-code severity settings; a code set to ``None`` ("off") is dropped."""
+    if not overrides:
+        return list(diags)
+    out: list[Diagnostic] = []
+    for d in diags:
+        if d.code in overrides:
+            sev = overrides[d.code]
+            if sev is None:
+                continue
+            d = replace(d, severity=sev)
+        out.append(d)
+    return out

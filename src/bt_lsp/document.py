@@ -1,0 +1,50 @@
+"""A document: its text, line index, tokens, model and diagnostics, kept current by edits.
+
+An edit re-scans only the tokens around it (:func:`bt_lsp.scanner.rescan`) and updates the
+line index in place of rebuilding it; the model and diagnostics are derived lazily from
+the tokens when first asked for.
+"""
+
+from __future__ import annotations
+
+from bt_lsp.diagnostics import Diagnostic, compute
+from bt_lsp.model import Model, build
+from bt_lsp.scanner import Scan, rescan, scan
+from bt_lsp.text import LineIndex
+
+
+class Document:
+    def __init__(self, text: str, path: str | None = None) -> None:
+        self.path = path
+        self.text = text
+        self.lines = LineIndex(text)
+        self.scan: Scan = scan(text)
+        self._model: Model | None = None
+        self._diagnostics: list[Diagnostic] | None = None
+
+    def edit(self, start: int, end: int, new_text: str) -> None:
+        """Replace ``text[start:end]`` (code-point offsets, clamped) with ``new_text``."""
+        n = len(self.text)
+        start = min(max(start, 0), n)
+        end = min(max(end, start), n)
+        new_full = self.text[:start] + new_text + self.text[end:]
+        self.lines = self.lines.edited(start, end, new_text, new_full)
+        self.scan, _ = rescan(self.scan, new_full, start, end, len(new_text))
+        self.text = new_full
+        self._model = None
+        self._diagnostics = None
+
+    def replace_all(self, text: str) -> None:
+        self.__init__(text, self.path)  # type: ignore[misc]
+
+    @property
+    def model(self) -> Model:
+        if self._model is None:
+            self._model = build(self.scan, self.text)
+        return self._model
+
+    @property
+    def diagnostics(self) -> list[Diagnostic]:
+        if self._diagnostics is None:
+            self._diagnostics = compute(self)
+        return self._diagnostics

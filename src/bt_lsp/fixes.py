@@ -1,0 +1,127 @@
+"""Fixes for name diagnostics: sanitized, unique replacements that rename every reference.
+
+Pure: these functions return edits; the front ends decide whether to apply them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.edits import TextEdit
+from bt_lsp.model import Model, NameRef, Symbol
+from bt_lsp.sanitize import candidates
+
+
+@dataclass(frozen=True, slots=True)
+class Fix:
+    title: str
+    edits: tuple[TextEdit, ...]
+    preferred: bool
+    diagnostic: Diagnostic
+
+
+def escape_value(text: str, quote: str) -> str:
+    """``text`` written inside an attribute value delimited by ``quote``."""
+    text = text.replace("&", "&amp;").replace("<", "&lt;")
+    if quote == '"':
+        text = text.replace('"', "&quot;")
+    elif quote == "'":
+        text = text.replace("'", "&apos;")
+    return text
+
+
+def _written(ref: NameRef, new_name: str) -> str:
+    return escape_value(new_name, ref.quote) if ref.quote else new_name
+
+
+def occurrences(model: Model, ref: NameRef) -> list[NameRef]:
+    """Every name token that a rename of ``ref`` must change, ``ref`` included."""
+    if ref.symbol is None:
+        return [ref]
+    return model.refs_to(ref.symbol)
+
+
+def rename_edits(refs: Iterable[NameRef], new_name: str) -> list[TextEdit]:
+    return sorted({TextEdit(r.start, r.end, _written(r, new_name)) for r in refs})
+
+
+def _namespace(symbol: Symbol) -> tuple[str, ...]:
+    """Names in one namespace must stay distinct: trees and models share one (a tree ID may
+    not be a node type), a port's namespace is its owner's ports."""
+    return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
+
+
+def taken_names(model: Model, symbol: Symbol | None) -> set[str]:
+    if symbol is None:
+        return set()
+    ns = _namespace(symbol)
+    return {
+        r.symbol[-1]
+        for r in model.refs
+        if r.symbol is not None and _namespace(r.symbol) == ns and r.symbol != symbol
+    }
+
+
+def shown(name: str) -> str:
+    """A name with its control characters written visibly (``U+0007``)."""
+    return "".join(c if c.isprintable() or c == " " else f"U+{ord(c):04X}" for c in name)
+
+
+def _title(old: str, new: str, places: int) -> str:
+    where = "1 place" if places == 1 else f"{places} places"
+    if not new:
+        return f"Clear '{shown(old)}' ({where})"
+    return f"Rename '{shown(old)}' to '{shown(new)}' ({where})"
+
+
+def fixes_for(model: Model, diag: Diagnostic) -> list[Fix]:
+    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives."""
+    if not diag.is_name_rule:
+        return []
+    ref = model.ref_at(diag.start)
+    if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
+        return []
+    occ = occurrences(model, ref)
+    names = candidates(ref.text, ref.kind, taken_names(model, ref.symbol))
+    fixes: list[Fix] = []
+    for i, new in enumerate(names):
+        if new == ref.text:
+            continue
+        edits = tuple(rename_edits(occ, new))
+        fixes.append(Fix(_title(ref.text, new, len(edits)), edits, i == 0, diag))
+    return fixes
+
+
+def fix_all(model: Model, diags: Iterable[Diagnostic]) -> list[TextEdit]:
+    """Every preferred name fix at once, consistently: one new name per symbol, all
+    distinct from each other and from the names that stay."""
+    chosen: dict[Symbol | tuple[int, int], str] = {}
+    edits: dict[tuple[int, int], TextEdit] = {}
+    taken_by_ns: dict[tuple[str, ...], set[str]] = {}
+    for diag in diags:
+        if not diag.is_name_rule:
+            continue
+        ref = model.ref_at(diag.start)
+        if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
+            continue
+        key: Symbol | tuple[int, int] = (
+            ref.symbol if ref.symbol is not None else (ref.start, ref.end)
+        )
+        if key in chosen:
+            continue
+        if ref.symbol is not None:
+            ns = _namespace(ref.symbol)
+            if ns not in taken_by_ns:
+                taken_by_ns[ns] = taken_names(model, ref.symbol) | {ref.symbol[-1]}
+            taken = taken_by_ns[ns] - {ref.symbol[-1]}
+        else:
+            taken = set()
+        new = candidates(ref.text, ref.kind, taken)[0]
+        chosen[key] = new
+        if ref.symbol is not None:
+            taken_by_ns[_namespace(ref.symbol)].add(new)
+        for e in rename_edits(occurrences(model, ref), new):
+            edits[(e.start, e.end)] = e
+    return sorted(edits.values())

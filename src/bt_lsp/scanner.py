@@ -1,0 +1,615 @@
+"""A tolerant, position-exact, incremental scanner for BT XML.
+
+The text is cut into a flat list of top-level tokens: text runs, start tags (with their
+attributes), end tags, comments, CDATA sections, processing instructions, DOCTYPEs and
+stray ``<``.  Between tokens the scanner has no state, and a token's result depends only
+on the text from its start up to its ``reach``.  That makes re-scanning after an edit
+cheap and exact: start again at the first token whose reach touches the edit, stop as
+soon as a new token starts where an old one (shifted by the edit) started after the
+edit, and reuse the rest.  A property test checks incremental == full scan.
+
+Offsets inside a token are relative to the token's start, so reused tokens are shared
+unchanged; only the list of absolute starts is shifted.
+
+The scanner never raises, never recurses, always advances and is linear: every loop
+either consumes text or stops.  It expands nothing: entity references other than XML's
+five and character references are left as written, DOCTYPEs are skipped whole.
+"""
+
+from __future__ import annotations
+
+import re
+from bisect import bisect_right
+from dataclasses import dataclass
+from enum import IntEnum
+
+
+class Kind(IntEnum):
+    TEXT = 0
+    START = 1  # start tag or empty-element tag
+    END = 2  # end tag
+    COMMENT = 3
+    CDATA = 4
+    PI = 5  # processing instruction or XML declaration
+    DOCTYPE = 6
+    STRAY = 7  # a '<' that starts no markup
+
+
+XML_SYNTAX = "xml-syntax"
+UNESCAPED = "xml-unescaped-char"
+DOCTYPE_CODE = "xml-doctype"
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    """A lexical problem; offsets relative to the token start."""
+
+    start: int
+    end: int
+    code: str
+    message: str
+
+
+@dataclass(frozen=True, slots=True)
+class Attr:
+    """An attribute; offsets relative to the token start.
+
+    ``value_start``/``value_end`` delimit the raw value between the quotes (entity
+    references included).  ``value`` is the decoded value, ``None`` when the attribute
+    has no value at all.
+    """
+
+    name: str
+    name_start: int
+    name_end: int
+    value: str | None
+    value_start: int
+    value_end: int
+    quote: str
+
+
+@dataclass(frozen=True, slots=True)
+class Token:
+    kind: Kind
+    length: int
+    reach: int  # how far (from the token start) the scan looked; >= length
+    name: str = ""
+    name_start: int = 0
+    name_end: int = 0
+    attrs: tuple[Attr, ...] = ()
+    self_closing: bool = False
+    closed: bool = True
+    problems: tuple[Problem, ...] = ()
+
+
+# Characters that end a tag or attribute name.  Anything else is part of the name, so
+# that names breaking the naming rules (``Open.Door``, ``a*b``) are still found whole.
+_NAME_STOP = " \t\r\n/>=<\"'"
+_NAME_RE = re.compile(r"[^ \t\r\n/>=<\"']+")
+_WS_RE = re.compile(r"[ \t\r\n]*")
+# Well-formed start tag, the common case, matched in one go.  Values may not hold '<'
+# (the slow path handles and reports those).
+_FAST_TAG_RE = re.compile(
+    r"<([^ \t\r\n/>=<\"']+)"
+    r"((?:[ \t\r\n]+[^ \t\r\n/>=<\"']+[ \t\r\n]*=[ \t\r\n]*(?:\"[^\"<]*\"|'[^'<]*'))*)"
+    r"[ \t\r\n]*(/?)>"
+)
+_FAST_ATTR_RE = re.compile(
+    r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
+)
+# An unterminated attribute value ends at its quote or before a line that starts a tag.
+_VALUE_END_RE = {
+    q: re.compile(q + r"|[\r\n][ \t\r\n]*<(?=[A-Za-z_:/!?]|[^\x00-\x7f])") for q in "\"'"
+}
+_UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
+_REF_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
+_PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
+
+
+def _char_ref(body: str) -> str | None:
+    try:
+        cp = int(body[2:], 16) if body[1] == "x" else int(body[1:])
+    except ValueError:
+        return None
+    if cp == 0 or cp > 0x10FFFF or 0xD800 <= cp <= 0xDFFF:
+        return None
+    return chr(cp)
+
+
+def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
+    """Decode references in an attribute value.
+
+    ``base`` is the raw value's offset (relative to its token) for problem positions.
+    BehaviorTree.CPP's tinyxml2 keeps a raw ``&`` or ``<`` as written, so they are
+    reported as warnings and kept.  Unknown entities are kept as written: bt-lsp never
+    expands DOCTYPE entities.
+    """
+    if "&" not in raw and "<" not in raw:
+        return raw
+    if problems is not None:
+        pos = raw.find("<")
+        while pos != -1:
+            problems.append(
+                Problem(
+                    base + pos,
+                    base + pos + 1,
+                    UNESCAPED,
+                    "Raw '<' in an attribute value; XML requires '&lt;'",
+                )
+            )
+            pos = raw.find("<", pos + 1)
+    if "&" not in raw:
+        return raw
+    out: list[str] = []
+    pos = 0
+    while True:
+        amp = raw.find("&", pos)
+        if amp == -1:
+            out.append(raw[pos:])
+            break
+        out.append(raw[pos:amp])
+        m = _REF_RE.match(raw, amp)
+        if m is None:
+            if problems is not None:
+                problems.append(
+                    Problem(
+                        base + amp,
+                        base + amp + 1,
+                        UNESCAPED,
+                        "Raw '&' in an attribute value; XML requires '&amp;'",
+                    )
+                )
+            out.append("&")
+            pos = amp + 1
+            continue
+        body = m.group(1)
+        if body[0] == "#":
+            ch = _char_ref(body)
+            if ch is None:
+                if problems is not None:
+                    problems.append(
+                        Problem(
+                            base + amp,
+                            base + m.end(),
+                            XML_SYNTAX,
+                            f"Invalid character reference '{m.group(0)}'",
+                        )
+                    )
+                out.append(m.group(0))
+            else:
+                out.append(ch)
+        elif body in _PREDEFINED:
+            out.append(_PREDEFINED[body])
+        else:
+            if problems is not None:
+                problems.append(
+                    Problem(
+                        base + amp,
+                        base + m.end(),
+                        XML_SYNTAX,
+                        f"Undefined entity '&{body};' (bt-lsp never expands DOCTYPE entities)",
+                    )
+                )
+            out.append(m.group(0))
+        pos = m.end()
+    return "".join(out)
+
+
+def _scan_text(text: str, pos: int, n: int) -> Token:
+    end = text.find("<", pos)
+    if end == -1:
+        return Token(Kind.TEXT, n - pos, n - pos)
+    return Token(Kind.TEXT, end - pos, end - pos + 1)
+
+
+def _scan_delimited(
+    text: str, pos: int, n: int, kind: Kind, opener: str, closer: str, what: str
+) -> Token:
+    end = text.find(closer, pos + len(opener))
+    if end == -1:
+        return Token(
+            kind,
+            n - pos,
+            n - pos,
+            closed=False,
+            problems=(
+                Problem(0, len(opener), XML_SYNTAX, f"Unterminated {what}: missing '{closer}'"),
+            ),
+        )
+    length = end + len(closer) - pos
+    name = ""
+    if kind == Kind.PI:
+        m = _NAME_RE.match(text, pos + 2, end)
+        name = m.group(0) if m else ""
+    return Token(kind, length, length, name=name)
+
+
+def _scan_doctype(text: str, pos: int, n: int) -> Token:
+    """Skip a DOCTYPE whole (internal subset, quoted strings); never interpret it."""
+    i = pos + 9
+    depth = 0
+    quote = ""
+    while i < n:
+        c = text[i]
+        if quote:
+            j = text.find(quote, i)
+            if j == -1:
+                i = n
+                break
+            i = j + 1
+            quote = ""
+            continue
+        if c in "\"'":
+            quote = c
+        elif c == "[":
+            depth += 1
+        elif c == "]":
+            depth = max(0, depth - 1)
+        elif c == ">" and depth == 0:
+            length = i + 1 - pos
+            return Token(
+                Kind.DOCTYPE,
+                length,
+                length,
+                name="DOCTYPE",
+                problems=(
+                    Problem(
+                        0,
+                        9,
+                        DOCTYPE_CODE,
+                        "DOCTYPE ignored: its entities and external DTDs are never "
+                        "expanded or fetched",
+                    ),
+                ),
+            )
+        i += 1
+    return Token(
+        Kind.DOCTYPE,
+        n - pos,
+        n - pos,
+        name="DOCTYPE",
+        closed=False,
+        problems=(Problem(0, 9, XML_SYNTAX, "Unterminated DOCTYPE: missing '>'"),),
+    )
+
+
+def _scan_end_tag(text: str, pos: int, n: int) -> Token:
+    problems: list[Problem] = []
+    m = _NAME_RE.match(text, pos + 2)
+    if m is None:
+        name, ns, ne = "", 2, 2
+        problems.append(Problem(0, 2, XML_SYNTAX, "End tag without a name"))
+        i = pos + 2
+    else:
+        name, ns, ne = m.group(0), 2, m.end() - pos
+        i = m.end()
+    i = _WS_RE.match(text, i).end()  # type: ignore[union-attr]
+    if i < n and text[i] == ">":
+        length = i + 1 - pos
+        return Token(
+            Kind.END,
+            length,
+            length + 1,
+            name=name,
+            name_start=ns,
+            name_end=ne,
+            problems=tuple(problems),
+        )
+    length = i - pos
+    problems.append(
+        Problem(
+            ns, ne if ne > ns else 2, XML_SYNTAX, f"End tag '</{name}' is not closed: expected '>'"
+        )
+    )
+    return Token(
+        Kind.END,
+        length,
+        length + 1,
+        name=name,
+        name_start=ns,
+        name_end=ne,
+        closed=False,
+        problems=tuple(problems),
+    )
+
+
+def _scan_start_fast(text: str, pos: int) -> Token | None:
+    m = _FAST_TAG_RE.match(text, pos)
+    if m is None:
+        return None
+    name = m.group(1)
+    attrs: list[Attr] = []
+    problems: list[Problem] = []
+    seen: set[str] = set()
+    a_start = m.start(2)
+    for am in _FAST_ATTR_RE.finditer(text, a_start, m.end(2)):
+        vi = 2 if am.group(2) is not None else 3
+        raw = am.group(vi)
+        vs = am.start(vi) - pos
+        aname = am.group(1)
+        if aname in seen:
+            problems.append(
+                Problem(
+                    am.start(1) - pos, am.end(1) - pos, XML_SYNTAX, f"Duplicate attribute '{aname}'"
+                )
+            )
+        seen.add(aname)
+        attrs.append(
+            Attr(
+                aname,
+                am.start(1) - pos,
+                am.end(1) - pos,
+                decode_value(raw, vs, problems),
+                vs,
+                vs + len(raw),
+                '"' if vi == 2 else "'",
+            )
+        )
+    length = m.end() - pos
+    return Token(
+        Kind.START,
+        length,
+        length + 1,
+        name=name,
+        name_start=1,
+        name_end=1 + len(name),
+        attrs=tuple(attrs),
+        self_closing=m.group(3) == "/",
+        problems=tuple(problems),
+    )
+
+
+def _scan_start(text: str, pos: int, n: int) -> Token:
+    fast = _scan_start_fast(text, pos)
+    if fast is not None:
+        return fast
+    problems: list[Problem] = []
+    attrs: list[Attr] = []
+    seen: set[str] = set()
+    m = _NAME_RE.match(text, pos + 1)
+    assert m is not None  # the caller checked that a name character follows '<'
+    name = m.group(0)
+    i = m.end()
+    reach = i
+    self_closing = False
+    closed = False
+    while True:
+        ws_end = _WS_RE.match(text, i).end()  # type: ignore[union-attr]
+        had_ws = ws_end > i
+        i = ws_end
+        reach = max(reach, i)
+        if i >= n:
+            problems.append(
+                Problem(
+                    1,
+                    1 + len(name),
+                    XML_SYNTAX,
+                    f"Start tag '<{name}' is not closed: expected '>' or '/>'",
+                )
+            )
+            break
+        c = text[i]
+        if c == ">":
+            i += 1
+            closed = True
+            break
+        if c == "/":
+            if i + 1 < n and text[i + 1] == ">":
+                i += 2
+                closed = self_closing = True
+                break
+            reach = max(reach, i + 1)
+            problems.append(Problem(i - pos, i + 1 - pos, XML_SYNTAX, "Expected '/>' after '/'"))
+            i += 1
+            continue
+        if c == "<":
+            problems.append(
+                Problem(
+                    1,
+                    1 + len(name),
+                    XML_SYNTAX,
+                    f"Start tag '<{name}' is not closed: expected '>' or '/>'",
+                )
+            )
+            break
+        am = _NAME_RE.match(text, i)
+        if am is None:  # '=' or a quote where a name should be
+            problems.append(
+                Problem(i - pos, i + 1 - pos, XML_SYNTAX, f"Unexpected {c!r} in tag '<{name}'")
+            )
+            if c in "\"'":
+                j = text.find(c, i + 1)
+                i = j + 1 if j != -1 and "<" not in text[i + 1 : j] else i + 1
+            else:
+                i += 1
+            reach = max(reach, i)
+            continue
+        aname = am.group(0)
+        ns, ne = am.start() - pos, am.end() - pos
+        if not had_ws and attrs:
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Missing whitespace before attribute '{aname}'")
+            )
+        if aname in seen:
+            problems.append(Problem(ns, ne, XML_SYNTAX, f"Duplicate attribute '{aname}'"))
+        seen.add(aname)
+        i = _WS_RE.match(text, am.end()).end()  # type: ignore[union-attr]
+        reach = max(reach, i + 1)
+        if i >= n or text[i] != "=":
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Attribute '{aname}' has no value: expected '=\"…\"'")
+            )
+            attrs.append(Attr(aname, ns, ne, None, -1, -1, ""))
+            continue
+        i = _WS_RE.match(text, i + 1).end()  # type: ignore[union-attr]
+        reach = max(reach, i + 1)
+        q = text[i] if i < n else ""
+        if q in ('"', "'") and q:
+            vstart = i + 1
+            vm = _VALUE_END_RE[q].search(text, vstart)
+            if vm is not None and vm.group(0) == q:
+                vend, i = vm.start(), vm.end()
+                reach = max(reach, i)
+            else:
+                vend = vm.start() if vm is not None else n
+                reach = max(reach, vm.end() if vm is not None else n)
+                i = vend
+                problems.append(
+                    Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' has no closing {q}")
+                )
+            raw = text[vstart:vend]
+            attrs.append(
+                Attr(
+                    aname,
+                    ns,
+                    ne,
+                    decode_value(raw, vstart - pos, problems),
+                    vstart - pos,
+                    vend - pos,
+                    q,
+                )
+            )
+        else:
+            # Unquoted value: XML forbids it; read up to whitespace or the tag's end.
+            vm2 = _UNQUOTED_RE.match(text, i)
+            vend = vm2.end() if vm2 else i
+            if vend > i and text[vend - 1] == "/" and vend < n and text[vend] == ">":
+                vend -= 1
+            reach = max(reach, vend + 1)
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' must be quoted")
+            )
+            raw = text[i:vend]
+            attrs.append(
+                Attr(aname, ns, ne, decode_value(raw, i - pos, None), i - pos, vend - pos, "")
+            )
+            i = vend
+    length = i - pos
+    return Token(
+        Kind.START,
+        length,
+        max(reach - pos, length) + 1,
+        name=name,
+        name_start=1,
+        name_end=1 + len(name),
+        attrs=tuple(attrs),
+        self_closing=self_closing,
+        closed=closed,
+        problems=tuple(problems),
+    )
+
+
+def scan_token(text: str, pos: int) -> Token:
+    """Scan the one token that starts at ``pos`` (``pos < len(text)``)."""
+    n = len(text)
+    if text[pos] != "<":
+        return _scan_text(text, pos, n)
+    nxt = text[pos + 1] if pos + 1 < n else ""
+    if nxt == "/":
+        return _scan_end_tag(text, pos, n)
+    if nxt == "!":
+        if text.startswith("<!--", pos):
+            return _scan_delimited(text, pos, n, Kind.COMMENT, "<!--", "-->", "comment")
+        if text.startswith("<![CDATA[", pos):
+            return _scan_delimited(text, pos, n, Kind.CDATA, "<![CDATA[", "]]>", "CDATA section")
+        if text.startswith("<!DOCTYPE", pos):
+            return _scan_doctype(text, pos, n)
+        end = text.find(">", pos)
+        length = (end + 1 if end != -1 else n) - pos
+        return Token(
+            Kind.STRAY,
+            length,
+            max(length, 9) + 1,
+            closed=False,
+            problems=(Problem(0, min(2, length), XML_SYNTAX, "Unknown markup declaration"),),
+        )
+    if nxt == "?":
+        return _scan_delimited(text, pos, n, Kind.PI, "<?", "?>", "processing instruction")
+    if nxt and nxt not in _NAME_STOP:
+        return _scan_start(text, pos, n)
+    return Token(
+        Kind.STRAY,
+        1,
+        2,
+        closed=False,
+        problems=(Problem(0, 1, XML_SYNTAX, "'<' does not start a tag; write '&lt;'"),),
+    )
+
+
+@dataclass(slots=True)
+class Scan:
+    """The tokens of a text and their absolute start offsets."""
+
+    tokens: list[Token]
+    starts: list[int]
+
+    def index_at(self, offset: int) -> int:
+        """Index of the token containing ``offset`` (the last token for offsets past it)."""
+        return max(0, bisect_right(self.starts, offset) - 1)
+
+
+def scan(text: str) -> Scan:
+    tokens: list[Token] = []
+    starts: list[int] = []
+    pos, n = 0, len(text)
+    while pos < n:
+        tok = scan_token(text, pos)
+        tokens.append(tok)
+        starts.append(pos)
+        pos += tok.length
+    return Scan(tokens, starts)
+
+
+@dataclass(frozen=True, slots=True)
+class Rescan:
+    """What an incremental re-scan replaced: old tokens ``[first, old_stop)`` became new
+    tokens ``[first, new_stop)``; every other token is the same object as before."""
+
+    first: int
+    old_stop: int
+    new_stop: int
+
+
+def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> tuple[Scan, Rescan]:
+    """Update ``old`` for the edit that replaced old ``[start, old_end)`` with ``new_len``
+    code points, giving ``new_text``.  Re-scans only around the edit."""
+    tokens, starts = old.tokens, old.starts
+    delta = new_len - (old_end - start)
+    if not tokens:
+        full = scan(new_text)
+        return full, Rescan(0, 0, len(full.tokens))
+    # First token whose scan may have looked at the edited region.
+    first = old.index_at(start)
+    lo = max(0, first - 8)
+    for k in range(first - 1, lo - 1, -1):
+        if starts[k] + tokens[k].reach > start:
+            first = k
+    if first > 0 and starts[first] == start:
+        # An insertion at a token boundary may extend the previous token.
+        first -= 1
+    pos = starts[first]
+    new_end = start + new_len
+    n = len(new_text)
+    new_tokens: list[Token] = []
+    new_starts: list[int] = []
+    k = first  # candidate old token to resynchronise with
+    nold = len(tokens)
+    while pos < n:
+        if pos >= new_end:
+            old_pos = pos - delta
+            if old_pos >= old_end:
+                while k < nold and starts[k] < old_pos:
+                    k += 1
+                if k < nold and starts[k] == old_pos:
+                    tail_starts = [s + delta for s in starts[k:]] if delta else starts[k:]
+                    result = Scan(
+                        tokens[:first] + new_tokens + tokens[k:],
+                        starts[:first] + new_starts + tail_starts,
+                    )
+                    return result, Rescan(first, k, first + len(new_tokens))
+        tok = scan_token(new_text, pos)
+        new_tokens.append(tok)
+        new_starts.append(pos)
+        pos += tok.length
+    result = Scan(tokens[:first] + new_tokens, starts[:first] + new_starts)
+    return result, Rescan(first, nold, first + len(new_tokens))

@@ -1,0 +1,291 @@
+"""Line index and LSP position conversion over Python strings.
+
+Offsets are code-point indices into a ``str``. Positions are ``(line, character)`` pairs
+where ``character`` counts code units of the negotiated position encoding: UTF-8 bytes,
+UTF-16 code units (a character outside the Basic Multilingual Plane counts 2) or UTF-32
+code units (code points).
+
+Only LSP's line ends are line ends: ``\\n``, ``\\r\\n`` and ``\\r``. ``str.splitlines``
+also splits on U+2028, U+2029, U+0085, ``\\x0b``, ``\\x0c`` and ``\\x1c``-``\\x1e``; here
+those are ordinary characters.
+
+Conversions clamp instead of raising, so positions sent by a client never crash a caller.
+This module is pure: it does not import any LSP library.
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_left, bisect_right
+from itertools import accumulate, count
+from operator import add
+from typing import Final, Literal
+
+__all__ = ["Encoding", "LineIndex", "normalize_encoding"]
+
+Encoding = Literal["utf-8", "utf-16", "utf-32"]
+
+_ENCODINGS: Final[dict[str, Encoding]] = {
+    "utf-8": "utf-8",
+    "utf8": "utf-8",
+    "utf-16": "utf-16",
+    "utf16": "utf-16",
+    "utf-32": "utf-32",
+    "utf32": "utf-32",
+}
+
+# Codec name (no byte-order mark) and bytes per code unit, per encoding.
+_CODECS: Final[dict[str, tuple[str, int]]] = {
+    "utf-8": ("utf-8", 1),
+    "utf-16": ("utf-16-le", 2),
+    "utf-32": ("utf-32-le", 4),
+}
+
+
+def normalize_encoding(value: object) -> Encoding:
+    """Map a position encoding to an :data:`Encoding`.
+
+    Accepts lsprotocol's ``PositionEncodingKind`` members (a ``str`` enum) and plain
+    strings such as ``"utf-8"``, case-insensitively. Anything else means ``"utf-16"``,
+    LSP's default.
+    """
+    raw = getattr(value, "value", value)
+    if isinstance(raw, str):
+        return _ENCODINGS.get(raw.strip().lower(), "utf-16")
+    return "utf-16"
+
+
+def _line_starts(text: str) -> list[int]:
+    """Offsets of every line start after the first (which is always 0), in C-level loops."""
+    if "\r" in text:
+        # Same length, and every line end becomes one "\n" at its last character.
+        text = text.replace("\r\n", " \n").replace("\r", "\n")
+    pieces = text.split("\n")
+    pieces.pop()
+    # Line k + 1 starts after k + 1 pieces and k + 1 "\n"s.
+    return list(map(add, accumulate(map(len, pieces)), count(1)))
+
+
+def _unit_width(char: str, encoding: Encoding) -> int:
+    """Code units of one code point (a lone surrogate counts as one code point)."""
+    code = ord(char)
+    if encoding == "utf-16":
+        return 2 if code > 0xFFFF else 1
+    if encoding == "utf-8":
+        if code < 0x80:
+            return 1
+        if code < 0x800:
+            return 2
+        return 3 if code < 0x10000 else 4
+    return 1
+
+
+class LineIndex:
+    """Line starts of a text, and conversions between offsets and LSP positions.
+
+    Lines are numbered from 0. A text with ``n`` line ends has ``n + 1`` lines; the last
+    one is empty when the text ends with a line end. A ``\\r\\n`` pair is one line end.
+    """
+
+    __slots__ = ("_starts", "_text")
+
+    _text: str
+    _starts: list[int]
+
+    def __init__(self, text: str) -> None:
+        self._text = text
+        self._starts = [0]
+        self._starts.extend(_line_starts(text))
+
+    @classmethod
+    def _from_parts(cls, text: str, starts: list[int]) -> LineIndex:
+        index = cls.__new__(cls)
+        index._text = text
+        index._starts = starts
+        return index
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, LineIndex):
+            return NotImplemented
+        return self._text == other._text and self._starts == other._starts
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"LineIndex(<{len(self._text)} chars, {len(self._starts)} lines>)"
+
+    # -- lines -------------------------------------------------------------------------
+
+    @property
+    def text(self) -> str:
+        return self._text
+
+    @property
+    def line_count(self) -> int:
+        return len(self._starts)
+
+    @property
+    def line_starts(self) -> tuple[int, ...]:
+        """Offset of the first character of every line."""
+        return tuple(self._starts)
+
+    def line_start(self, line: int) -> int:
+        """Offset where ``line`` starts; clamped to the first and last line."""
+        starts = self._starts
+        if line <= 0:
+            return 0
+        if line >= len(starts):
+            return starts[-1]
+        return starts[line]
+
+    def line_end(self, line: int) -> int:
+        """Offset of ``line``'s terminator (``len(text)`` for the last line).
+
+        The line's content is ``text[line_start(line):line_end(line)]``. ``line`` is
+        clamped to the first and last line.
+        """
+        starts = self._starts
+        if line < 0:
+            line = 0
+        if line >= len(starts) - 1:
+            return len(self._text)
+        nxt = starts[line + 1]
+        if self._text[nxt - 1] == "\n" and nxt >= 2 and self._text[nxt - 2] == "\r":
+            return nxt - 2
+        return nxt - 1
+
+    def line_text(self, line: int) -> str:
+        """The content of ``line`` without its terminator."""
+        return self._text[self.line_start(line) : self.line_end(line)]
+
+    def line_of(self, offset: int) -> int:
+        """The line holding ``offset`` (clamped to ``[0, len(text)]``)."""
+        offset = min(max(offset, 0), len(self._text))
+        return bisect_right(self._starts, offset) - 1
+
+    # -- conversions -------------------------------------------------------------------
+
+    def position(self, offset: int, encoding: Encoding) -> tuple[int, int]:
+        """``(line, character)`` of ``offset``, clamped to ``[0, len(text)]``.
+
+        An offset on a line terminator, including between the ``\\r`` and ``\\n`` of a
+        pair, is the end of its line. The end of the text is on the last line, which is
+        the empty line after a trailing line end.
+        """
+        text = self._text
+        offset = min(max(offset, 0), len(text))
+        line = bisect_right(self._starts, offset) - 1
+        start = self._starts[line]
+        if offset > start and text[offset - 1] == "\r" and text[offset : offset + 1] == "\n":
+            offset -= 1  # between "\r" and "\n": the end of the line
+        if encoding == "utf-32":
+            return line, offset - start
+        segment = text[start:offset]
+        if segment.isascii():
+            return line, offset - start
+        codec, unit = _CODECS[encoding]
+        return line, len(segment.encode(codec, "surrogatepass")) // unit
+
+    def offset(self, line: int, character: int, encoding: Encoding) -> int:
+        """The offset of a position; the inverse of :meth:`position`.
+
+        Never raises: a negative line is the start of the text, a line past the last is
+        the end of the text, a negative character is the start of the line, a character
+        past the end of the line is the line's end (before its terminator), and a
+        character inside a code point (half of a UTF-16 surrogate pair, inside a UTF-8
+        multi-byte sequence) rounds down to the start of that code point.
+        """
+        if line < 0:
+            return 0
+        if line >= len(self._starts):
+            return len(self._text)
+        start = self._starts[line]
+        if character <= 0:
+            return start
+        end = self.line_end(line)
+        if encoding == "utf-32":
+            return min(start + character, end)
+        # A code point is at least one code unit, so `character` units span at most
+        # `character` code points.
+        segment = self._text[start : min(start + character, end)]
+        if segment.isascii():
+            return start + len(segment)
+        codec, unit = _CODECS[encoding]
+        try:
+            data = segment.encode(codec)
+        except UnicodeEncodeError:
+            return start + self._count_code_points(segment, character, encoding)
+        # Decoding drops a code point cut in half at the end, which rounds down.
+        return start + len(data[: character * unit].decode(codec, "ignore"))
+
+    @staticmethod
+    def _count_code_points(segment: str, character: int, encoding: Encoding) -> int:
+        """How many whole code points of ``segment`` fit in ``character`` code units.
+
+        The slow path, for text holding lone surrogates (which strict codecs reject).
+        """
+        units = 0
+        for taken, char in enumerate(segment):
+            units += _unit_width(char, encoding)
+            if units > character:
+                return taken
+        return len(segment)
+
+    def range_to_offsets(
+        self,
+        start_line: int,
+        start_char: int,
+        end_line: int,
+        end_char: int,
+        encoding: Encoding,
+    ) -> tuple[int, int]:
+        """``(start, end)`` offsets of a range, each clamped like :meth:`offset`."""
+        return (
+            self.offset(start_line, start_char, encoding),
+            self.offset(end_line, end_char, encoding),
+        )
+
+    def offsets_to_range(
+        self, start: int, end: int, encoding: Encoding
+    ) -> tuple[int, int, int, int]:
+        """``(start_line, start_char, end_line, end_char)`` of two offsets."""
+        start_line, start_char = self.position(start, encoding)
+        end_line, end_char = self.position(end, encoding)
+        return start_line, start_char, end_line, end_char
+
+    # -- incremental update ------------------------------------------------------------
+
+    def edited(self, start: int, end: int, new_text: str, new_full_text: str) -> LineIndex:
+        """The index of ``new_full_text``: this text with ``[start:end)`` replaced.
+
+        Line starts before and after the edit are reused; only the replaced span and the
+        characters next to it are scanned again (a ``\\r`` before the edit and a ``\\n``
+        after it may now form one line end, and an edit may split a ``\\r\\n``).
+        Raises ``ValueError`` if the arguments do not describe such an edit.
+        """
+        old = self._text
+        if not 0 <= start <= end <= len(old):
+            raise ValueError(f"edit [{start}:{end}) outside a text of length {len(old)}")
+        new_end = start + len(new_text)
+        if len(new_full_text) != len(old) - (end - start) + len(new_text) or (
+            new_full_text[start:new_end] != new_text
+        ):
+            raise ValueError("new_full_text is not the text with the edit applied")
+
+        starts = self._starts
+        # A line start p depends only on the characters at p - 1 and p. Those are unchanged
+        # for old starts p < start and p > end, so only [start, new_end] is rescanned, from
+        # one character before it to one character after it.
+        keep_before = bisect_left(starts, start)
+        keep_after = bisect_right(starts, end)
+        lo = max(start - 1, 0)
+        hi = min(new_end + 1, len(new_full_text))
+        rescanned = [lo + rel for rel in _line_starts(new_full_text[lo:hi]) if lo + rel <= new_end]
+
+        result = starts[:keep_before] if keep_before else [0]
+        result.extend(rescanned)
+        delta = new_end - end
+        if delta:
+            result.extend(map(delta.__add__, starts[keep_after:]))
+        else:
+            result.extend(starts[keep_after:])
+        return LineIndex._from_parts(new_full_text, result)

@@ -1,0 +1,170 @@
+"""The scanner: tolerant, position-exact, incremental."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bt_lsp.scanner import Kind, decode_value, rescan, scan
+
+# Text built from the pieces that matter to a tag scanner, so hypothesis reaches the
+# interesting states (half tags, quotes, references) far more often than with raw text.
+PIECES = [
+    "<",
+    ">",
+    "/>",
+    "</",
+    "<!--",
+    "-->",
+    "<![CDATA[",
+    "]]>",
+    "<?",
+    "?>",
+    "<!DOCTYPE r [",
+    "]>",
+    '"',
+    "'",
+    "=",
+    " ",
+    "\n",
+    "\r\n",
+    "\r",
+    "\t",
+    "&",
+    "&amp;",
+    "&#x20;",
+    "&#1;",
+    "&bogus;",
+    "a",
+    "Seq",
+    "ID",
+    "name",
+    "x.y",
+    "é",
+    "😋",
+    "\x00",
+    "\x07",
+    "<root>",
+    "</root>",
+    '<A b="1"/>',
+    "<Sequence>",
+    "</Sequence>",
+    "\n  <B",
+    "<1",
+]
+xmlish = st.lists(st.sampled_from(PIECES) | st.text(max_size=3), max_size=40).map("".join)
+
+
+def check_spans(text: str) -> None:
+    s = scan(text)
+    pos = 0
+    for start, tok in zip(s.starts, s.tokens, strict=True):
+        assert start == pos and tok.length > 0 and tok.reach >= tok.length
+        pos += tok.length
+        if tok.kind in (Kind.START, Kind.END) and tok.name:
+            assert text[start + tok.name_start : start + tok.name_end] == tok.name
+        for a in tok.attrs:
+            assert text[start + a.name_start : start + a.name_end] == a.name
+            if a.value is not None:
+                raw = text[start + a.value_start : start + a.value_end]
+                assert decode_value(raw, 0, None) == a.value
+        for p in tok.problems:
+            assert 0 <= p.start <= p.end <= tok.length
+    assert pos == len(text)
+
+
+@given(xmlish)
+@settings(max_examples=400)
+def test_never_raises_and_spans_slice_their_token(text: str) -> None:
+    check_spans(text)
+
+
+@given(st.text())
+def test_arbitrary_unicode(text: str) -> None:
+    check_spans(text)
+
+
+@given(xmlish, st.data())
+@settings(max_examples=500)
+def test_incremental_equals_full_scan(text: str, data: st.DataObject) -> None:
+    old = scan(text)
+    for _ in range(3):
+        start = data.draw(st.integers(0, len(text)))
+        end = data.draw(st.integers(start, len(text)))
+        insert = data.draw(xmlish)
+        new_text = text[:start] + insert + text[end:]
+        new, _info = rescan(old, new_text, start, end, len(insert))
+        full = scan(new_text)
+        assert new.starts == full.starts
+        assert new.tokens == full.tokens
+        text, old = new_text, new
+
+
+def test_incremental_reuses_tokens_far_from_the_edit() -> None:
+    body = "".join(f'  <Action ID="A{i}" x="{i}"/>\n' for i in range(2000))
+    text = f'<root><BehaviorTree ID="T">\n{body}</BehaviorTree></root>'
+    old = scan(text)
+    at = text.index('"A1000"') + 2
+    new_text = text[:at] + "9" + text[at:]
+    new, info = rescan(old, new_text, at, at, 1)
+    assert info.new_stop - info.first <= 3
+    assert new.tokens[-1] is old.tokens[-1]
+    assert new.tokens == scan(new_text).tokens
+
+
+def test_names_in_unterminated_tags_are_found() -> None:
+    text = '<root>\n  <Open.Door door.id="x"\n  <Sequence>\n</root>'
+    s = scan(text)
+    starts = [t for t in s.tokens if t.kind == Kind.START]
+    assert [t.name for t in starts] == ["root", "Open.Door", "Sequence"]
+    assert starts[1].attrs[0].name == "door.id"
+    assert not starts[1].closed
+
+
+def test_unterminated_value_stops_before_next_tag_line() -> None:
+    text = '<root>\n  <A name="oops\n  <B x="1"/>\n</root>'
+    names = [t.name for t in scan(text).tokens if t.kind == Kind.START]
+    assert names == ["root", "A", "B"]
+
+
+def test_references_decoded_raw_span_kept() -> None:
+    text = '<A name="a&amp;b&#x20;c&#1;"/>'
+    (tok,) = scan(text).tokens
+    a = tok.attrs[0]
+    assert a.value == "a&b c\x01"
+    assert text[a.value_start : a.value_end] == "a&amp;b&#x20;c&#1;"
+
+
+def test_raw_amp_and_lt_are_warnings_not_errors() -> None:
+    (tok,) = scan('<A _while="a && b<1.0"/>').tokens
+    assert {p.code for p in tok.problems} == {"xml-unescaped-char"}
+    assert tok.attrs[0].value == "a && b<1.0"
+
+
+def test_doctype_is_skipped_not_expanded() -> None:
+    text = (
+        '<!DOCTYPE lolz [<!ENTITY lol "lol"><!ENTITY lol2 "&lol;&lol;">'
+        '<!ENTITY x SYSTEM "file:///etc/passwd">]>\n<root a="&lol2;&x;"/>'
+    )
+    s = scan(text)
+    assert s.tokens[0].kind == Kind.DOCTYPE
+    assert s.tokens[0].problems[0].code == "xml-doctype"
+    root = s.tokens[2]
+    assert root.attrs[0].value == "&lol2;&x;"
+
+
+def test_comments_cdata_pi_are_single_tokens() -> None:
+    text = "<!-- <A/> --><![CDATA[<B/>]]><?xml version='1.0'?>"
+    assert [t.kind for t in scan(text).tokens] == [Kind.COMMENT, Kind.CDATA, Kind.PI]
+
+
+def test_deep_nesting_is_linear_and_never_recurses() -> None:
+    depth = 100_000
+    text = "<A>" * depth + "</A>" * depth
+    s = scan(text)
+    assert len(s.tokens) == 2 * depth
+
+
+def test_stray_lt_and_nul() -> None:
+    s = scan("a < b\x00<")
+    assert [t.kind for t in s.tokens] == [Kind.TEXT, Kind.STRAY, Kind.TEXT, Kind.STRAY]
