@@ -1,12 +1,11 @@
-"""Diagnostics of a document: lexical problems, XML structure, and the name rules.
-
-Further rule families (BehaviorTree.CPP semantics) add their findings through
-:data:`EXTRA_CHECKS`; each is a pure function of the document's model.
+"""Diagnostics that depend on one document alone: lexical problems, XML structure and
+the name rules.  They are cached on the document; rules that also need the rest of the
+workspace live in :mod:`bt_lsp.semantics` and are combined in :mod:`bt_lsp.analysis`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import TYPE_CHECKING, Any
@@ -80,18 +79,11 @@ def lexical_diagnostics(scan: Scan) -> list[Diagnostic]:
     return out
 
 
-Check = Callable[["Document"], Iterable[Diagnostic]]
-#: Rule families beyond names and syntax register here (see bt_lsp.semantics).
-EXTRA_CHECKS: list[Check] = []
-
-
 def compute(doc: Document) -> list[Diagnostic]:
     model = doc.model
     out = lexical_diagnostics(doc.scan)
     out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
     out.extend(name_diagnostics(model))
-    for check in EXTRA_CHECKS:
-        out.extend(check(doc))
     out.sort(key=lambda d: (d.start, d.end, d.code))
     return out
 

@@ -7,6 +7,8 @@ the tokens when first asked for.
 
 from __future__ import annotations
 
+import re
+
 from bt_lsp.diagnostics import Diagnostic, compute
 from bt_lsp.model import Model, build
 from bt_lsp.scanner import Scan, rescan, scan
@@ -48,3 +50,12 @@ class Document:
         if self._diagnostics is None:
             self._diagnostics = compute(self)
         return self._diagnostics
+
+
+_BT_MARKERS = re.compile(r"<(?:BehaviorTree|TreeNodesModel)[\s/>]|<root[\s/>]")
+
+
+def looks_like_bt(text: str) -> bool:
+    """Whether a text is BT XML (a ``<root>``, ``<BehaviorTree>`` or ``<TreeNodesModel>``
+    element), so that other XML files (launch files, package.xml) get no diagnostics."""
+    return _BT_MARKERS.search(text) is not None

@@ -1,0 +1,351 @@
+"""Syntax check for BehaviorTree.CPP's scripting language.
+
+The language is used by ``<Script code>``, ``<ScriptCondition code>``, ``<Precondition if>``
+and the ``_skipIf _successIf _failureIf _while _onSuccess _onFailure _onHalted _post``
+attributes. :func:`check_script` reports the first syntax error that BehaviorTree.CPP 4.10
+(the hand-written tokenizer + Pratt parser that replaced the lexy grammar) would report,
+as a code-point range into the script text.
+
+Grammar, as BehaviorTree.CPP 4.10 reads it:
+
+* a script is one or more expressions separated by ``;``; extra ``;`` between statements
+  and after the last one are allowed, a leading ``;`` is not; an empty script is an error;
+* white space is space, TAB, LF and CR only, anywhere between tokens;
+* operands: integers (``42``, ``0x1F``), reals (``3.14``, ``1e3``, ``2.5E-3``), strings in
+  single quotes (no escapes; anything but ``'`` inside), ``true``/``false``, identifiers
+  (ASCII letter, ``_`` or ``@`` first, then ASCII letters, digits and ``_``: blackboard
+  keys, ``@root_keys`` and enum names), and parenthesised expressions;
+* prefix operators ``-`` ``!`` ``~``; binary operators ``* /``, ``+ -``, ``..`` (string
+  concatenation), ``& | ^``, ``== != < <= > >=`` (chainable), ``&& ||``, the ternary
+  ``c ? a : b`` and the assignments ``:= = += -= *= /=``;
+* everything else is an error: double quotes, ``%``, ``,``, ``.5``, ``and``/``or``/``not``
+  used as operators (they are identifiers), a backslash, non-ASCII characters outside
+  strings, numbers with a suffix (``3foo``, ``65.``, ``0x``).
+
+Precedence decides the shape of the tree, never whether a script parses, so the check is
+a linear, non-recursive state machine (operand expected / operator expected) with an
+explicit stack for ``(`` and ``?``. The messages follow BehaviorTree.CPP's form, e.g.
+``Expected operand at position 4 (got '==')``; "position" there is BehaviorTree.CPP's
+byte offset into the UTF-8 script, while :class:`ScriptError` offsets are code points.
+
+``legacy=True`` also accepts what the lexy-based parser of BehaviorTree.CPP 4.0-4.9
+accepted and 4.10 rejects: ``"double-quoted"`` strings, non-ASCII identifiers and a
+backslash-newline line continuation (a backslash followed by any white space, since an XML
+parser normalizes a newline inside an attribute value to a space). A caller can check strictly first and re-check with
+``legacy=True`` to tell "breaks with 4.10" from "broken everywhere".
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Final
+
+__all__ = ["ScriptError", "check_script"]
+
+
+@dataclass(frozen=True, slots=True)
+class ScriptError:
+    """A syntax error: ``code[offset:end]`` is the offending character or token.
+
+    At the end of the script ``offset == end == len(code)``.
+    """
+
+    offset: int
+    end: int
+    message: str
+
+
+# Token kinds
+_ATOM: Final = 0  # number, string, true/false, identifier
+_LPAREN: Final = 1
+_RPAREN: Final = 2
+_QUESTION: Final = 3
+_COLON: Final = 4
+_SEMI: Final = 5
+_BINARY: Final = 6  # every binary operator except '-'
+_MINUS: Final = 7  # binary or prefix
+_PREFIX: Final = 8  # '!' and '~'
+_EOF: Final = 9
+_ERROR: Final = 10
+
+_WHITESPACE: Final = frozenset(" \t\n\r")
+_DIGITS: Final = frozenset("0123456789")
+_HEX_DIGITS: Final = frozenset("0123456789abcdefABCDEF")
+_ASCII_LETTERS: Final = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")
+_IDENT_START: Final = _ASCII_LETTERS | {"_", "@"}
+_IDENT_CHAR: Final = _ASCII_LETTERS | _DIGITS | {"_"}
+
+_TWO_CHAR_OPS: Final = {
+    "..": _BINARY,
+    "&&": _BINARY,
+    "||": _BINARY,
+    "==": _BINARY,
+    "!=": _BINARY,
+    "<=": _BINARY,
+    ">=": _BINARY,
+    ":=": _BINARY,
+    "+=": _BINARY,
+    "-=": _BINARY,
+    "*=": _BINARY,
+    "/=": _BINARY,
+}
+_ONE_CHAR_OPS: Final = {
+    "+": _BINARY,
+    "-": _MINUS,
+    "*": _BINARY,
+    "/": _BINARY,
+    "&": _BINARY,
+    "|": _BINARY,
+    "^": _BINARY,
+    "~": _PREFIX,
+    "!": _PREFIX,
+    "<": _BINARY,
+    ">": _BINARY,
+    "=": _BINARY,
+    "?": _QUESTION,
+    ":": _COLON,
+    "(": _LPAREN,
+    ")": _RPAREN,
+    ";": _SEMI,
+}
+
+_MAX_SHOWN: Final = 24
+_WORD_OPERATORS: Final = {"and": "&&", "or": "||"}
+
+
+@dataclass(frozen=True, slots=True)
+class _Token:
+    kind: int
+    start: int
+    end: int
+    problem: str = ""  # for _ERROR: what is wrong (the position is added after it)
+    hint: str = ""  # for _ERROR: appended after the position
+
+
+def check_script(code: str, *, legacy: bool = False) -> ScriptError | None:
+    """The first syntax error in ``code``, or ``None`` if BehaviorTree.CPP parses it.
+
+    ``code`` is the decoded attribute value (XML entities already replaced). Never raises;
+    time and memory are linear in ``len(code)``.
+    """
+    try:
+        return _Checker(code, legacy).run()
+    except Exception as exc:  # pragma: no cover - defensive: a checker must never crash
+        return ScriptError(0, len(code), f"Internal error while checking the script: {exc}")
+
+
+class _Checker:
+    def __init__(self, code: str, legacy: bool) -> None:
+        self.code = code
+        self.legacy = legacy
+
+    # -- reporting ---------------------------------------------------------------------
+
+    def position(self, offset: int) -> int:
+        """BehaviorTree.CPP's position: the UTF-8 byte offset of ``offset``."""
+        return len(self.code[:offset].encode("utf-8", "surrogatepass"))
+
+    def shown(self, token: _Token) -> str:
+        if token.kind == _EOF:
+            return "end of input"
+        text = self.code[token.start : token.end]
+        if len(text) > _MAX_SHOWN:
+            text = text[: _MAX_SHOWN - 3] + "..."
+        return f"'{text}'"
+
+    def error(self, token: _Token, what: str, extra: str = "") -> ScriptError:
+        message = f"{what} at position {self.position(token.start)} (got {self.shown(token)})"
+        return ScriptError(token.start, token.end, message + extra)
+
+    def lexical_error(self, token: _Token) -> ScriptError:
+        message = f"{token.problem} at position {self.position(token.start)}{token.hint}"
+        return ScriptError(token.start, token.end, message)
+
+    def unclosed(self, token: _Token, stack: list[tuple[int, int]]) -> ScriptError:
+        kind, start = stack[-1]
+        if kind == _LPAREN:
+            return self.error(
+                token, "Expected ')'", f"; '(' at position {self.position(start)} is not closed"
+            )
+        return self.error(
+            token, "Expected ':'", f"; '?' at position {self.position(start)} has no ':'"
+        )
+
+    # -- parsing -----------------------------------------------------------------------
+
+    def run(self) -> ScriptError | None:
+        tokens = self.tokens()
+        stack: list[tuple[int, int]] = []  # (_LPAREN or _QUESTION, start offset)
+        expect_operand = True
+        first = True
+        token = next(tokens)
+        while True:
+            kind = token.kind
+            if kind == _ERROR:
+                return self.lexical_error(token)
+            if expect_operand:
+                if kind == _ATOM:
+                    expect_operand = False
+                elif kind == _LPAREN:
+                    stack.append((_LPAREN, token.start))
+                elif kind in (_MINUS, _PREFIX):
+                    pass
+                elif kind == _EOF and first:
+                    return ScriptError(0, len(self.code), "Empty Script")
+                else:
+                    return self.error(token, "Expected operand")
+            elif kind in (_BINARY, _MINUS):
+                expect_operand = True
+            elif kind == _QUESTION:
+                stack.append((_QUESTION, token.start))
+                expect_operand = True
+            elif kind == _COLON:
+                if not stack or stack[-1][0] != _QUESTION:
+                    if stack:
+                        return self.unclosed(token, stack)
+                    return self.error(token, "Expected ';' or end of script")
+                stack.pop()
+                expect_operand = True
+            elif kind == _RPAREN:
+                if not stack:
+                    return ScriptError(
+                        token.start,
+                        token.end,
+                        f"Unmatched ')' at position {self.position(token.start)}",
+                    )
+                if stack[-1][0] != _LPAREN:
+                    return self.unclosed(token, stack)
+                stack.pop()
+            elif kind in (_SEMI, _EOF):
+                if stack:
+                    return self.unclosed(token, stack)
+                while kind == _SEMI:
+                    token = next(tokens)
+                    kind = token.kind
+                if kind == _EOF:
+                    return None
+                expect_operand = True
+                continue  # the token after the ';' starts the next statement
+            elif stack:
+                return self.unclosed(token, stack)
+            else:
+                word = self.code[token.start : token.end]
+                hint = f"; use '{_WORD_OPERATORS[word]}' instead" if word in _WORD_OPERATORS else ""
+                return self.error(token, "Expected ';' or end of script", hint)
+            first = False
+            token = next(tokens)
+
+    # -- tokenizing --------------------------------------------------------------------
+
+    def tokens(self) -> Iterator[_Token]:
+        """Tokens of ``code``, then ``_EOF`` forever."""
+        code = self.code
+        n = len(code)
+        i = 0
+        while i < n:
+            c = code[i]
+            if c in _WHITESPACE:
+                i += 1
+                continue
+            if c == "\\" and self.legacy and code[i + 1 : i + 2] in _WHITESPACE:
+                i += 2  # line continuation (an XML parser may have turned its LF into a space)
+                continue
+            start = i
+            if c == "'" or (c == '"' and self.legacy):
+                close = code.find(c, i + 1)
+                if close < 0:
+                    yield _Token(_ERROR, start, n, "Unterminated string")
+                    return
+                i = close + 1
+                yield _Token(_ATOM, start, i)
+            elif c in _DIGITS:
+                i, bad = self.scan_number(i)
+                if bad:
+                    yield _Token(_ERROR, start, i, f"Invalid number '{code[start:i]}'")
+                    return
+                yield _Token(_ATOM, start, i)
+            elif self.is_ident_start(c):
+                i += 1
+                while i < n and self.is_ident_char(code[i]):
+                    i += 1
+                yield _Token(_ATOM, start, i)
+            elif code[i : i + 2] in _TWO_CHAR_OPS:
+                i += 2
+                yield _Token(_TWO_CHAR_OPS[code[start:i]], start, i)
+            elif c in _ONE_CHAR_OPS:
+                i += 1
+                yield _Token(_ONE_CHAR_OPS[c], start, i)
+            else:
+                shown = f"'{c}'" if c.isprintable() else f"U+{ord(c):04X}"
+                hint = self.invalid_character_hint(c, start)
+                yield _Token(_ERROR, start, start + 1, f"Invalid character {shown}", hint)
+                return
+        while True:
+            yield _Token(_EOF, n, n)
+
+    def is_ident_start(self, c: str) -> bool:
+        if c in _IDENT_START:
+            return True
+        return self.legacy and c > "\x7f" and c.isidentifier()
+
+    def is_ident_char(self, c: str) -> bool:
+        if c in _IDENT_CHAR:
+            return True
+        return self.legacy and c > "\x7f" and ("a" + c).isidentifier()
+
+    def invalid_character_hint(self, c: str, offset: int) -> str:
+        if c == '"':
+            return "; strings are written in single quotes"
+        if c == "\\" and self.code[offset + 1 : offset + 2] in _WHITESPACE:
+            return "; a backslash line continuation is not needed, remove it"
+        if c == "." and self.code[offset + 1 : offset + 2] in _DIGITS:
+            return "; write a number as 0.5, not .5"
+        return ""
+
+    def scan_number(self, i: int) -> tuple[int, bool]:
+        """Scan a number starting at ``code[i]`` (a digit): (end, malformed)."""
+        code = self.code
+        n = len(code)
+        if code[i] == "0" and code[i + 1 : i + 2] in ("x", "X"):
+            i += 2
+            bad = i >= n or code[i] not in _HEX_DIGITS
+            while i < n and code[i] in _HEX_DIGITS:
+                i += 1
+            if i < n and (code[i] == "." or code[i] in _IDENT_CHAR):
+                bad = True
+                i = self.skip_garbage(i)
+            return i, bad
+        bad = False
+        while i < n and code[i] in _DIGITS:
+            i += 1
+        if i < n and code[i] == ".":
+            following = code[i + 1 : i + 2]
+            if following == ".":
+                pass  # "65..x" is 65 followed by the '..' operator
+            elif following != "" and following in _DIGITS:
+                i += 1
+                while i < n and code[i] in _DIGITS:
+                    i += 1
+            else:
+                bad = True  # "65." or "65.x"
+                i = self.skip_garbage(i + 1)
+        if not bad and i < n and code[i] in "eE":
+            i += 1
+            if i < n and code[i] in "+-":
+                i += 1
+            if i >= n or code[i] not in _DIGITS:
+                bad = True
+            while i < n and code[i] in _DIGITS:
+                i += 1
+        if not bad and i < n and code[i] in _IDENT_START:
+            bad = True  # "3foo"
+            while i < n and code[i] in _IDENT_CHAR:
+                i += 1
+        return i, bad
+
+    def skip_garbage(self, i: int) -> int:
+        code = self.code
+        while i < len(code) and (code[i] in _IDENT_CHAR or code[i] == "."):
+            i += 1
+        return i

@@ -1,0 +1,14 @@
+"""The language server: a thin LSP front end over the pure core."""
+
+from __future__ import annotations
+
+
+def serve(tcp: bool = False, host: str = "127.0.0.1", port: int = 2087) -> None:
+    """Run the server on stdio (default) or TCP until the client says ``exit``."""
+    from bt_lsp.server.app import create_server
+
+    server = create_server()
+    if tcp:
+        server.start_tcp(host, port)
+    else:
+        server.start_io()

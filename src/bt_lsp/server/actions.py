@@ -1,0 +1,133 @@
+"""textDocument/codeAction and codeAction/resolve: quick fixes and fix-all.
+
+Fixes come from the server's own diagnostics in the requested range, never from the
+client's copies (Neovim 0.7 sends byte columns there).  When the client can resolve
+edits lazily, actions carry only a reference to their fix and the edit is built on
+``codeAction/resolve``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from lsprotocol import types
+
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.edits import TextEdit
+from bt_lsp.fixes import Fix, fix_all, fixes_for
+from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit
+from bt_lsp.server.state import OpenDocument
+
+if TYPE_CHECKING:
+    from bt_lsp.server.app import BtServer
+
+FIX_ALL_KIND = "source.fixAll.bt-lsp"
+
+
+def _wants(only: Sequence[str] | None, kind: str) -> bool:
+    """Whether a requested ``only`` list admits ``kind`` (kinds are dot-separated
+    hierarchies: ``source.fixAll`` admits ``source.fixAll.bt-lsp``)."""
+    if not only:
+        return True
+    return any(kind == k or kind.startswith(k + ".") for k in only)
+
+
+def _workspace_edit(
+    ls: BtServer, od: OpenDocument, edits: Sequence[TextEdit]
+) -> types.WorkspaceEdit:
+    enc = ls.encoding
+    lsp_edits = [to_text_edit(od.doc.lines, e, enc) for e in edits]
+    if ls.versioned_edits:
+        return types.WorkspaceEdit(
+            document_changes=[
+                types.TextDocumentEdit(
+                    text_document=types.OptionalVersionedTextDocumentIdentifier(
+                        uri=od.uri, version=od.version
+                    ),
+                    edits=list(lsp_edits),
+                )
+            ]
+        )
+    return types.WorkspaceEdit(changes={od.uri: list(lsp_edits)})
+
+
+def _all_fixes(od: OpenDocument, diag: Diagnostic) -> list[Fix]:
+    return fixes_for(od.doc.model, diag)
+
+
+def _fix_all_edits(ls: BtServer, od: OpenDocument) -> list[TextEdit]:
+    return fix_all(od.doc.model, ls.diagnostics_of(od))
+
+
+def register(server: BtServer) -> None:
+    @server.feature(
+        types.TEXT_DOCUMENT_CODE_ACTION,
+        types.CodeActionOptions(
+            code_action_kinds=[types.CodeActionKind.QuickFix, FIX_ALL_KIND],
+            resolve_provider=True,
+        ),
+    )
+    def code_action(
+        ls: BtServer, params: types.CodeActionParams
+    ) -> list[types.CodeAction | types.Command] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return []
+        enc = ls.encoding
+        lines = od.doc.lines
+        start, end = to_offsets(lines, params.range, enc)
+        only = params.context.only
+        diags = ls.diagnostics_of(od)
+        actions: list[types.CodeAction | types.Command] = []
+        if _wants(only, types.CodeActionKind.QuickFix):
+            for d in diags:
+                if d.start > end or d.end < start:
+                    continue
+                for i, fix in enumerate(_all_fixes(od, d)):
+                    action = types.CodeAction(
+                        title=fix.title,
+                        kind=types.CodeActionKind.QuickFix,
+                        diagnostics=[to_diagnostic(lines, d, enc)],
+                        is_preferred=fix.preferred,
+                    )
+                    if ls.resolve_edits:
+                        action.data = {
+                            "uri": od.uri,
+                            "version": od.version,
+                            "start": d.start,
+                            "end": d.end,
+                            "code": d.code,
+                            "index": i,
+                        }
+                    else:
+                        action.edit = _workspace_edit(ls, od, fix.edits)
+                    actions.append(action)
+        if _wants(only, FIX_ALL_KIND) and any(d.is_name_rule for d in diags):
+            action = types.CodeAction(title="Fix all bt-lsp name problems", kind=FIX_ALL_KIND)
+            if ls.resolve_edits:
+                action.data = {"uri": od.uri, "version": od.version, "fixAll": True}
+            else:
+                action.edit = _workspace_edit(ls, od, _fix_all_edits(ls, od))
+            actions.append(action)
+        return actions
+
+    @server.feature(types.CODE_ACTION_RESOLVE)
+    def resolve(ls: BtServer, action: types.CodeAction) -> types.CodeAction:
+        data: Any = action.data
+        if not isinstance(data, dict):
+            return action
+        od = ls.get(str(data.get("uri")))
+        if od is None or od.version != data.get("version"):
+            return action  # the document changed; the client asks again
+        if data.get("fixAll"):
+            action.edit = _workspace_edit(ls, od, _fix_all_edits(ls, od))
+            return action
+        for d in ls.diagnostics_of(od):
+            if (d.start, d.end, d.code) == (data.get("start"), data.get("end"), data.get("code")):
+                fixes = _all_fixes(od, d)
+                index = data.get("index")
+                if isinstance(index, int) and 0 <= index < len(fixes):
+                    action.edit = _workspace_edit(ls, od, fixes[index].edits)
+                break
+        return action

@@ -1,0 +1,228 @@
+"""The bt-lsp language server: state, lifecycle and settings.
+
+Each LSP feature lives in its own module and only translates between LSP types and the
+core; this module owns the open documents and when diagnostics are published.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import traceback
+from typing import Any
+
+from lsprotocol import types
+from pygls.lsp.server import LanguageServer
+
+from bt_lsp import __version__
+from bt_lsp.analysis import analyze
+from bt_lsp.codes import CODES
+from bt_lsp.diagnostics import Diagnostic, make, with_severities
+from bt_lsp.server.convert import to_diagnostic
+from bt_lsp.server.protocol import BtProtocol
+from bt_lsp.server.state import OpenDocument
+from bt_lsp.settings import Settings
+from bt_lsp.text import Encoding, normalize_encoding
+
+log = logging.getLogger(__name__)
+
+SECTION = "btLsp"
+
+
+class BtServer(LanguageServer):
+    def __init__(self) -> None:
+        super().__init__(
+            "bt-lsp",
+            __version__,
+            protocol_cls=BtProtocol,
+            text_document_sync_kind=types.TextDocumentSyncKind.Incremental,
+        )
+        self.docs: dict[str, OpenDocument] = {}
+        self.settings = Settings()
+        self.pull_diagnostics = False
+        self.configuration_support = False
+        self.refresh_support = False
+        self.resolve_edits = False
+        self.versioned_edits = False
+        self.generation = 0  # bumped when settings change; part of every resultId
+        self._timers: dict[str, asyncio.TimerHandle] = {}
+
+    # -- state ----------------------------------------------------------------------------
+
+    @property
+    def encoding(self) -> Encoding:
+        try:
+            return normalize_encoding(self.workspace.position_encoding)
+        except RuntimeError:  # before initialize
+            return "utf-16"
+
+    def get(self, uri: str) -> OpenDocument | None:
+        return self.docs.get(uri)
+
+    def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
+        """The document's diagnostics after severity settings, cached per version."""
+        key = (od.version, self.generation)
+        if od.cache_key == key:
+            return od.cached
+        if not od.is_bt:
+            result: list[Diagnostic] = []
+        else:
+            size = len(od.doc.text.encode("utf-8", "surrogatepass"))
+            if size > self.settings.max_document_bytes:
+                result = list(od.doc.diagnostics)
+                result.append(
+                    make(
+                        0,
+                        0,
+                        "document-too-large",
+                        f"Document is {size} bytes, above btLsp.maxDocumentBytes "
+                        f"({self.settings.max_document_bytes}): only XML and name checks run",
+                    )
+                )
+            else:
+                result = analyze(od.doc)
+            result = with_severities(result, self.settings.severity)
+        od.cache_key, od.cached = key, result
+        return result
+
+    def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
+        enc = self.encoding
+        return [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
+
+    # -- publishing -------------------------------------------------------------------------
+
+    def schedule(self, uri: str) -> None:
+        """Diagnostics are due for ``uri``: push them after the debounce delay (clients
+        that pull are told nothing; they ask after each change)."""
+        if self.pull_diagnostics:
+            return
+        timer = self._timers.pop(uri, None)
+        if timer is not None:
+            timer.cancel()
+        delay = self.settings.debounce_ms / 1000
+        if delay <= 0:
+            self.publish(uri)
+            return
+        loop = asyncio.get_running_loop()
+        self._timers[uri] = loop.call_later(delay, self.publish, uri)
+
+    def publish(self, uri: str) -> None:
+        self._timers.pop(uri, None)
+        od = self.docs.get(uri)
+        if od is None:
+            return
+        try:
+            diags = self.lsp_diagnostics(od)
+        except Exception:  # a bug must not stop the server; say so in its log
+            self.log_error(f"computing diagnostics for {uri}")
+            return
+        self.text_document_publish_diagnostics(
+            types.PublishDiagnosticsParams(uri=uri, diagnostics=diags, version=od.version)
+        )
+
+    def clear(self, uri: str) -> None:
+        timer = self._timers.pop(uri, None)
+        if timer is not None:
+            timer.cancel()
+        if not self.pull_diagnostics:
+            self.text_document_publish_diagnostics(
+                types.PublishDiagnosticsParams(uri=uri, diagnostics=[])
+            )
+
+    def settings_changed(self) -> None:
+        self.generation += 1
+        if self.pull_diagnostics:
+            if self.refresh_support:
+                self.workspace_diagnostic_refresh(None)
+        else:
+            for uri in list(self.docs):
+                self.publish(uri)
+
+    # -- logging ----------------------------------------------------------------------------
+
+    def log_message(self, message: str, kind: types.MessageType = types.MessageType.Log) -> None:
+        try:
+            self.window_log_message(types.LogMessageParams(type=kind, message=message))
+        except Exception:  # no client connected yet
+            log.warning("%s", message)
+
+    def log_error(self, what: str) -> None:
+        self.log_message(
+            f"bt-lsp: error {what}:\n{traceback.format_exc()}", types.MessageType.Error
+        )
+
+    def report_server_error(self, error: Exception, source: Any) -> None:
+        """Log internal errors to the client's log instead of popping up messages; requests
+        are answered with a JSON-RPC error by pygls itself."""
+        self.log_message(
+            f"bt-lsp: internal error ({getattr(source, '__name__', source)}): {error!r}",
+            types.MessageType.Error,
+        )
+
+    # -- settings ---------------------------------------------------------------------------
+
+    def apply_settings(self, raw: object) -> None:
+        problems: list[str] = []
+        self.settings = Settings.parse(raw, problems)
+        for p in problems:
+            self.log_message(f"bt-lsp settings: {p}", types.MessageType.Warning)
+
+    async def fetch_settings(self) -> None:
+        if not self.configuration_support:
+            return
+        try:
+            result = await self.workspace_configuration_async(
+                types.ConfigurationParams(items=[types.ConfigurationItem(section=SECTION)])
+            )
+        except Exception:
+            self.log_error("reading workspace/configuration")
+            return
+        if result and result[0] is not None:
+            self.apply_settings(result[0])
+
+
+def create_server() -> BtServer:
+    from bt_lsp.server import actions, documents, hover
+
+    server = BtServer()
+
+    @server.feature(types.INITIALIZE)
+    def initialize(ls: BtServer, params: types.InitializeParams) -> None:
+        caps = params.capabilities
+        td = caps.text_document
+        ls.pull_diagnostics = td is not None and td.diagnostic is not None
+        ws = caps.workspace
+        ls.configuration_support = bool(ws and ws.configuration)
+        ls.refresh_support = bool(ws and ws.diagnostics and ws.diagnostics.refresh_support)
+        ls.versioned_edits = bool(ws and ws.workspace_edit and ws.workspace_edit.document_changes)
+        ca = td.code_action if td else None
+        ls.resolve_edits = bool(
+            ca and ca.resolve_support and "edit" in ca.resolve_support.properties
+        )
+        if params.initialization_options is not None:
+            ls.apply_settings(params.initialization_options)
+
+    @server.feature(types.INITIALIZED)
+    async def initialized(ls: BtServer, params: types.InitializedParams) -> None:
+        if ls.configuration_support:
+            await ls.fetch_settings()
+            ls.settings_changed()
+
+    @server.feature(types.WORKSPACE_DID_CHANGE_CONFIGURATION)
+    async def did_change_configuration(
+        ls: BtServer, params: types.DidChangeConfigurationParams
+    ) -> None:
+        raw = params.settings
+        if isinstance(raw, dict) and isinstance(raw.get(SECTION), dict):
+            ls.apply_settings(raw[SECTION])
+        elif ls.configuration_support:
+            await ls.fetch_settings()
+        ls.settings_changed()
+
+    documents.register(server)
+    actions.register(server)
+    hover.register(server)
+    return server
+
+
+__all__ = ["CODES", "BtServer", "OpenDocument", "create_server"]

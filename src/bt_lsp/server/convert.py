@@ -1,0 +1,39 @@
+"""Conversions between the core's code-point offsets and LSP positions and types."""
+
+from __future__ import annotations
+
+from lsprotocol import types
+
+from bt_lsp.codes import CODES
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.edits import TextEdit
+from bt_lsp.text import Encoding, LineIndex
+
+
+def to_range(lines: LineIndex, start: int, end: int, enc: Encoding) -> types.Range:
+    sl, sc = lines.position(start, enc)
+    el, ec = lines.position(end, enc)
+    return types.Range(types.Position(sl, sc), types.Position(el, ec))
+
+
+def to_offsets(lines: LineIndex, rng: types.Range, enc: Encoding) -> tuple[int, int]:
+    start = lines.offset(rng.start.line, rng.start.character, enc)
+    end = lines.offset(rng.end.line, rng.end.character, enc)
+    return (start, end) if start <= end else (end, start)
+
+
+def to_diagnostic(lines: LineIndex, d: Diagnostic, enc: Encoding) -> types.Diagnostic:
+    info = CODES.get(d.code)
+    return types.Diagnostic(
+        range=to_range(lines, d.start, d.end, enc),
+        message=d.message,
+        severity=types.DiagnosticSeverity(int(d.severity)),
+        code=d.code,
+        code_description=types.CodeDescription(href=info.url) if info else None,
+        source="bt-lsp",
+        data=dict(d.data) if d.data is not None else None,
+    )
+
+
+def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit:
+    return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)

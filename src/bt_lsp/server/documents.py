@@ -1,0 +1,70 @@
+"""Document sync (open, incremental change, close) and pulled diagnostics."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from lsprotocol import types
+
+from bt_lsp.document import Document
+from bt_lsp.server.convert import to_offsets
+from bt_lsp.server.state import OpenDocument
+
+if TYPE_CHECKING:
+    from bt_lsp.server.app import BtServer
+
+
+def register(server: BtServer) -> None:
+    @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
+    def did_open(ls: BtServer, params: types.DidOpenTextDocumentParams) -> None:
+        item = params.text_document
+        od = OpenDocument(item.uri, Document(item.text, item.uri), item.version, item.language_id)
+        od.refresh_kind()
+        ls.docs[item.uri] = od
+        ls.schedule(item.uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
+    def did_change(ls: BtServer, params: types.DidChangeTextDocumentParams) -> None:
+        uri = params.text_document.uri
+        od = ls.get(uri)
+        if od is None:
+            ls.log_message(f"bt-lsp: didChange for a document that is not open: {uri}")
+            return
+        enc = ls.encoding
+        was_bt = od.is_bt
+        for change in params.content_changes:
+            if isinstance(change, types.TextDocumentContentChangePartial):
+                start, end = to_offsets(od.doc.lines, change.range, enc)
+                od.doc.edit(start, end, change.text)
+            else:
+                od.doc.replace_all(change.text)
+        od.version = params.text_document.version
+        od.refresh_kind()
+        if was_bt and not od.is_bt:
+            ls.clear(uri)
+        ls.schedule(uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
+    def did_close(ls: BtServer, params: types.DidCloseTextDocumentParams) -> None:
+        uri = params.text_document.uri
+        if ls.docs.pop(uri, None) is not None:
+            ls.clear(uri)
+
+    @server.feature(
+        types.TEXT_DOCUMENT_DIAGNOSTIC,
+        types.DiagnosticOptions(
+            identifier="bt-lsp", inter_file_dependencies=True, workspace_diagnostics=False
+        ),
+    )
+    def diagnostic(
+        ls: BtServer, params: types.DocumentDiagnosticParams
+    ) -> types.DocumentDiagnosticReport:
+        od = ls.get(params.text_document.uri)
+        if od is None:
+            return types.RelatedFullDocumentDiagnosticReport(items=[], result_id=None)
+        result_id = f"{od.version}:{ls.generation}"
+        if params.previous_result_id == result_id and od.cache_key is not None:
+            return types.RelatedUnchangedDocumentDiagnosticReport(result_id=result_id)
+        return types.RelatedFullDocumentDiagnosticReport(
+            items=ls.lsp_diagnostics(od), result_id=result_id
+        )

@@ -1,0 +1,31 @@
+"""textDocument/hover: why a name breaks a rule, or what a name is."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from lsprotocol import types
+
+from bt_lsp.hover import hover_at
+from bt_lsp.server.convert import to_range
+
+if TYPE_CHECKING:
+    from bt_lsp.server.app import BtServer
+
+
+def register(server: BtServer) -> None:
+    @server.feature(types.TEXT_DOCUMENT_HOVER)
+    def hover(ls: BtServer, params: types.HoverParams) -> types.Hover | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        enc = ls.encoding
+        lines = od.doc.lines
+        offset = lines.offset(params.position.line, params.position.character, enc)
+        found = hover_at(od.doc, offset)
+        if found is None:
+            return None
+        return types.Hover(
+            contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=found.markdown),
+            range=to_range(lines, found.start, found.end, enc),
+        )

@@ -1,0 +1,23 @@
+"""What the server knows about one open document."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.document import Document, looks_like_bt
+
+
+@dataclass(slots=True)
+class OpenDocument:
+    uri: str
+    doc: Document
+    version: int | None
+    language_id: str
+    is_bt: bool = False
+    # Diagnostics cached for (version, settings/workspace generation).
+    cache_key: tuple[int | None, int] | None = None
+    cached: list[Diagnostic] = field(default_factory=list)
+
+    def refresh_kind(self) -> None:
+        self.is_bt = looks_like_bt(self.doc.text)
