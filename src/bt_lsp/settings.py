@@ -24,15 +24,17 @@ class Settings:
     model_files: tuple[str, ...] = ()
 
     @classmethod
-    def parse(cls, raw: object, problems: list[str] | None = None) -> Settings:
+    def parse(cls, raw: Any, problems: list[str] | None = None) -> Settings:
         """Settings from the client's JSON (``btLsp`` section or initializationOptions)."""
         problems = problems if problems is not None else []
         if not isinstance(raw, Mapping):
             if raw is not None:
                 problems.append("btLsp settings must be an object")
             return cls()
-        if isinstance(raw.get("btLsp"), Mapping):
-            raw = raw["btLsp"]
+        section: Mapping[str, Any] = raw
+        if isinstance(section.get("btLsp"), Mapping):
+            section = section["btLsp"]
+        raw = section
         kw: dict[str, Any] = {}
         debounce = raw.get("debounceMs")
         if debounce is not None:
