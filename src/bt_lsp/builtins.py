@@ -554,7 +554,7 @@ def _convert_real(value: str, is_float: bool, strict: bool) -> str | None:
 
 
 def _has_nonzero_digit(token: str) -> bool:
-    mantissa = re.split(r"[eEpP]", token.lower().removeprefix("-").removeprefix("+"), 1)[0]
+    mantissa = re.split(r"[eEpP]", token.lower().lstrip("+-"), maxsplit=1)[0]
     mantissa = mantissa.removeprefix("0x")
     return any(c not in "0." for c in mantissa)
 

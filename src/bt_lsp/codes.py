@@ -112,6 +112,14 @@ CODES: dict[str, Code] = {
             "analysis limited because the document is larger than the configured maximum",
             _XML,
         ),
+        # Includes, resolved by the workspace layer.
+        Code(
+            "include-not-found",
+            Severity.ERROR,
+            "an included file does not exist or cannot be read",
+            _BT,
+        ),
+        Code("include-cycle", Severity.ERROR, "files include each other in a cycle", _BT),
     )
 }
 

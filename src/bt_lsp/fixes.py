@@ -5,8 +5,8 @@ Pure: these functions return edits; the front ends decide whether to apply them.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
 
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.edits import TextEdit
@@ -16,10 +16,17 @@ from bt_lsp.sanitize import candidates
 
 @dataclass(frozen=True, slots=True)
 class Fix:
+    """A fix: edits to the document, and to other workspace files by path."""
+
     title: str
     edits: tuple[TextEdit, ...]
     preferred: bool
     diagnostic: Diagnostic
+    other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
+
+    @property
+    def places(self) -> int:
+        return len(self.edits) + sum(len(e) for e in self.other_edits.values())
 
 
 def escape_value(text: str, quote: str) -> str:
@@ -53,15 +60,32 @@ def _namespace(symbol: Symbol) -> tuple[str, ...]:
     return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
 
 
-def taken_names(model: Model, symbol: Symbol | None) -> set[str]:
+def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = ()) -> set[str]:
+    """Names a new name for ``symbol`` must avoid: the others in its namespace, in this
+    document and in the other workspace documents."""
     if symbol is None:
         return set()
     ns = _namespace(symbol)
     return {
         r.symbol[-1]
-        for r in model.refs
+        for m in (model, *others)
+        for r in m.refs
         if r.symbol is not None and _namespace(r.symbol) == ns and r.symbol != symbol
     }
+
+
+def other_file_edits(
+    symbol: Symbol | None, new_name: str, others: Mapping[str, Model]
+) -> dict[str, tuple[TextEdit, ...]]:
+    """The edits renaming ``symbol`` in other workspace documents (by path)."""
+    if symbol is None:
+        return {}
+    out: dict[str, tuple[TextEdit, ...]] = {}
+    for path, m in others.items():
+        refs = m.refs_to(symbol)
+        if refs:
+            out[path] = tuple(rename_edits(refs, new_name))
+    return out
 
 
 def shown(name: str) -> str:
@@ -76,21 +100,32 @@ def _title(old: str, new: str, places: int) -> str:
     return f"Rename '{shown(old)}' to '{shown(new)}' ({where})"
 
 
-def fixes_for(model: Model, diag: Diagnostic) -> list[Fix]:
-    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives."""
+def fixes_for(
+    model: Model, diag: Diagnostic, others: Mapping[str, Model] | None = None
+) -> list[Fix]:
+    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.
+    ``others`` are the other workspace documents' models, by path: references there are
+    renamed too."""
     if not diag.is_name_rule:
         return []
     ref = model.ref_at(diag.start)
     if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
         return []
+    others = others or {}
     occ = occurrences(model, ref)
-    names = candidates(ref.text, ref.kind, taken_names(model, ref.symbol))
+    names = candidates(ref.text, ref.kind, taken_names(model, ref.symbol, others.values()))
     fixes: list[Fix] = []
     for i, new in enumerate(names):
         if new == ref.text:
             continue
         edits = tuple(rename_edits(occ, new))
-        fixes.append(Fix(_title(ref.text, new, len(edits)), edits, i == 0, diag))
+        elsewhere = other_file_edits(ref.symbol, new, others)
+        places = len(edits) + sum(len(e) for e in elsewhere.values())
+        title = _title(ref.text, new, places)
+        if elsewhere:
+            n = len(elsewhere)
+            title = title[:-1] + f", {n} other file{'s' if n > 1 else ''})"
+        fixes.append(Fix(title, edits, i == 0, diag, elsewhere))
     return fixes
 
 

@@ -31,8 +31,9 @@ byte offset into the UTF-8 script, while :class:`ScriptError` offsets are code p
 ``legacy=True`` also accepts what the lexy-based parser of BehaviorTree.CPP 4.0-4.9
 accepted and 4.10 rejects: ``"double-quoted"`` strings, non-ASCII identifiers and a
 backslash-newline line continuation (a backslash followed by any white space, since an XML
-parser normalizes a newline inside an attribute value to a space). A caller can check strictly first and re-check with
-``legacy=True`` to tell "breaks with 4.10" from "broken everywhere".
+parser normalizes a newline inside an attribute value to a space). A caller can check
+strictly first and re-check with ``legacy=True`` to tell "breaks with 4.10" from "broken
+everywhere".
 """
 
 from __future__ import annotations
@@ -152,7 +153,7 @@ class _Checker:
         text = self.code[token.start : token.end]
         if len(text) > _MAX_SHOWN:
             text = text[: _MAX_SHOWN - 3] + "..."
-        return f"'{text}'"
+        return "'" + text.replace("\n", "\\n").replace("\r", "\\r").replace("\t", "\\t") + "'"
 
     def error(self, token: _Token, what: str, extra: str = "") -> ScriptError:
         message = f"{what} at position {self.position(token.start)} (got {self.shown(token)})"

@@ -262,8 +262,10 @@ def test_vscode_squiggle_problems_quick_fix_hover(
     assert len(problems) == 1, context
     assert "bt-lsp" in problems[0] and "Main Tree" in problems[0], context
 
-    # The hover explains the character and shows the replacement.
-    assert "' ' (space)" in result["hover"] and "Main_Tree" in result["hover"], context
+    # The hover (our Markdown, not the problem's message above it) explains the character and
+    # shows the replacement.
+    explanation = "\n".join(part["text"] for part in result["hoverParts"] if not part["marker"])
+    assert "' ' (space)" in explanation and "Main_Tree" in explanation, context
 
     # The preferred quick fix renames the tree and its reference; the problem is gone.
     assert any(a.startswith(FIX_TITLE) and "(2 places)" in a for a in result["actions"]), context

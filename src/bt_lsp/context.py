@@ -1,0 +1,317 @@
+"""What the rest of the workspace provides to the semantic checks of one document.
+
+A :class:`Context` is frozen, plain data and knows nothing of the protocol: the node
+models declared anywhere (``<TreeNodesModel>`` sections of this document, of its includes,
+of other workspace files and of model files named in the settings), the trees visible to
+the document (its own and those of its include closure, sharing one ID namespace as in
+BehaviorTree.CPP), the trees elsewhere in the workspace, and a few settings.
+
+:meth:`Context.from_document` builds one from a document alone; :meth:`Context.combine`
+adds other documents, which the workspace layer reads and resolves (include resolution is
+not done here).  What one document declares is extracted once per model and cached, so
+combining is proportional to the number of declarations, not to the size of the documents.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Final, cast
+
+from bt_lsp.builtins import BUILTINS, Category, Direction, PortModel
+from bt_lsp.model import Element, Model, Zone
+
+if TYPE_CHECKING:
+    from bt_lsp.document import Document
+
+__all__ = ["Context", "DocumentFacts", "ModelDecl", "TreeDecl", "facts_of"]
+
+_EMPTY: Final[Mapping[str, object]] = MappingProxyType({})
+
+_ENTRY_CATEGORIES: Final[frozenset[str]] = frozenset(
+    {"Action", "Condition", "Control", "Decorator", "SubTree"}
+)
+_DIRECTIONS: Final[Mapping[str, Direction]] = MappingProxyType(
+    {"input_port": "input", "output_port": "output", "inout_port": "inout"}
+)
+# Attributes of a model entry that are not ports in the pre-3.x attribute form
+# (``<Action ID="Say" message=""/>``).
+_ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "description"})
+
+
+@dataclass(frozen=True, slots=True)
+class ModelDecl:
+    """A node model (or the port list of a tree) declared in a ``<TreeNodesModel>``.
+
+    ``category`` is the entry's tag.  ``ports`` are :class:`~bt_lsp.builtins.PortModel`
+    values; a port's ``default`` is the ``default`` attribute as written, ``None`` when
+    absent.  ``path`` is the declaring document (``None`` for an unsaved one) and
+    ``start``/``end`` the code-point span of the entry's ``ID`` value (its tag name when it
+    has no ``ID``).
+    """
+
+    id: str
+    category: Category
+    ports: tuple[PortModel, ...]
+    path: str | None
+    start: int
+    end: int
+
+    def port(self, name: str) -> PortModel | None:
+        for p in self.ports:
+            if p.name == name:
+                return p
+        return None
+
+    @property
+    def child_range(self) -> tuple[int, int | None]:
+        """How many children a node of this category takes: (minimum, maximum or None)."""
+        if self.category == "Decorator":
+            return 1, 1
+        if self.category == "Control":
+            return 1, None
+        return 0, 0
+
+
+@dataclass(frozen=True, slots=True)
+class TreeDecl:
+    """A ``<BehaviorTree ID>``: where it is and which trees it calls.
+
+    ``start``/``end`` span the ``ID`` value.  ``calls`` are the IDs of its ``<SubTree>``
+    elements in document order (empty IDs left out) and ``call_spans`` the spans of those
+    ``ID`` values, index for index.
+    """
+
+    id: str
+    path: str | None
+    start: int
+    end: int
+    calls: tuple[str, ...] = ()
+    call_spans: tuple[tuple[int, int], ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class DocumentFacts:
+    """What one document declares, in document order."""
+
+    path: str | None
+    trees: tuple[TreeDecl, ...]
+    models: tuple[ModelDecl, ...]  # Action/Condition/Control/Decorator entries
+    subtree_models: tuple[ModelDecl, ...]  # <SubTree> entries
+
+
+@dataclass(frozen=True, slots=True)
+class Context:
+    """The workspace as one document sees it.
+
+    * ``models``: custom node models by ID (built-in IDs left out: a registered built-in
+      wins over any declaration); the first declaration wins, this document's first.
+    * ``subtree_models``: the ``<TreeNodesModel><SubTree ID>`` entries (a tree's ports).
+    * ``trees``: the trees visible by ID, this document's and its include closure's, in
+      BehaviorTree.CPP's load order (included documents first, this document last, so the
+      last entry is the one BehaviorTree.CPP keeps); several entries mean a duplicate ID.
+    * ``workspace_trees``: trees of other workspace documents that are not included.
+    * ``workspace_has_custom_models``: whether any custom node model is known at all; when
+      not, nodes missing from the models are probably registered in C++ only.
+    * ``ros_pkg_paths``: ROS package name -> share directory (settings).
+    * ``included_by``: paths of workspace documents that include this one.
+    * ``path``: this document's path; declarations with this path are its own.
+    """
+
+    path: str | None = None
+    models: Mapping[str, ModelDecl] = field(
+        default_factory=lambda: cast("Mapping[str, ModelDecl]", _EMPTY)
+    )
+    subtree_models: Mapping[str, ModelDecl] = field(
+        default_factory=lambda: cast("Mapping[str, ModelDecl]", _EMPTY)
+    )
+    trees: Mapping[str, tuple[TreeDecl, ...]] = field(
+        default_factory=lambda: cast("Mapping[str, tuple[TreeDecl, ...]]", _EMPTY)
+    )
+    workspace_trees: Mapping[str, tuple[TreeDecl, ...]] = field(
+        default_factory=lambda: cast("Mapping[str, tuple[TreeDecl, ...]]", _EMPTY)
+    )
+    workspace_has_custom_models: bool = False
+    ros_pkg_paths: Mapping[str, str] = field(
+        default_factory=lambda: cast("Mapping[str, str]", _EMPTY)
+    )
+    included_by: tuple[str, ...] = ()
+
+    def is_own(self, decl: TreeDecl | ModelDecl) -> bool:
+        """Whether ``decl`` is declared in this context's document."""
+        return decl.path == self.path
+
+    @classmethod
+    def from_document(
+        cls,
+        doc: Document,
+        path: str | None = None,
+        *,
+        ros_pkg_paths: Mapping[str, str] | None = None,
+    ) -> Context:
+        """The context of a document that sees nothing but itself."""
+        return cls.combine(doc, (), path=path, ros_pkg_paths=ros_pkg_paths)
+
+    @classmethod
+    def combine(
+        cls,
+        own: Document,
+        others: Iterable[tuple[str, Document, bool]],
+        *,
+        path: str | None = None,
+        ros_pkg_paths: Mapping[str, str] | None = None,
+        included_by: Iterable[str] = (),
+        workspace_has_custom_models: bool | None = None,
+    ) -> Context:
+        """The context of ``own`` among ``others``: ``(path, document, included)`` triples.
+
+        ``included`` is true for documents of ``own``'s include closure (their trees join
+        its namespace; give them in BehaviorTree.CPP's depth-first load order) and false
+        for any other workspace document or model file (only its declarations count; its
+        trees go to ``workspace_trees``).  A document whose path is ``own``'s is skipped.
+        ``workspace_has_custom_models`` defaults to whether any custom model is known.
+        """
+        own_path = path if path is not None else own.path
+        own_facts = facts_of(own, own_path)
+        models: dict[str, ModelDecl] = {}
+        subtree_models: dict[str, ModelDecl] = {}
+        trees: dict[str, list[TreeDecl]] = {}
+        workspace_trees: dict[str, list[TreeDecl]] = {}
+
+        def add_models(f: DocumentFacts) -> None:
+            for m in f.models:
+                if m.id not in BUILTINS:
+                    models.setdefault(m.id, m)
+            for m in f.subtree_models:
+                subtree_models.setdefault(m.id, m)
+
+        add_models(own_facts)
+        included: list[DocumentFacts] = []
+        for other_path, other, in_closure in others:
+            if other_path == own_path:
+                continue
+            f = facts_of(other, other_path)
+            add_models(f)
+            if in_closure:
+                included.append(f)
+            else:
+                for t in f.trees:
+                    workspace_trees.setdefault(t.id, []).append(t)
+        for f in (*included, own_facts):
+            for t in f.trees:
+                trees.setdefault(t.id, []).append(t)
+        has_custom = bool(models) if workspace_has_custom_models is None else (
+            workspace_has_custom_models
+        )
+        return cls(
+            path=own_path,
+            models=MappingProxyType(models),
+            subtree_models=MappingProxyType(subtree_models),
+            trees=MappingProxyType({k: tuple(v) for k, v in trees.items()}),
+            workspace_trees=MappingProxyType({k: tuple(v) for k, v in workspace_trees.items()}),
+            workspace_has_custom_models=has_custom,
+            ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
+            included_by=tuple(included_by),
+        )
+
+
+# --- extraction ---------------------------------------------------------------------------
+
+# Model -> facts, keyed by document; a cached entry is valid while the document's model is
+# the same object (a document builds a new model after every edit).
+_CACHE: weakref.WeakKeyDictionary[Document, tuple[Model, str | None, DocumentFacts]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def facts_of(doc: Document, path: str | None = None) -> DocumentFacts:
+    """What ``doc`` declares (cached per model and path)."""
+    model = doc.model
+    if path is None:
+        path = doc.path
+    hit = _CACHE.get(doc)
+    if hit is not None and hit[0] is model and hit[1] == path:
+        return hit[2]
+    facts = extract(model, path)
+    _CACHE[doc] = (model, path, facts)
+    return facts
+
+
+def _id_span(el: Element) -> tuple[str | None, int, int]:
+    a = el.attr("ID")
+    if a is None or a.value is None:
+        return None, el.name_start, el.name_end
+    s, e = el.span_of_value(a)
+    return a.value, s, e
+
+
+def extract(model: Model, path: str | None) -> DocumentFacts:
+    """One pass over the elements: trees with their calls, and the model entries."""
+    elements = model.elements
+    trees: list[TreeDecl] = []
+    models: list[ModelDecl] = []
+    subtree_models: list[ModelDecl] = []
+    # The tree being read: (id, start, end, calls, spans), or None outside trees.
+    cur: tuple[str, int, int, list[str], list[tuple[int, int]]] | None = None
+    entry: tuple[str, Category, int, int, list[PortModel]] | None = None
+
+    def close_tree() -> None:
+        if cur is not None:
+            trees.append(TreeDecl(cur[0], path, cur[1], cur[2], tuple(cur[3]), tuple(cur[4])))
+
+    def close_entry() -> None:
+        if entry is not None:
+            decl = ModelDecl(entry[0], entry[1], tuple(entry[4]), path, entry[2], entry[3])
+            (subtree_models if entry[1] == "SubTree" else models).append(decl)
+
+    for el in elements:
+        zone = el.zone
+        if zone == Zone.NODE:
+            if el.name == "SubTree" and cur is not None:
+                a = el.attr("ID")
+                if a is not None and a.value:
+                    cur[3].append(a.value)
+                    cur[4].append(el.span_of_value(a))
+        elif zone == Zone.TREE:
+            close_tree()
+            tid, s, e = _id_span(el)
+            cur = (tid, s, e, [], []) if tid else None
+        elif zone == Zone.MODEL_ENTRY:
+            close_tree()
+            cur = None
+            close_entry()
+            entry = None
+            if el.name in _ENTRY_CATEGORIES:
+                mid, s, e = _id_span(el)
+                if mid is not None:
+                    ports: list[PortModel] = []
+                    # The attribute form of very old models: every other attribute a port.
+                    for a in el.attrs:
+                        if a.name not in _ENTRY_NON_PORT_ATTRS and a.value is not None:
+                            ports.append(PortModel(a.name, "input", "", a.value, ""))
+                    entry = (mid, cast("Category", el.name), s, e, ports)
+        elif zone == Zone.PORT_DECL:
+            if entry is not None:
+                pname = el.value("name")
+                if pname is not None:
+                    entry[4].append(
+                        PortModel(
+                            pname,
+                            _DIRECTIONS[el.name],
+                            el.value("type") or "",
+                            el.value("default"),
+                            el.value("description") or "",
+                        )
+                    )
+        elif zone in (Zone.ROOT, Zone.MODELS, Zone.INCLUDE, Zone.OUTSIDE) or (
+            zone == Zone.OTHER and el.depth <= 1
+        ):
+            close_tree()
+            cur = None
+            close_entry()
+            entry = None
+    close_tree()
+    close_entry()
+    return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))

@@ -1,0 +1,290 @@
+"""The workspace: open documents, the BT XML files around them, and their includes.
+
+This is the only layer that reads files.  It resolves ``<include path>`` the way
+BehaviorTree.CPP does (relative to the including file; ``ros_pkg`` through the
+``rosPackages`` setting), finds include cycles, collects the other BT files of the
+workspace folders, and gives each document the :class:`~bt_lsp.context.Context` that the
+semantic rules read.  Files are read lazily and cached by modification time and size.
+Nothing here ever fetches a URL or follows a DOCTYPE.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from bt_lsp.diagnostics import Diagnostic, make
+from bt_lsp.document import Document, looks_like_bt
+from bt_lsp.fileio import FileError, read_text
+from bt_lsp.model import Zone
+from bt_lsp.settings import Settings
+
+# Folders that never hold a project's own trees (build outputs, VCS, dependencies).
+SKIP_DIRS = frozenset(
+    {
+        ".git",
+        ".hg",
+        ".svn",
+        "node_modules",
+        "build",
+        "install",
+        "log",
+        "__pycache__",
+        ".venv",
+        "venv",
+        ".tox",
+        ".mypy_cache",
+        ".ruff_cache",
+        ".pytest_cache",
+    }
+)
+MAX_WORKSPACE_FILES = 5000
+MAX_INCLUDE_FILES = 1000
+
+
+def normalize(path: str | os.PathLike[str]) -> Path:
+    """An absolute, normalized path (``..`` folded lexically, symlinks kept)."""
+    return Path(os.path.normpath(os.path.abspath(os.fspath(path))))
+
+
+@dataclass(frozen=True, slots=True)
+class Include:
+    """One ``<include>`` of a document: the span of its ``path`` value and where it leads."""
+
+    start: int
+    end: int
+    written: str
+    target: Path | None  # None when it cannot be resolved (no path, unknown ros_pkg)
+    ros_pkg: str | None
+
+
+def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
+    out: list[Include] = []
+    for el in doc.model.elements:
+        if el.zone != Zone.INCLUDE:
+            continue
+        a = el.attr("path")
+        if a is None or a.value is None or not a.value.strip():
+            continue  # include-missing-path is a semantic rule of the document itself
+        start, end = el.span_of_value(a)
+        written = a.value.strip()
+        pkg = el.value("ros_pkg")
+        target: Path | None
+        if os.path.isabs(written):
+            target = normalize(written)
+        elif pkg:
+            base = settings.ros_packages.get(pkg)
+            target = normalize(Path(base) / written) if base else None
+        else:
+            target = normalize(path.parent / written)
+        out.append(Include(start, end, written, target, pkg or None))
+    return out
+
+
+class Workspace:
+    def __init__(
+        self, roots: Sequence[str | os.PathLike[str]] = (), settings: Settings | None = None
+    ) -> None:
+        self.roots = [normalize(r) for r in roots]
+        self.settings = settings or Settings()
+        self._open: dict[Path, Document] = {}
+        self._disk: dict[Path, tuple[tuple[int, int], Document | None, str | None]] = {}
+        self._files: list[Path] | None = None
+        self.generation = 0  # bumps whenever a file other than an edited open one changes
+
+    # -- documents --------------------------------------------------------------------------
+
+    def open(self, path: str | os.PathLike[str], doc: Document) -> None:
+        self._open[normalize(path)] = doc
+
+    def close(self, path: str | os.PathLike[str]) -> None:
+        self._open.pop(normalize(path), None)
+        self.generation += 1
+
+    def is_open(self, path: Path) -> bool:
+        return path in self._open
+
+    def document(self, path: Path) -> Document | None:
+        """The open document at ``path``, else the file on disk (cached), else ``None``."""
+        doc = self._open.get(path)
+        if doc is not None:
+            return doc
+        return self._read(path)[0]
+
+    def read_error(self, path: Path) -> str | None:
+        if path in self._open:
+            return None
+        return self._read(path)[1]
+
+    def _read(self, path: Path) -> tuple[Document | None, str | None]:
+        try:
+            st = path.stat()
+        except OSError as e:
+            return None, e.strerror or str(e)
+        if not path.is_file():
+            return None, "not a file"
+        stamp = (st.st_mtime_ns, st.st_size)
+        cached = self._disk.get(path)
+        if cached is not None and cached[0] == stamp:
+            return cached[1], cached[2]
+        try:
+            decoded = read_text(str(path), max_bytes=self.settings.max_document_bytes)
+            doc: Document | None = Document(decoded.text, str(path))
+            err = None
+        except FileError as e:
+            doc, err = None, e.message
+        self._disk[path] = (stamp, doc, err)
+        return doc, err
+
+    def file_changed(self, path: str | os.PathLike[str]) -> None:
+        """A file was created, changed or deleted on disk (workspace/didChangeWatchedFiles)."""
+        p = normalize(path)
+        self._disk.pop(p, None)
+        self._files = None
+        self.generation += 1
+
+    def set_settings(self, settings: Settings) -> None:
+        self.settings = settings
+        self._disk.clear()
+        self.generation += 1
+
+    # -- the workspace's BT files -------------------------------------------------------------
+
+    def files(self) -> list[Path]:
+        """Every BT XML file under the workspace folders and the model files from the
+        settings (sorted; a bounded number, skipping build and VCS folders)."""
+        if self._files is None:
+            found: set[Path] = set()
+            for root in self.roots:
+                for p in _walk_xml(root):
+                    found.add(p)
+                    if len(found) >= MAX_WORKSPACE_FILES:
+                        break
+            for m in self.settings.model_files:
+                mp = Path(m)
+                found.add(
+                    normalize(mp if mp.is_absolute() or not self.roots else self.roots[0] / mp)
+                )
+            self._files = sorted(found)
+        return self._files
+
+    def bt_documents(self) -> Iterator[tuple[Path, Document]]:
+        paths = set(self.files()) | set(self._open)
+        for p in sorted(paths):
+            doc = self.document(p)
+            if doc is not None and (looks_like_bt(doc.text) or p.suffix == ".btproj"):
+                yield p, doc
+
+    # -- includes -----------------------------------------------------------------------------
+
+    def includes(self, path: Path, doc: Document | None = None) -> list[Include]:
+        doc = doc if doc is not None else self.document(path)
+        if doc is None:
+            return []
+        return includes_of(path, doc, self.settings)
+
+    def include_closure(self, path: Path, doc: Document | None = None) -> list[Path]:
+        """Files reachable through includes from ``path`` (not ``path`` itself), in
+        depth-first order; iterative and bounded, cycles are cut."""
+        seen = {path}
+        order: list[Path] = []
+        stack: list[Path] = [
+            inc.target for inc in reversed(self.includes(path, doc)) if inc.target is not None
+        ]
+        while stack and len(order) < MAX_INCLUDE_FILES:
+            p = stack.pop()
+            if p in seen:
+                continue
+            seen.add(p)
+            order.append(p)
+            for inc in reversed(self.includes(p)):
+                if inc.target is not None and inc.target not in seen:
+                    stack.append(inc.target)
+        return order
+
+    def _reaches(self, start: Path, goal: Path) -> list[Path] | None:
+        """A chain of includes from ``start`` to ``goal`` (both included), or None."""
+        parent: dict[Path, Path | None] = {start: None}
+        stack = [start]
+        while stack and len(parent) < MAX_INCLUDE_FILES:
+            p = stack.pop()
+            if p == goal:
+                chain = [p]
+                while parent[chain[-1]] is not None:
+                    prev = parent[chain[-1]]
+                    assert prev is not None
+                    chain.append(prev)
+                return chain[::-1]
+            for inc in self.includes(p):
+                t = inc.target
+                if t is not None and t not in parent:
+                    parent[t] = p
+                    stack.append(t)
+        return None
+
+    def include_diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
+        """``include-not-found`` and ``include-cycle`` for the includes of one document."""
+        out: list[Diagnostic] = []
+        for inc in self.includes(path, doc):
+            if inc.target is None:
+                continue  # no path / unmapped ros_pkg: the document's own rules say so
+            if inc.target == path:
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-cycle",
+                        f"'{inc.written}' includes this file itself; BehaviorTree.CPP "
+                        "recurses until it crashes",
+                    )
+                )
+                continue
+            if self.document(inc.target) is None:
+                why = self.read_error(inc.target) or "cannot be read"
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-not-found",
+                        f"Included file '{inc.written}' not found ({inc.target}: {why})",
+                    )
+                )
+                continue
+            chain = self._reaches(inc.target, path)
+            if chain is not None:
+                names = " → ".join(_short(p, path) for p in [path, *chain])
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-cycle",
+                        f"Include cycle: {names}; BehaviorTree.CPP fails with a "
+                        "misleading 'file not found' or crashes",
+                    )
+                )
+        return out
+
+    def dependents(self, path: Path) -> list[Path]:
+        """Open documents whose include closure contains ``path``."""
+        return [p for p in self._open if p != path and path in self.include_closure(p)]
+
+
+def _short(p: Path, base: Path) -> str:
+    try:
+        return os.path.relpath(p, base.parent)
+    except ValueError:
+        return str(p)
+
+
+def _walk_xml(root: Path) -> Iterable[Path]:
+    if root.is_file():
+        if root.suffix in (".xml", ".btproj"):
+            yield root
+        return
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = sorted(d for d in dirnames if d not in SKIP_DIRS and not d.startswith("."))
+        for f in sorted(filenames):
+            if f.endswith((".xml", ".btproj")):
+                yield normalize(Path(dirpath) / f)

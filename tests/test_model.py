@@ -1,0 +1,129 @@
+"""The BT document model: which token is which kind of name, and what it refers to."""
+
+from __future__ import annotations
+
+import pytest
+
+from bt_lsp.document import Document
+from bt_lsp.model import Role, Zone
+from bt_lsp.names import NameKind
+from tests.marks import unmark
+
+# Every checked name position of the contract is marked; nothing else may be a checked name.
+POSITIONS = [
+    # compact node element names inside trees; their attributes are ports
+    '<root><BehaviorTree ID="⟦T⟧"><⟦MoveBase⟧ ⟦goal⟧="{g}" ⟦speed⟧="1"/></BehaviorTree></root>',
+    # explicit IDs and SubTree IDs; attributes of SubTree calls are ports
+    '<root><BehaviorTree ID="⟦T⟧"><⟦Sequence⟧><Action ID="⟦Go⟧" ⟦to⟧="x"/>'
+    '<SubTree ID="⟦Sub⟧" ⟦target⟧="{t}" _autoremap="true"/></Sequence></BehaviorTree></root>',
+    # instance names are values of name=
+    '<root><BehaviorTree ID="⟦T⟧"><⟦Foo⟧ name="⟦my foo⟧"/></BehaviorTree></root>',
+    # reserved attributes on nodes are not ports
+    '<root><BehaviorTree ID="⟦T⟧"><⟦Foo⟧ _skipIf="a" _while="b" _onSuccess="c" _post="d" '
+    '_description="x" __shared_blackboard="y" _autoremap="1"/></BehaviorTree></root>',
+    # TreeNodesModel entry IDs and port declarations
+    "<root><TreeNodesModel><Action ID=\"⟦Go⟧\"><input_port name=\"⟦to⟧\" type=\"int\"/>"
+    "<output_port name=\"⟦out⟧\"/></Action><SubTree ID=\"⟦Sub⟧\">"
+    "<inout_port name=\"⟦io⟧\" default=\"1\"/></SubTree></TreeNodesModel></root>",
+    # not names: root attributes, include path, comments, CDATA, BehaviorTree attributes
+    '<root BTCPP_format="4" main_tree_to_execute="T"><include path="a b.xml"/>'
+    '<!-- <Bad.Name/> --><BehaviorTree ID="⟦T⟧" _description="d.e"><![CDATA[<X.Y/>]]>'
+    "<⟦AlwaysSuccess⟧/></BehaviorTree></root>",
+    # entity references stay inside the span
+    '<root><BehaviorTree ID="⟦Main&#x20;Tree⟧"><⟦A⟧ name="⟦a&amp;b⟧"/></BehaviorTree></root>',
+]
+
+
+@pytest.mark.parametrize("marked", POSITIONS)
+def test_checked_names_are_exactly_the_contract_positions(marked: str) -> None:
+    text, spans = unmark(marked)
+    model = Document(text).model
+    got = sorted((r.start, r.end) for r in model.refs if r.kind is not None)
+    assert got == spans, [text[s:e] for s, e in got]
+
+
+def roles(marked: str) -> list[tuple[str, Role, NameKind | None, tuple[str, ...] | None]]:
+    text, _ = unmark(marked)
+    return [(r.text, r.role, r.kind, r.symbol) for r in Document(text).model.refs]
+
+
+def test_symbols_link_references_to_their_targets() -> None:
+    text = (
+        '<root main_tree_to_execute="Main"><BehaviorTree ID="Main"><Sequence>'
+        '<Go to="x"></Go><SubTree ID="Sub" p="1"/></Sequence></BehaviorTree>'
+        '<BehaviorTree ID="Sub"><Action ID="Go" to="y"/></BehaviorTree>'
+        '<TreeNodesModel><Action ID="Go"><input_port name="to"/></Action>'
+        '<SubTree ID="Sub"><input_port name="p"/></SubTree></TreeNodesModel></root>'
+    )
+    model = Document(text).model
+    by_symbol: dict[tuple[str, ...], list[Role]] = {}
+    for r in model.refs:
+        if r.symbol is not None:
+            by_symbol.setdefault(r.symbol, []).append(r.role)
+    assert by_symbol[("tree", "Main")] == [Role.MAIN_TREE, Role.TREE_DEF]
+    assert by_symbol[("tree", "Sub")] == [Role.SUBTREE_CALL, Role.TREE_DEF, Role.MODEL_DEF]
+    assert by_symbol[("model", "Go")] == [
+        Role.NODE_TYPE, Role.NODE_TYPE_END, Role.NODE_ID, Role.MODEL_DEF,
+    ]
+    assert by_symbol[("port", "model", "Go", "to")] == [Role.PORT_USE, Role.PORT_USE, Role.PORT_DECL]
+    assert by_symbol[("port", "tree", "Sub", "p")] == [Role.PORT_USE, Role.PORT_DECL]
+
+
+def test_zones() -> None:
+    text = (
+        "<root><include path='x'/><BehaviorTree ID='T'><A><B/></A></BehaviorTree>"
+        "<TreeNodesModel><Action ID='A'><input_port name='p'/><MetadataFields/></Action>"
+        "</TreeNodesModel><Other/></root>"
+    )
+    zones = [(e.name, e.zone) for e in Document(text).model.elements]
+    assert zones == [
+        ("root", Zone.ROOT), ("include", Zone.INCLUDE), ("BehaviorTree", Zone.TREE),
+        ("A", Zone.NODE), ("B", Zone.NODE), ("TreeNodesModel", Zone.MODELS),
+        ("Action", Zone.MODEL_ENTRY), ("input_port", Zone.PORT_DECL),
+        ("MetadataFields", Zone.OTHER), ("Other", Zone.OTHER),
+    ]
+
+
+def xml_errors(text: str) -> list[tuple[str, str]]:
+    doc = Document(text)
+    return [(doc.text[d.start : d.end], d.message) for d in doc.diagnostics
+            if d.code == "xml-syntax"]
+
+
+def test_structure_errors_do_not_cascade() -> None:
+    # A missing end tag is one error, at the unclosed element.
+    errs = xml_errors("<root><BehaviorTree ID='T'><Sequence><A/></BehaviorTree></root>")
+    assert [e[0] for e in errs] == ["Sequence"]
+    # An unterminated start tag is reported once, not again when its parent closes.
+    errs = xml_errors('<root><BehaviorTree ID="T">\n<Open door="x"\n<B/></BehaviorTree></root>')
+    assert [e[0] for e in errs] == ["Open"]
+    # A stray end tag.
+    errs = xml_errors("<root></Nope></root>")
+    assert [e[0] for e in errs] == ["Nope"]
+
+
+def test_well_formed_documents_have_no_syntax_errors() -> None:
+    text = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<!-- c -->\n<root BTCPP_format="4">\n'
+        '  <BehaviorTree ID="T"><Script code="a := 1; b = &apos;x&apos;"/></BehaviorTree>\n'
+        "</root>\n"
+    )
+    assert xml_errors(text) == []
+
+
+def test_raw_amp_and_lt_in_values_are_warnings_only() -> None:
+    doc = Document('<root><BehaviorTree ID="T"><A _while="a && b&lt;1" _skipIf="x<1.0"/>'
+                   "</BehaviorTree></root>")
+    assert {d.code for d in doc.diagnostics} == {"xml-unescaped-char"}
+
+
+def test_invalid_xml_name_characters_not_covered_by_the_name_rules() -> None:
+    errs = xml_errors('<root><BehaviorTree ID="T"><Move(JTC) a="1"/></BehaviorTree></root>')
+    assert errs and errs[0][0] == "("
+    # '.' is a valid XML name character: only the name rule reports it.
+    assert xml_errors('<root><BehaviorTree ID="T"><Open.Door/></BehaviorTree></root>') == []
+
+
+def test_text_outside_root() -> None:
+    errs = xml_errors("<root/>\ntrailing")
+    assert errs == [("trailing", "Text outside the root element")]

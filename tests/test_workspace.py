@@ -1,0 +1,108 @@
+"""The workspace layer: includes, cycles, missing files, the workspace's BT files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from bt_lsp.document import Document
+from bt_lsp.settings import Settings
+from bt_lsp.workspace import Workspace, normalize
+
+
+def tree(body: str = "", includes: tuple[str, ...] = ()) -> str:
+    inc = "".join(f'<include path="{p}"/>' for p in includes)
+    return f'<root BTCPP_format="4">{inc}{body}</root>\n'
+
+
+def write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return normalize(path)
+
+
+def diags(ws: Workspace, path: Path) -> list[tuple[str, str]]:
+    doc = ws.document(path)
+    assert doc is not None
+    return [(d.code, doc.text[d.start : d.end]) for d in ws.include_diagnostics(path, doc)]
+
+
+def test_include_resolved_relative_to_the_including_file(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("trees/b.xml",)))
+    b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
+    c = write(tmp_path / "trees" / "c.xml", tree())
+    ws = Workspace([tmp_path])
+    assert ws.include_closure(a) == [b, c]
+    assert diags(ws, a) == []
+
+
+def test_missing_include_is_flagged_at_its_path(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("nope.xml",)))
+    ws = Workspace([tmp_path])
+    assert diags(ws, a) == [("include-not-found", "nope.xml")]
+
+
+def test_self_include_by_bare_name_is_a_cycle(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("a.xml",)))
+    ws = Workspace([tmp_path])
+    assert diags(ws, a) == [("include-cycle", "a.xml")]
+
+
+def test_every_file_of_a_cycle_is_flagged_at_its_include(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("trees/b.xml",)))
+    b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
+    c = write(tmp_path / "trees" / "c.xml", tree(includes=("../a.xml",)))
+    ws = Workspace([tmp_path])
+    assert diags(ws, a) == [("include-cycle", "trees/b.xml")]
+    assert diags(ws, b) == [("include-cycle", "c.xml")]
+    assert diags(ws, c) == [("include-cycle", "../a.xml")]
+    doc = ws.document(a)
+    assert doc is not None
+    (d,) = ws.include_diagnostics(a, doc)
+    assert "a.xml → trees/b.xml → trees/c.xml → a.xml" in d.message
+
+
+def test_open_document_overrides_disk_and_dependents(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("b.xml",)))
+    b = write(tmp_path / "b.xml", tree())
+    ws = Workspace([tmp_path])
+    ws.open(a, Document(tree(includes=("missing.xml",)), str(a)))
+    assert diags(ws, a) == [("include-not-found", "missing.xml")]
+    ws.open(a, Document(tree(includes=("b.xml",)), str(a)))
+    ws.open(b, Document(tree(), str(b)))
+    assert ws.dependents(b) == [a]
+
+
+def test_file_changed_invalidates_cache(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", tree(includes=("b.xml",)))
+    ws = Workspace([tmp_path])
+    assert diags(ws, a) == [("include-not-found", "b.xml")]
+    write(tmp_path / "b.xml", tree())
+    ws.file_changed(tmp_path / "b.xml")
+    assert diags(ws, a) == []
+
+
+def test_ros_pkg_resolved_through_settings(tmp_path: Path) -> None:
+    a = write(tmp_path / "a.xml", '<root><include ros_pkg="pkg" path="t/b.xml"/></root>')
+    write(tmp_path / "share" / "pkg" / "t" / "b.xml", tree())
+    ws = Workspace([tmp_path], Settings(ros_packages={"pkg": str(tmp_path / "share" / "pkg")}))
+    assert len(ws.include_closure(a)) == 1
+    ws2 = Workspace([tmp_path])
+    assert ws2.include_closure(a) == []  # unmapped: the include-ros-pkg rule reports it
+
+
+def test_workspace_files_skip_build_and_hidden_dirs_and_non_bt(tmp_path: Path) -> None:
+    a = write(tmp_path / "src" / "a.xml", tree())
+    write(tmp_path / "build" / "x.xml", tree())
+    write(tmp_path / ".git" / "y.xml", tree())
+    write(tmp_path / "package.xml", "<package><name>x</name></package>")
+    ws = Workspace([tmp_path])
+    assert [p for p, _ in ws.bt_documents()] == [a]
+
+
+def test_include_closure_is_bounded_and_iterative(tmp_path: Path) -> None:
+    n = 300
+    for i in range(n):
+        write(tmp_path / f"f{i}.xml", tree(includes=(f"f{i + 1}.xml",)))
+    write(tmp_path / f"f{n}.xml", tree())
+    ws = Workspace([tmp_path])
+    assert len(ws.include_closure(normalize(tmp_path / "f0.xml"))) == n
