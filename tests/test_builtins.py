@@ -294,7 +294,11 @@ _OK: list[tuple[str, str]] = [
     ("007", "int"),
     ("12abc", "int"),  # std::from_chars stops at the first non-digit: accepted as 12
     ("1.5", "int"),
-    ("0x10", "int"),  # read as 0: std::from_chars has no "0x" prefix and stops at 'x'
+    ("0x10", "int"),
+    (
+        "-" + "0" * 5000 + "1",
+        "int",
+    ),  # read as 0: std::from_chars has no "0x" prefix and stops at 'x'
     ("4294967295", "unsigned int"),
     ("0", "unsigned int"),
     ("-0", "unsigned int"),
@@ -394,6 +398,7 @@ _BAD: list[tuple[str, str, str]] = [
     ),
     ("1;x;3", "std::vector<int>", "item 'x' is not an integer"),
     (";1", "std::vector<int>", "item '' is not an integer"),
+    ("9" * 5000, "long", f"'{'9' * 5000}' is out of range for a 64-bit integer"),
     ("{}", "int", "'{}' is not an integer"),  # too short to be a blackboard reference
     ("{x", "int", "'{x' is not an integer"),
 ]

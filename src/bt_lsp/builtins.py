@@ -510,7 +510,10 @@ def _leading_int(value: str, unsigned_parse: bool) -> tuple[int | None, bool]:
         j += 1
     if j == i:
         return None, False
-    number = int(value[i:j])
+    digits = value[i:j].lstrip("0") or "0"
+    if len(digits) > 40:  # far outside any 64-bit range; avoids huge int() conversions
+        digits = "9" * 40
+    number = int(digits)
     return (-number if negative else number), j == len(value)
 
 

@@ -249,69 +249,80 @@ def _id_span(el: Element) -> tuple[str | None, int, int]:
 
 def extract(model: Model, path: str | None) -> DocumentFacts:
     """One pass over the elements: trees with their calls, and the model entries."""
-    elements = model.elements
     trees: list[TreeDecl] = []
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
-    # The tree being read: (id, start, end, calls, spans), or None outside trees.
-    cur: tuple[str, int, int, list[str], list[tuple[int, int]]] | None = None
-    entry: tuple[str, Category, int, int, list[PortModel]] | None = None
-
-    def close_tree() -> None:
-        if cur is not None:
-            trees.append(TreeDecl(cur[0], path, cur[1], cur[2], tuple(cur[3]), tuple(cur[4])))
-
-    def close_entry() -> None:
-        if entry is not None:
-            decl = ModelDecl(entry[0], entry[1], tuple(entry[4]), path, entry[2], entry[3])
-            (subtree_models if entry[1] == "SubTree" else models).append(decl)
-
-    for el in elements:
+    tree: _OpenTree | None = None
+    entry: _OpenEntry | None = None
+    for el in model.elements:
         zone = el.zone
         if zone == Zone.NODE:
-            if el.name == "SubTree" and cur is not None:
+            if tree is not None and el.name == "SubTree":
                 a = el.attr("ID")
                 if a is not None and a.value:
-                    cur[3].append(a.value)
-                    cur[4].append(el.span_of_value(a))
-        elif zone == Zone.TREE:
-            close_tree()
+                    tree.calls.append(a.value)
+                    tree.spans.append(el.span_of_value(a))
+            continue
+        if el.depth <= 1 or zone == Zone.MODEL_ENTRY:
+            if tree is not None:
+                trees.append(tree.close(path))
+                tree = None
+            if entry is not None:
+                decl = entry.close(path)
+                (subtree_models if decl.category == "SubTree" else models).append(decl)
+                entry = None
+        if zone == Zone.TREE:
             tid, s, e = _id_span(el)
-            cur = (tid, s, e, [], []) if tid else None
+            if tid:
+                tree = _OpenTree(tid, s, e)
         elif zone == Zone.MODEL_ENTRY:
-            close_tree()
-            cur = None
-            close_entry()
-            entry = None
             if el.name in _ENTRY_CATEGORIES:
                 mid, s, e = _id_span(el)
                 if mid is not None:
-                    ports: list[PortModel] = []
+                    entry = _OpenEntry(mid, cast("Category", el.name), s, e)
                     # The attribute form of very old models: every other attribute a port.
                     for a in el.attrs:
                         if a.name not in _ENTRY_NON_PORT_ATTRS and a.value is not None:
-                            ports.append(PortModel(a.name, "input", "", a.value, ""))
-                    entry = (mid, cast("Category", el.name), s, e, ports)
-        elif zone == Zone.PORT_DECL:
-            if entry is not None:
-                pname = el.value("name")
-                if pname is not None:
-                    entry[4].append(
-                        PortModel(
-                            pname,
-                            _DIRECTIONS[el.name],
-                            el.value("type") or "",
-                            el.value("default"),
-                            el.value("description") or "",
-                        )
+                            entry.ports.append(PortModel(a.name, "input", "", a.value, ""))
+        elif zone == Zone.PORT_DECL and entry is not None:
+            pname = el.value("name")
+            if pname is not None:
+                entry.ports.append(
+                    PortModel(
+                        pname,
+                        _DIRECTIONS[el.name],
+                        el.value("type") or "",
+                        el.value("default"),
+                        el.value("description") or "",
                     )
-        elif zone in (Zone.ROOT, Zone.MODELS, Zone.INCLUDE, Zone.OUTSIDE) or (
-            zone == Zone.OTHER and el.depth <= 1
-        ):
-            close_tree()
-            cur = None
-            close_entry()
-            entry = None
-    close_tree()
-    close_entry()
+                )
+    if tree is not None:
+        trees.append(tree.close(path))
+    if entry is not None:
+        decl = entry.close(path)
+        (subtree_models if decl.category == "SubTree" else models).append(decl)
     return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
+
+
+@dataclass(slots=True)
+class _OpenTree:
+    id: str
+    start: int
+    end: int
+    calls: list[str] = field(default_factory=list)
+    spans: list[tuple[int, int]] = field(default_factory=list)
+
+    def close(self, path: str | None) -> TreeDecl:
+        return TreeDecl(self.id, path, self.start, self.end, tuple(self.calls), tuple(self.spans))
+
+
+@dataclass(slots=True)
+class _OpenEntry:
+    id: str
+    category: Category
+    start: int
+    end: int
+    ports: list[PortModel] = field(default_factory=list)
+
+    def close(self, path: str | None) -> ModelDecl:
+        return ModelDecl(self.id, self.category, tuple(self.ports), path, self.start, self.end)

@@ -101,6 +101,7 @@ _FAST_ATTR_RE = re.compile(
 _VALUE_END_RE = {
     q: re.compile(q + r"|[\r\n][ \t\r\n]*<(?=[A-Za-z_:/!?]|[^\x00-\x7f])") for q in "\"'"
 }
+_STRAY_QUOTE_END = {q: re.compile(f"[{q}<]") for q in "\"'"}
 _UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
 _REF_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
 _PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
@@ -418,11 +419,13 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
                 Problem(i - pos, i + 1 - pos, XML_SYNTAX, f"Unexpected {c!r} in tag '<{name}'")
             )
             if c in "\"'":
-                j = text.find(c, i + 1)
-                i = j + 1 if j != -1 and "<" not in text[i + 1 : j] else i + 1
+                # Skip a stray quoted chunk, but never past the start of another tag.
+                jm = _STRAY_QUOTE_END[c].search(text, i + 1)
+                reach = max(reach, jm.end() if jm is not None else n)
+                i = jm.end() if jm is not None and jm.group(0) == c else i + 1
             else:
                 i += 1
-            reach = max(reach, i)
+                reach = max(reach, i)
             continue
         aname = am.group(0)
         ns, ne = am.start() - pos, am.end() - pos

@@ -224,7 +224,7 @@ function M.clients()
 end
 
 local function client_stopped(client)
-  if client == nil then
+  if client == nil or vim.lsp.get_client_by_id(client.id) == nil then
     return true
   end
   if vim.fn.has("nvim-0.10") == 1 then
@@ -314,7 +314,7 @@ function M.restart()
         buffers[bufnr] = true
       end
     end
-    client.stop()
+    vim.lsp.stop_client(client.id)
   end
   state.clients = {}
   local function start_again()
@@ -339,7 +339,7 @@ function M.restart()
     end
     if running then
       for _, client in ipairs(clients) do
-        client.stop(true)
+        vim.lsp.stop_client(client.id, true)
       end
     end
     timer:stop()

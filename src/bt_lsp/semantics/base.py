@@ -1,0 +1,172 @@
+"""What the rule families share: the state of one check and how a node's model is found."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Final, Literal
+
+from bt_lsp.builtins import BUILTINS, Category, PortModel
+from bt_lsp.codes import CODES, Severity
+from bt_lsp.context import Context
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.model import EXPLICIT_TAGS, Element, Model
+
+if TYPE_CHECKING:
+    from bt_lsp.document import Document
+
+Origin = Literal["builtin", "custom", "subtree"]
+
+
+@dataclass(frozen=True, slots=True)
+class Resolved:
+    """The model of a node type as the checks need it.
+
+    ``origin`` says where it comes from: a built-in of BehaviorTree.CPP (exact), a custom
+    ``<TreeNodesModel>`` entry (what the author declared; BehaviorTree.CPP itself reads the
+    C++ registration), or the ``<SubTree>`` model of a tree.
+    """
+
+    id: str
+    origin: Origin
+    category: Category
+    ports: Mapping[str, PortModel]
+    min_children: int
+    max_children: int | None
+
+    @property
+    def exact(self) -> bool:
+        """Whether BehaviorTree.CPP is known to use exactly this model."""
+        return self.origin != "custom"
+
+
+def resolve_builtin(type_id: str) -> Resolved | None:
+    m = BUILTINS.get(type_id)
+    if m is None:
+        return None
+    return Resolved(
+        m.id,
+        "builtin",
+        m.category,
+        {p.name: p for p in m.ports},
+        m.min_children,
+        m.max_children,
+    )
+
+
+_BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
+    k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None
+}
+
+
+def is_compact(el: Element) -> bool:
+    return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
+
+
+@dataclass(slots=True)
+class State:
+    """One run of the checks over one document."""
+
+    doc: Document
+    ctx: Context
+    model: Model
+    text: str
+    out: list[Diagnostic] = field(default_factory=list)
+    v4: bool = False  # <root> declares BTCPP_format
+    _types: dict[str, Resolved | None] = field(default_factory=dict)
+    _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
+
+    def add(
+        self,
+        start: int,
+        end: int,
+        code: str,
+        message: str,
+        severity: Severity | None = None,
+        data: Mapping[str, Any] | None = None,
+    ) -> None:
+        sev = CODES[code].severity if severity is None else severity
+        self.out.append(Diagnostic(start, end, code, message, sev, data))
+
+    def resolve(self, type_id: str) -> Resolved | None:
+        """The model of node type ``type_id``: built-in first, then a custom declaration."""
+        r = _BUILTIN_RESOLVED.get(type_id)
+        if r is not None:
+            return r
+        if type_id in self._types:
+            return self._types[type_id]
+        decl = self.ctx.models.get(type_id)
+        res: Resolved | None = None
+        if decl is not None:
+            lo, hi = decl.child_range
+            res = Resolved(
+                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi
+            )
+        self._types[type_id] = res
+        return res
+
+    def resolve_subtree(self, tree_id: str) -> Resolved | None:
+        """The ``<TreeNodesModel><SubTree>`` model of tree ``tree_id``, if declared."""
+        if tree_id in self._subtrees:
+            return self._subtrees[tree_id]
+        decl = self.ctx.subtree_models.get(tree_id)
+        res = (
+            None
+            if decl is None
+            else Resolved(decl.id, "subtree", "SubTree", {p.name: p for p in decl.ports}, 0, 0)
+        )
+        self._subtrees[tree_id] = res
+        return res
+
+    def node_type(self, el: Element) -> str | None:
+        """The registration ID a node element asks for (``None`` when it has none)."""
+        if is_compact(el):
+            return el.name
+        return el.value("ID")
+
+
+def quoted(text: str, limit: int = 60) -> str:
+    """``text`` in single quotes for a message, control characters shown, long text cut."""
+    shown = "".join(c if c.isprintable() else f"\\u{ord(c):04x}" for c in text)
+    if len(shown) > limit:
+        shown = shown[: limit - 1] + "…"
+    return f"'{shown}'"
+
+
+def edit_distance(a: str, b: str, limit: int) -> int:
+    """Levenshtein distance of ``a`` and ``b``; any value above ``limit`` is ``limit + 1``."""
+    if abs(len(a) - len(b)) > limit:
+        return limit + 1
+    prev = list(range(len(b) + 1))
+    for i, ca in enumerate(a, 1):
+        cur = [i]
+        best = i
+        for j, cb in enumerate(b, 1):
+            v = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (ca != cb))
+            cur.append(v)
+            best = min(best, v)
+        if best > limit:
+            return limit + 1
+        prev = cur
+    return min(prev[-1], limit + 1)
+
+
+@dataclass(slots=True)
+class BlackboardUse:
+    """The first port that used a blackboard key in a tree: its type and where."""
+
+    type: str  # canonical type name
+    shown: str  # as written
+    exact: bool  # from a built-in model
+    port: str
+    node: str
+
+
+@dataclass(slots=True)
+class TreeScope:
+    """What the checks remember while inside one ``<BehaviorTree>``."""
+
+    element: Element | None
+    subtree_names: dict[str, Element] = field(default_factory=dict)
+    depth_flagged: list[bool] = field(default_factory=lambda: [False])
+    keys: dict[str, BlackboardUse] = field(default_factory=dict)
