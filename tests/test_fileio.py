@@ -204,7 +204,7 @@ def test_write_in_read_only_directory(tmp_path: Path) -> None:
     path.write_bytes(b"<a/>")
     tmp_path.chmod(0o555)
     try:
-        with pytest.raises(FileError, match="cannot write .*Permission denied"):
+        with pytest.raises(FileError, match=r"cannot write .*Permission denied"):
             write_text_atomic(str(path), "<b/>", "utf-8", False)
     finally:
         tmp_path.chmod(0o755)
@@ -223,7 +223,9 @@ _ENCODED = st.sampled_from(
 
 @settings(max_examples=150, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=st.text(st.characters(exclude_categories=["Cs"])), enc=_ENCODED)
-def test_read_then_write_is_byte_identical(tmp_path: Path, text: str, enc: tuple[str, bytes]) -> None:
+def test_read_then_write_is_byte_identical(
+    tmp_path: Path, text: str, enc: tuple[str, bytes]
+) -> None:
     codec, bom = enc
     data = bom + text.encode(codec)
     path = tmp_path / "p.xml"

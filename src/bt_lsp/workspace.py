@@ -15,10 +15,12 @@ from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from bt_lsp.analysis import analyze
+from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic, make
 from bt_lsp.document import Document, looks_like_bt
 from bt_lsp.fileio import FileError, read_text
-from bt_lsp.model import Zone
+from bt_lsp.model import Model, Zone
 from bt_lsp.settings import Settings
 
 # Folders that never hold a project's own trees (build outputs, VCS, dependencies).
@@ -119,16 +121,20 @@ class Workspace:
         return self._read(path)[1]
 
     def _read(self, path: Path) -> tuple[Document | None, str | None]:
+        """Read a file once; it is read again only after :meth:`file_changed` (the server
+        hears of changes through watched-file notifications) or :meth:`refresh`."""
+        cached = self._disk.get(path)
+        if cached is not None:
+            return cached[1], cached[2]
         try:
             st = path.stat()
         except OSError as e:
+            self._disk[path] = ((0, 0), None, e.strerror or str(e))
             return None, e.strerror or str(e)
         if not path.is_file():
+            self._disk[path] = ((0, 0), None, "not a file")
             return None, "not a file"
         stamp = (st.st_mtime_ns, st.st_size)
-        cached = self._disk.get(path)
-        if cached is not None and cached[0] == stamp:
-            return cached[1], cached[2]
         try:
             decoded = read_text(str(path), max_bytes=self.settings.max_document_bytes)
             doc: Document | None = Document(decoded.text, str(path))
@@ -142,6 +148,12 @@ class Workspace:
         """A file was created, changed or deleted on disk (workspace/didChangeWatchedFiles)."""
         p = normalize(path)
         self._disk.pop(p, None)
+        self._files = None
+        self.generation += 1
+
+    def refresh(self) -> None:
+        """Forget everything read from disk (for clients that do not report file changes)."""
+        self._disk.clear()
         self._files = None
         self.generation += 1
 
@@ -265,6 +277,41 @@ class Workspace:
                     )
                 )
         return out
+
+    # -- what one document sees ----------------------------------------------------------------
+
+    def context_for(self, path: Path, doc: Document) -> Context:
+        """The rest of the workspace as ``doc`` (at ``path``) sees it: its include closure
+        (trees join its namespace) and every other BT file (models count)."""
+        closure = self.include_closure(path, doc)
+        in_closure = set(closure)
+        others: list[tuple[str, Document, bool]] = []
+        # BehaviorTree.CPP loads included documents depth-first before the includer.
+        for p in reversed(closure):
+            d = self.document(p)
+            if d is not None:
+                others.append((str(p), d, True))
+        included_by: list[str] = []
+        for p, d in self.bt_documents():
+            if p == path or p in in_closure:
+                continue
+            others.append((str(p), d, False))
+            if any(inc.target == path for inc in self.includes(p, d)):
+                included_by.append(str(p))
+        return Context.combine(doc, others, path=str(path),
+                               ros_pkg_paths=self.settings.ros_packages,
+                               included_by=included_by)
+
+    def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
+        """Every diagnostic of ``doc`` in this workspace."""
+        out = analyze(doc, self.context_for(path, doc))
+        out.extend(self.include_diagnostics(path, doc))
+        out.sort(key=lambda d: (d.start, d.end, d.code))
+        return out
+
+    def other_models(self, path: Path) -> dict[str, Model]:
+        """The models of the other BT documents of the workspace, by path (for renames)."""
+        return {str(p): d.model for p, d in self.bt_documents() if p != path}
 
     def dependents(self, path: Path) -> list[Path]:
         """Open documents whose include closure contains ``path``."""

@@ -28,6 +28,7 @@ from pygls.protocol import default_converter
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
+from bt_lsp.codes import CODES
 from tests.marks import unmark
 
 # The server under test, as users start it.
@@ -232,7 +233,7 @@ class BtClient(LanguageClient):
             TIMEOUT,
         )
 
-    async def diagnostics(self, uri: str, version: int) -> list[types.Diagnostic]:
+    async def diags(self, uri: str, version: int) -> list[types.Diagnostic]:
         """The document's diagnostics at ``version``, pushed or pulled as the client does."""
         if self.pull:
             report = await self.pull_report(uri)
@@ -486,3 +487,18 @@ def key(r: types.Range) -> tuple[int, int, int, int]:
 def summary(diags: Sequence[types.Diagnostic]) -> list[tuple[str, tuple[int, int, int, int]]]:
     """(code, range) of each diagnostic, sorted."""
     return sorted((str(d.code), key(d.range)) for d in diags)
+
+
+# -- diagnostic families --------------------------------------------------------------------
+
+NAME_CODES = frozenset(c for c, info in CODES.items() if info.family == "names")
+XML_CODES = frozenset(c for c, info in CODES.items() if info.family == "xml")
+
+
+def names_only(diags: Sequence[types.Diagnostic]) -> list[types.Diagnostic]:
+    """The name-rule diagnostics (other rule families are tested elsewhere)."""
+    return [d for d in diags if d.code in NAME_CODES]
+
+
+def syntax_and_names(diags: Sequence[types.Diagnostic]) -> list[types.Diagnostic]:
+    return [d for d in diags if d.code in NAME_CODES or d.code in XML_CODES]

@@ -112,6 +112,9 @@ async function main(page) {
   result.squiggle = await page
     .waitForSelector('.editor-instance .squiggly-error', { timeout: SERVER_TIMEOUT })
     .then(() => true, () => false);
+  if (!result.squiggle) {
+    throw new Error(`no error squiggle within ${SERVER_TIMEOUT} ms (is the server running? see its log)`);
+  }
 
   mark('problems view');
   await page.keyboard.press('Control+Shift+M');

@@ -8,16 +8,20 @@ edits lazily, actions carry only a reference to their fix and the edit is built 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from lsprotocol import types
+from pygls.uris import from_fs_path
 
+from bt_lsp import semantics
+from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.edits import TextEdit
 from bt_lsp.fixes import Fix, fix_all, fixes_for
 from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit
 from bt_lsp.server.state import OpenDocument
+from bt_lsp.workspace import normalize
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -34,26 +38,51 @@ def _wants(only: Sequence[str] | None, kind: str) -> bool:
 
 
 def _workspace_edit(
-    ls: BtServer, od: OpenDocument, edits: Sequence[TextEdit]
+    ls: BtServer,
+    od: OpenDocument,
+    edits: Sequence[TextEdit],
+    other_edits: Mapping[str, Sequence[TextEdit]] | None = None,
 ) -> types.WorkspaceEdit:
+    """One edit for the document and, by path, for other workspace files (converted with
+    their own line index; versioned when they are open in the editor)."""
     enc = ls.encoding
-    lsp_edits = [to_text_edit(od.doc.lines, e, enc) for e in edits]
+    per_uri: list[tuple[str, int | None, list[types.TextEdit]]] = [
+        (od.uri, od.version, [to_text_edit(od.doc.lines, e, enc) for e in edits])
+    ]
+    for path, file_edits in (other_edits or {}).items():
+        doc = ls.project.document(normalize(path))
+        if doc is None:
+            continue
+        uri = from_fs_path(path) or path
+        open_doc = ls.get(uri)
+        version = open_doc.version if open_doc is not None else None
+        per_uri.append((uri, version, [to_text_edit(doc.lines, e, enc) for e in file_edits]))
     if ls.versioned_edits:
         return types.WorkspaceEdit(
             document_changes=[
                 types.TextDocumentEdit(
                     text_document=types.OptionalVersionedTextDocumentIdentifier(
-                        uri=od.uri, version=od.version
+                        uri=uri, version=version
                     ),
                     edits=list(lsp_edits),
                 )
+                for uri, version, lsp_edits in per_uri
             ]
         )
-    return types.WorkspaceEdit(changes={od.uri: list(lsp_edits)})
+    return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
 
 
-def _all_fixes(od: OpenDocument, diag: Diagnostic) -> list[Fix]:
-    return fixes_for(od.doc.model, diag)
+def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
+    others = ls.project.other_models(od.path) if od.path is not None else {}
+    fixes = fixes_for(od.doc.model, diag, others)
+    if not diag.is_name_rule:
+        ctx = (
+            ls.project.context_for(od.path, od.doc)
+            if od.path is not None
+            else Context.from_document(od.doc)
+        )
+        fixes += semantics.fixes_for(od.doc, ctx, diag)
+    return fixes
 
 
 def _fix_all_edits(ls: BtServer, od: OpenDocument) -> list[TextEdit]:
@@ -84,7 +113,7 @@ def register(server: BtServer) -> None:
             for d in diags:
                 if d.start > end or d.end < start:
                     continue
-                for i, fix in enumerate(_all_fixes(od, d)):
+                for i, fix in enumerate(_all_fixes(ls, od, d)):
                     action = types.CodeAction(
                         title=fix.title,
                         kind=types.CodeActionKind.QuickFix,
@@ -101,7 +130,7 @@ def register(server: BtServer) -> None:
                             "index": i,
                         }
                     else:
-                        action.edit = _workspace_edit(ls, od, fix.edits)
+                        action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits)
                     actions.append(action)
         if _wants(only, FIX_ALL_KIND) and any(d.is_name_rule for d in diags):
             action = types.CodeAction(title="Fix all bt-lsp name problems", kind=FIX_ALL_KIND)
@@ -125,9 +154,11 @@ def register(server: BtServer) -> None:
             return action
         for d in ls.diagnostics_of(od):
             if (d.start, d.end, d.code) == (data.get("start"), data.get("end"), data.get("code")):
-                fixes = _all_fixes(od, d)
+                fixes = _all_fixes(ls, od, d)
                 index = data.get("index")
                 if isinstance(index, int) and 0 <= index < len(fixes):
-                    action.edit = _workspace_edit(ls, od, fixes[index].edits)
+                    action.edit = _workspace_edit(
+                        ls, od, fixes[index].edits, fixes[index].other_edits
+                    )
                 break
         return action

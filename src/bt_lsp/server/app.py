@@ -13,6 +13,7 @@ from typing import Any
 
 from lsprotocol import types
 from pygls.lsp.server import LanguageServer
+from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
 from bt_lsp.analysis import analyze
@@ -23,6 +24,7 @@ from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.settings import Settings
 from bt_lsp.text import Encoding, normalize_encoding
+from bt_lsp.workspace import Workspace
 
 log = logging.getLogger(__name__)
 
@@ -44,7 +46,10 @@ class BtServer(LanguageServer):
         self.refresh_support = False
         self.resolve_edits = False
         self.versioned_edits = False
+        self.watch_files = False
         self.generation = 0  # bumped when settings change; part of every resultId
+        self.project = Workspace()
+        self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
 
     # -- state ----------------------------------------------------------------------------
@@ -61,7 +66,7 @@ class BtServer(LanguageServer):
 
     def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
         """The document's diagnostics after severity settings, cached per version."""
-        key = (od.version, self.generation)
+        key = (od.version, self.generation, self.project.generation + self.edits)
         if od.cache_key == key:
             return od.cached
         if not od.is_bt:
@@ -79,6 +84,8 @@ class BtServer(LanguageServer):
                         f"({self.settings.max_document_bytes}): only XML and name checks run",
                     )
                 )
+            elif od.path is not None:
+                result = self.project.diagnostics(od.path, od.doc)
             else:
                 result = analyze(od.doc)
             result = with_severities(result, self.settings.severity)
@@ -106,6 +113,14 @@ class BtServer(LanguageServer):
         loop = asyncio.get_running_loop()
         self._timers[uri] = loop.call_later(delay, self.publish, uri)
 
+    def schedule_all(self, uri: str) -> None:
+        """``uri`` changed: its diagnostics are due, and those of the other open BT
+        documents too, whose includes, trees and models it may provide."""
+        self.schedule(uri)
+        for other, od in self.docs.items():
+            if other != uri and od.is_bt:
+                self.schedule(other)
+
     def publish(self, uri: str) -> None:
         self._timers.pop(uri, None)
         od = self.docs.get(uri)
@@ -129,7 +144,18 @@ class BtServer(LanguageServer):
                 types.PublishDiagnosticsParams(uri=uri, diagnostics=[])
             )
 
+    def refresh_all(self) -> None:
+        """The workspace changed: re-publish (or ask pull clients to re-pull) everything."""
+        self.generation += 1
+        if self.pull_diagnostics:
+            if self.refresh_support:
+                self.workspace_diagnostic_refresh(None)
+        else:
+            for uri in list(self.docs):
+                self.schedule(uri)
+
     def settings_changed(self) -> None:
+        self.project.set_settings(self.settings)
         self.generation += 1
         if self.pull_diagnostics:
             if self.refresh_support:
@@ -201,12 +227,48 @@ def create_server() -> BtServer:
         )
         if params.initialization_options is not None:
             ls.apply_settings(params.initialization_options)
+        roots = [f.uri for f in params.workspace_folders or []]
+        if not roots and params.root_uri:
+            roots = [params.root_uri]
+        paths = [p for p in (to_fs_path(r) for r in roots) if p]
+        ls.project = Workspace(paths, ls.settings)
+        ls.watch_files = bool(
+            ws and ws.did_change_watched_files and ws.did_change_watched_files.dynamic_registration
+        )
 
     @server.feature(types.INITIALIZED)
     async def initialized(ls: BtServer, params: types.InitializedParams) -> None:
+        if ls.watch_files:
+            try:
+                await ls.client_register_capability_async(
+                    types.RegistrationParams(
+                        registrations=[
+                            types.Registration(
+                                id="bt-lsp-watched-files",
+                                method=types.WORKSPACE_DID_CHANGE_WATCHED_FILES,
+                                register_options=types.DidChangeWatchedFilesRegistrationOptions(
+                                    watchers=[
+                                        types.FileSystemWatcher(glob_pattern="**/*.xml"),
+                                        types.FileSystemWatcher(glob_pattern="**/*.btproj"),
+                                    ]
+                                ),
+                            )
+                        ]
+                    )
+                )
+            except Exception:
+                ls.log_error("registering for watched-file changes")
         if ls.configuration_support:
             await ls.fetch_settings()
             ls.settings_changed()
+
+    @server.feature(types.WORKSPACE_DID_CHANGE_WATCHED_FILES)
+    def did_change_watched_files(ls: BtServer, params: types.DidChangeWatchedFilesParams) -> None:
+        for change in params.changes:
+            path = to_fs_path(change.uri)
+            if path:
+                ls.project.file_changed(path)
+        ls.refresh_all()
 
     @server.feature(types.WORKSPACE_DID_CHANGE_CONFIGURATION)
     async def did_change_configuration(

@@ -40,14 +40,18 @@ def register(server: BtServer) -> None:
                 od.doc.replace_all(change.text)
         od.version = params.text_document.version
         od.refresh_kind()
+        ls.edits += 1
         if was_bt and not od.is_bt:
             ls.clear(uri)
-        ls.schedule(uri)
+        ls.schedule_all(uri)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(ls: BtServer, params: types.DidCloseTextDocumentParams) -> None:
         uri = params.text_document.uri
-        if ls.docs.pop(uri, None) is not None:
+        od = ls.docs.pop(uri, None)
+        if od is not None:
+            if od.path is not None:
+                ls.project.close(od.path)
             ls.clear(uri)
 
     @server.feature(

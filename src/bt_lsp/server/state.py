@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.document import Document, looks_like_bt
@@ -14,9 +15,10 @@ class OpenDocument:
     doc: Document
     version: int | None
     language_id: str
+    path: Path | None = None  # None for documents that are not files (untitled)
     is_bt: bool = False
-    # Diagnostics cached for (version, settings/workspace generation).
-    cache_key: tuple[int | None, int] | None = None
+    # Diagnostics cached for (version, settings generation, workspace generation).
+    cache_key: tuple[int | None, int, int] | None = None
     cached: list[Diagnostic] = field(default_factory=list)
 
     def refresh_kind(self) -> None:

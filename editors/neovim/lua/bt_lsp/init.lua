@@ -199,13 +199,16 @@ local function base_config()
     settings = { [M.section] = settings },
     on_attach = opts.on_attach,
   }
-  if opts.capabilities then
-    config.capabilities = vim.tbl_deep_extend(
-      "force",
-      vim.lsp.protocol.make_client_capabilities(),
-      opts.capabilities
-    )
+  local capabilities = vim.lsp.protocol.make_client_capabilities()
+  -- Neovim 0.7 answers workspace/configuration (from `settings`) but does not say so.
+  capabilities.workspace = capabilities.workspace or {}
+  if capabilities.workspace.configuration == nil then
+    capabilities.workspace.configuration = true
   end
+  if opts.capabilities then
+    capabilities = vim.tbl_deep_extend("force", capabilities, opts.capabilities)
+  end
+  config.capabilities = capabilities
   return config
 end
 
