@@ -34,7 +34,7 @@ EMOJI = (
     "  <TreeNodesModel>\n"
     '    <Action ID="Say.Hi">\n'
     '      <input_port name="text"/>\n'
-    '      <input_port name="1port"/>\n'
+    '      <input_port name="1port" default="0"/>\n'
     "    </Action>\n"
     "  </TreeNodesModel>\n"
     "</root>\n"
@@ -79,7 +79,7 @@ FIXABLE = (
     "  <TreeNodesModel>\n"
     '    <Action ID="Say.Hi">\n'
     '      <input_port name="text"/>\n'
-    '      <input_port name="goal.x"/>\n'
+    '      <input_port name="goal.x" default="0"/>\n'
     "    </Action>\n"
     "  </TreeNodesModel>\n"
     "</root>\n"
@@ -660,13 +660,13 @@ def test_fix_preserves_encoding_bom_line_ends_and_mode(
 
 def test_fix_reports_what_is_left(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
     # An XML error elsewhere stays (and is reported); the names are still fixed.
-    text = FIXABLE.replace("<Sequence>", "<Sequence x=1>")
+    text = FIXABLE.replace("<Sequence>", "<Sequence> 1 < 2 ")
     path = _put(work / "a.xml", text)
     assert not _parses(path.read_bytes())
     assert main(["check", "--fix", "--format", "json", "a.xml"]) == 1
     out, err = capsys.readouterr()
     assert path.read_text(encoding="utf-8") == _fixed(text)
-    assert [(d["code"], d["line"], d["column"]) for d in json.loads(out)] == [("xml-syntax", 3, 15)]
+    assert [(d["code"], d["line"], d["column"]) for d in json.loads(out)] == [("xml-syntax", 3, 18)]
     assert err == "fixed 9 problems in a.xml\n"
 
 
@@ -740,3 +740,34 @@ def test_fix_keeps_a_symlink(work: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert main(["check", "--fix", "link.xml"]) == 0
     assert (work / "link.xml").is_symlink()
     assert real.read_text(encoding="utf-8") == _fixed(FIXABLE)
+
+
+def test_fix_does_not_rewrite_a_clean_file(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _put(work / "a.xml", CLEAN)
+    os.utime(path, ns=(1_000_000_000, 1_000_000_000))
+    before = path.stat()
+    assert main(["check", "--fix", "a.xml"]) == 0
+    after = path.stat()
+    assert (after.st_ino, after.st_mtime_ns) == (before.st_ino, before.st_mtime_ns)
+    assert capsys.readouterr().err == "0 errors, 0 warnings in 1 file\n"
+
+
+def test_internal_error_names_the_file_and_goes_on(
+    work: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from bt_lsp import analysis
+
+    real = analysis.analyze
+
+    def flaky(doc: Any) -> Any:
+        if doc.path == "boom.xml":
+            raise RuntimeError("kaboom")
+        return real(doc)
+
+    monkeypatch.setattr(analysis, "analyze", flaky)
+    _put(work / "boom.xml", CLEAN)
+    _put(work / "crlf.xml", CRLF)
+    assert main(["check", "boom.xml", "crlf.xml"]) == 2
+    out, err = capsys.readouterr()
+    _assert_lines(out, CRLF_LINES)
+    assert "bt-lsp: internal error while checking boom.xml: RuntimeError: kaboom\n" in err

@@ -113,7 +113,7 @@ class Context:
       BehaviorTree.CPP's load order (included documents first, this document last, so the
       last entry is the one BehaviorTree.CPP keeps); several entries mean a duplicate ID.
     * ``workspace_trees``: trees of other workspace documents that are not included.
-    * ``workspace_has_custom_models``: whether any custom node model is known at all; when
+    * ``workspace_has_custom_models``: whether a catalog of the custom nodes is known; when
       not, nodes missing from the models are probably registered in C++ only.
     * ``ros_pkg_paths``: ROS package name -> share directory (settings).
     * ``included_by``: paths of workspace documents that include this one.
@@ -150,9 +150,16 @@ class Context:
         path: str | None = None,
         *,
         ros_pkg_paths: Mapping[str, str] | None = None,
+        workspace_has_custom_models: bool = False,
     ) -> Context:
         """The context of a document that sees nothing but itself."""
-        return cls.combine(doc, (), path=path, ros_pkg_paths=ros_pkg_paths)
+        return cls.combine(
+            doc,
+            (),
+            path=path,
+            ros_pkg_paths=ros_pkg_paths,
+            workspace_has_custom_models=workspace_has_custom_models,
+        )
 
     @classmethod
     def combine(
@@ -162,6 +169,7 @@ class Context:
         *,
         path: str | None = None,
         ros_pkg_paths: Mapping[str, str] | None = None,
+        model_files: Iterable[tuple[str, Document]] = (),
         included_by: Iterable[str] = (),
         workspace_has_custom_models: bool | None = None,
     ) -> Context:
@@ -169,9 +177,15 @@ class Context:
 
         ``included`` is true for documents of ``own``'s include closure (their trees join
         its namespace; give them in BehaviorTree.CPP's depth-first load order) and false
-        for any other workspace document or model file (only its declarations count; its
-        trees go to ``workspace_trees``).  A document whose path is ``own``'s is skipped.
-        ``workspace_has_custom_models`` defaults to whether any custom model is known.
+        for any other workspace document (only its models count; its trees go to
+        ``workspace_trees``).  A document whose path is ``own``'s is skipped.
+        ``model_files`` are the node catalogs named in the settings (``<TreeNodesModel>``
+        files, e.g. exported with BehaviorTree.CPP's ``bt_nodes_model``).
+
+        ``workspace_has_custom_models`` defaults to whether the model files declare any
+        custom node: ``<TreeNodesModel>`` sections inside tree files are usually partial
+        (editors write the nodes they show), so only a catalog makes a node missing from
+        the models an error.
         """
         own_path = path if path is not None else own.path
         own_facts = facts_of(own, own_path)
@@ -202,9 +216,12 @@ class Context:
         for f in (*included, own_facts):
             for t in f.trees:
                 trees.setdefault(t.id, []).append(t)
-        has_custom = bool(models) if workspace_has_custom_models is None else (
-            workspace_has_custom_models
-        )
+        catalog = False
+        for model_path, model_doc in model_files:
+            f = facts_of(model_doc, model_path)
+            add_models(f)
+            catalog = catalog or any(m.id not in BUILTINS for m in f.models)
+        has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
         return cls(
             path=own_path,
             models=MappingProxyType(models),

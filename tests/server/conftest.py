@@ -107,6 +107,7 @@ class BtClient(LanguageClient):
         super().__init__(*args, **kwargs)
         self.published: dict[str, list[types.PublishDiagnosticsParams]] = {}
         self.configuration_requests = 0
+        self.registrations: list[types.Registration] = []
         self._waiters: list[asyncio.Event] = []
 
     # notifications from the server
@@ -314,6 +315,15 @@ def _on_refresh(client: BtClient, params: None) -> None:
     client._notify_waiters()
 
 
+def _on_register(client: BtClient, params: types.RegistrationParams) -> None:
+    client.registrations.extend(params.registrations)
+
+
+def _on_unregister(client: BtClient, params: types.UnregistrationParams) -> None:
+    gone = {u.id for u in params.unregisterations}
+    client.registrations[:] = [r for r in client.registrations if r.id not in gone]
+
+
 def make_client() -> BtClient:
     client = BtClient(converter_factory=default_converter)
     features = dict(DEFAULT_CLIENT_FEATURES)
@@ -321,6 +331,8 @@ def make_client() -> BtClient:
     features[types.WINDOW_LOG_MESSAGE] = _on_log
     features[types.WORKSPACE_CONFIGURATION] = _on_configuration
     features[types.WORKSPACE_DIAGNOSTIC_REFRESH] = _on_refresh
+    features[types.CLIENT_REGISTER_CAPABILITY] = _on_register
+    features[types.CLIENT_UNREGISTER_CAPABILITY] = _on_unregister
     register_lsp_features(client, features)
     return client
 

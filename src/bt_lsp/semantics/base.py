@@ -17,6 +17,21 @@ if TYPE_CHECKING:
 
 Origin = Literal["builtin", "custom", "subtree"]
 
+#: Rules about what BehaviorTree.CPP 4 defines (built-in ports, load-time checks it added)
+#: whose errors are warnings in a document without ``BTCPP_format``, which may be written
+#: for version 3.
+VERSION_4_RULES: Final[frozenset[str]] = frozenset(
+    {
+        "undeclared-port",
+        "missing-required-port",
+        "invalid-port-value",
+        "reactive-explicit-child",
+        "reactive-async-children",
+        "parallel-threshold",
+        "blackboard-type-mismatch",
+    }
+)
+
 
 @dataclass(frozen=True, slots=True)
 class Resolved:
@@ -86,6 +101,9 @@ class State:
         data: Mapping[str, Any] | None = None,
     ) -> None:
         sev = CODES[code].severity if severity is None else severity
+        if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
+            sev = Severity.WARNING
+            message += " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
         self.out.append(Diagnostic(start, end, code, message, sev, data))
 
     def resolve(self, type_id: str) -> Resolved | None:

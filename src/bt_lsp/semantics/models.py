@@ -41,7 +41,11 @@ def check_port_decl(st: State, el: Element) -> None:
             )
         return
     name = a.value
-    if name is None or is_allowed_port_name(name) or check_name(name, NameKind.PORT, declaration=True):
+    if (
+        name is None
+        or is_allowed_port_name(name)
+        or check_name(name, NameKind.PORT, declaration=True)
+    ):
         return
     s, e = el.span_of_value(a)
     if entry.name == "SubTree":

@@ -43,6 +43,13 @@ _BUILTIN_LOWER: Final[dict[str, str]] = {k.lower(): k for k in BUILTINS}
 _LEADING_INT: Final = re.compile(r"-?[0-9]+")
 # Entries of V3_RENAMES that are typos rather than version 3 names.
 _MISSPELLINGS: Final = frozenset({"RetryUntilSuccesful"})
+# Built-ins of BehaviorTree.CPP 3 that version 4 dropped.
+V3_ONLY: Final[dict[str, str]] = {
+    "BlackboardCheckInt": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckDouble": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckString": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckBool": "ScriptCondition or a _skipIf/_successIf precondition",
+}
 
 
 def check_node(st: State, el: Element) -> Resolved | None:
@@ -124,13 +131,23 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             data,
         )
         return
+    if type_id in V3_ONLY:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"{quoted(type_id)} was a built-in node of BehaviorTree.CPP 3; version 4 does not "
+            f"register it by default (register it in C++, or use {V3_ONLY[type_id]})",
+            None if ctx.workspace_has_custom_models else Severity.HINT,
+            data,
+        )
+        return
     if type_id in ctx.trees or type_id in ctx.workspace_trees:
         st.add(
             start,
             end,
             "unknown-node",
-            f"{quoted(type_id)} is a tree, not a node type; call it with "
-            f'<SubTree ID="{type_id}"/>',
+            f'{quoted(type_id)} is a tree, not a node type; call it with <SubTree ID="{type_id}"/>',
             Severity.ERROR if st.v4 else Severity.WARNING,
             data,
         )
@@ -192,9 +209,13 @@ def _children(st: State, el: Element, res: Resolved) -> None:
         if res.id.startswith("Switch") and res.origin == "builtin":
             need += f" ({lo - 1} cases + default)"
     elif hi is None:
-        need = f"must have {lo} or more children" if lo <= 1 else f"must have at least {lo} children"
+        need = (
+            f"must have {lo} or more children" if lo <= 1 else f"must have at least {lo} children"
+        )
     else:
-        need = f"must have {lo} or {hi} children" if hi == lo + 1 else f"must have {lo}-{hi} children"
+        need = (
+            f"must have {lo} or {hi} children" if hi == lo + 1 else f"must have {lo}-{hi} children"
+        )
     what = {"custom": f"a {res.category} declared in <TreeNodesModel>"}.get(res.origin, "")
     st.add(
         el.name_start,

@@ -69,7 +69,9 @@ _STRING_TYPES: Final = frozenset(
         "std::basic_string<char, std::char_traits<char>, std::allocator<char> >",
     }
 )
-_WEAK_TYPES: Final = frozenset({"", "any", "Any", "BT::Any", "AnyTypeAllowed", "BT::AnyTypeAllowed"})
+_WEAK_TYPES: Final = frozenset(
+    {"", "any", "Any", "BT::Any", "AnyTypeAllowed", "BT::AnyTypeAllowed"}
+)
 
 
 def canonical_type(type_: str) -> str | None:
@@ -228,9 +230,7 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
     if res.origin == "subtree":
         if autoremap:
             return
-        missing = [
-            p.name for p in res.ports.values() if not p.default and p.name not in given
-        ]
+        missing = [p.name for p in res.ports.values() if not p.default and p.name not in given]
     else:
         missing = [
             p.name
@@ -244,7 +244,7 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
     if res.origin == "subtree":
         message = (
             f"{_owner(res)} declares mandatory port{plural} {shown} without a default, and "
-            "this call neither remaps it nor sets _autoremap=\"true\""
+            'this call neither remaps it nor sets _autoremap="true"'
         )
         severity = None
     elif res.origin == "builtin":
@@ -259,7 +259,9 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
             "given here"
         )
         severity = Severity.WARNING
-    st.add(el.name_start, el.name_end, "missing-required-port", message, severity, {"ports": missing})
+    st.add(
+        el.name_start, el.name_end, "missing-required-port", message, severity, {"ports": missing}
+    )
 
 
 def _blackboard_use(
@@ -275,10 +277,7 @@ def _blackboard_use(
     if canon is None:
         return
     key = value.strip(" ")
-    if key in ("=", "{=}"):
-        key = a.name
-    else:
-        key = key[1:-1].strip(" ")
+    key = a.name if key in ("=", "{=}") else key[1:-1].strip(" ")
     first = scope.keys.get(key)
     if first is None:
         scope.keys[key] = BlackboardUse(canon, port.type, res.exact, a.name, res.id)

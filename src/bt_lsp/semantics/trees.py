@@ -27,6 +27,7 @@
 from __future__ import annotations
 
 import os
+
 from bt_lsp.builtins import BUILTINS
 from bt_lsp.codes import Severity
 from bt_lsp.context import TreeDecl
@@ -137,11 +138,12 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
             scope.subtree_names[name.value] = el
         else:
             s, e = el.span_of_value(name)
+            line = st.doc.lines.line_of(first.name_start) + 1
             st.add(
                 s,
                 e,
                 "duplicate-subtree-name",
-                f"Another <SubTree> in this tree (line {st.doc.lines.line_of(first.name_start) + 1}) "
+                f"Another <SubTree> in this tree (line {line}) "
                 f"has the name {quoted(name.value)}; BehaviorTree.CPP rejects the duplicate "
                 "SubTree path (use unique names or omit 'name')",
             )
@@ -258,6 +260,5 @@ def _report_cycle(
         target[0],
         target[1],
         "subtree-recursion",
-        f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive "
-        "trees",
+        f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive trees",
     )

@@ -132,11 +132,25 @@ local function settled_diagnostics(bufnr, quiet_ms, differs_from)
   return diagnostics(bufnr)
 end
 
-local function hover(bufnr, row, col)
+-- The LSP character offset of byte column `col` in row `row`, in the client's encoding.
+local function character(bufnr, client, row, col)
+  local line = vim.api.nvim_buf_get_lines(bufnr, row, row + 1, true)[1]
+  local enc = client.offset_encoding
+  if enc == "utf-8" then
+    return col
+  end
+  if vim.fn.has("nvim-0.11") == 1 then
+    return vim.str_utfindex(line, enc, col)
+  end
+  local utf32, utf16 = vim.str_utfindex(line, col)
+  return enc == "utf-16" and utf16 or utf32
+end
+
+local function hover(bufnr, client, row, col)
   -- The raw Markdown, as the server sent it.
   local params = {
     textDocument = { uri = vim.uri_from_bufnr(bufnr) },
-    position = { line = row, character = col }, -- ASCII up to here: bytes == UTF-16 units
+    position = { line = row, character = character(bufnr, client, row, col) },
   }
   local responses = vim.lsp.buf_request_sync(bufnr, "textDocument/hover", params, TIMEOUT)
   local markdown = nil
@@ -180,7 +194,7 @@ local function quickfix_scenario()
   emit("diagnostics", { items = diags })
 
   local row, col = locate(bufnr, '<BehaviorTree ID="Main Tree"', "Main Tree")
-  local markdown, shown = hover(bufnr, row, col + 2)
+  local markdown, shown = hover(bufnr, client, row, col + 2)
   emit("hover", { markdown = markdown or vim.NIL, window = shown })
 
   -- The quick fix, as a user gets it: cursor on the name, code_action(), pick from the list.
@@ -262,6 +276,24 @@ local function no_client_scenario()
       client = client_info(client),
       plain_buffer_clients = #buf_clients(bufnr),
     })
+
+    -- :BtLspRestart replaces the client with a new one on the same buffer.
+    vim.cmd("BtLspRestart")
+    local restarted = nil
+    wait("a new client after :BtLspRestart", function()
+      for _, c in ipairs(buf_clients(bt_buf)) do
+        if c.name == "bt_lsp" and c.id ~= client.id and c.initialized ~= false then
+          restarted = c
+          return true
+        end
+      end
+      return false
+    end)
+    local running = {}
+    for _, c in ipairs(all_clients()) do
+      table.insert(running, client_info(c))
+    end
+    emit("restarted", { client = client_info(restarted), clients = running })
   end
 end
 

@@ -1,0 +1,59 @@
+"""BehaviorTree.CPP's semantic rules over one document and its workspace context.
+
+:func:`check` runs every rule family in one pass over the document's elements (the
+context, which holds what the document itself declares, is built before it):
+
+* :mod:`~bt_lsp.semantics.document`: ``<root>``, sections, includes, nesting depth;
+* :mod:`~bt_lsp.semantics.trees`: tree IDs, ``<SubTree>`` calls, the main tree, cycles;
+* :mod:`~bt_lsp.semantics.nodes`: node types, compact/explicit form, children;
+* :mod:`~bt_lsp.semantics.ports`: ports, attribute values, blackboard types;
+* :mod:`~bt_lsp.semantics.scripts`: script syntax;
+* :mod:`~bt_lsp.semantics.models`: ``<TreeNodesModel>`` entries.
+
+:func:`fixes_for` gives the quick fixes of one diagnostic (:mod:`~bt_lsp.semantics.fixes`).
+Each module's docstring lists its codes with their severity and range.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from bt_lsp.context import Context
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.model import Zone
+from bt_lsp.semantics import document, models, nodes, ports, trees
+from bt_lsp.semantics.base import State, TreeScope
+from bt_lsp.semantics.fixes import fixes_for
+
+if TYPE_CHECKING:
+    from bt_lsp.document import Document
+
+__all__ = ["check", "fixes_for"]
+
+
+def check(doc: Document, ctx: Context) -> list[Diagnostic]:
+    """Every semantic diagnostic of ``doc`` seen through ``ctx``, sorted by position."""
+    model = doc.model
+    st = State(doc, ctx, model, doc.text)
+    document.check_root(st)
+    scope = TreeScope(None)
+    for el in model.elements:
+        zone = el.zone
+        if zone == Zone.NODE:
+            document.check_depth(st, el, scope.depth_flagged)
+            res = nodes.check_node(st, el)
+            is_subtree = el.name == "SubTree"
+            if is_subtree:
+                trees.check_call(st, el, scope)
+            ports.check_attributes(st, el, res, scope, is_subtree)
+        elif zone == Zone.TREE:
+            scope = TreeScope(el)
+            trees.begin_tree(st, el)
+        elif zone == Zone.MODEL_ENTRY:
+            models.check_entry(st, el)
+        elif zone == Zone.PORT_DECL:
+            models.check_port_decl(st, el)
+    trees.check_main_tree(st)
+    trees.check_recursion(st)
+    st.out.sort(key=lambda d: (d.start, d.end, d.code))
+    return st.out
