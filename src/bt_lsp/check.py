@@ -27,6 +27,7 @@ import stat
 import sys
 import traceback
 import unicodedata
+from bisect import bisect_right
 from collections import Counter
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -112,6 +113,7 @@ class FileResult:
     error: FileError | None = None
     fixed: int = 0
     not_fixed: str | None = None  # why a file with fixes was left unchanged
+    detail: str = ""  # the traceback of an internal error
 
 
 # -- collecting files --------------------------------------------------------------------
@@ -239,8 +241,11 @@ def _new_spans(edits: Sequence[TextEdit]) -> list[tuple[int, int]]:
     return spans
 
 
-def _touches(d: Diagnostic, spans: Sequence[tuple[int, int]]) -> bool:
-    return any(d.start <= end and start <= d.end for start, end in spans)
+def _touches(d: Diagnostic, spans: Sequence[tuple[int, int]], starts: Sequence[int]) -> bool:
+    """Whether ``d`` overlaps or touches one of ``spans`` (sorted, disjoint; ``starts``
+    are their starts)."""
+    i = bisect_right(starts, d.end) - 1
+    return i >= 0 and spans[i][1] >= d.start
 
 
 def _xml_counts(diags: Iterable[Diagnostic]) -> Counter[str]:
@@ -293,13 +298,18 @@ def _fix(
     worse = sorted(code for code in after if after[code] > before[code])
     if worse:
         return f"the fixes would add {', '.join(worse)} problems"
-    old_spans = [(e.start, e.end) for e in edits]
+    old_spans = [(e.start, e.end) for e in sorted(edits)]
+    old_starts = [start for start, _ in old_spans]
     new_spans = _new_spans(edits)
-    left = [d for d in new_raw if d.is_name_rule and _touches(d, new_spans)]
+    new_starts = [start for start, _ in new_spans]
+    left = [d for d in new_raw if d.is_name_rule and _touches(d, new_spans, new_starts)]
     if left:
-        return f"the fixes would leave {left[0].code} at offset {left[0].start}"
-    old_elsewhere = sum(1 for d in raw if d.is_name_rule and not _touches(d, old_spans))
-    new_elsewhere = sum(1 for d in new_raw if d.is_name_rule and not _touches(d, new_spans))
+        line, col = new_doc.lines.position(left[0].start, "utf-32")
+        return f"the fixes would leave {left[0].code} at {line + 1}:{col + 1}"
+    old_elsewhere = sum(1 for d in raw if d.is_name_rule and not _touches(d, old_spans, old_starts))
+    new_elsewhere = sum(
+        1 for d in new_raw if d.is_name_rule and not _touches(d, new_spans, new_starts)
+    )
     if new_elsewhere > old_elsewhere:
         return "the fixes would add name problems elsewhere"
     if _well_formed(decoded.encode(doc.text)) and not _well_formed(new_bytes):
@@ -335,7 +345,7 @@ def check_file(path: str, options: Options) -> FileResult:
         result.not_fixed = e.message
         result.findings = _findings(path, doc, diags)
     except Exception as e:
-        traceback.print_exc(file=sys.stderr)
+        result.detail = traceback.format_exc()
         result.error = FileError(
             path, f"internal error while checking {path}: {type(e).__name__}: {e}"
         )
@@ -606,7 +616,7 @@ def run(
         r = check_file(path, options)
         results.append(r)
         if r.error is not None:
-            say(err, f"bt-lsp: {r.error.message}\n")
+            say(err, f"{r.detail}bt-lsp: {r.error.message}\n")
         if r.not_fixed is not None:
             say(err, f"bt-lsp: not fixing {_visible(path)}: {r.not_fixed}\n")
         if r.fixed:

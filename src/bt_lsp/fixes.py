@@ -5,13 +5,13 @@ Pure: these functions return edits; the front ends decide whether to apply them.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Collection, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.edits import TextEdit
 from bt_lsp.model import Model, NameRef, Symbol
-from bt_lsp.sanitize import candidates
+from bt_lsp.sanitize import candidates, sanitize
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,18 +60,22 @@ def _namespace(symbol: Symbol) -> tuple[str, ...]:
     return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
 
 
+def _names_in(model: Model, ns: tuple[str, ...]) -> set[str]:
+    return {sym[-1] for sym in model.by_symbol if _namespace(sym) == ns}
+
+
 def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = ()) -> set[str]:
     """Names a new name for ``symbol`` must avoid: the others in its namespace, in this
     document and in the other workspace documents."""
     if symbol is None:
         return set()
     ns = _namespace(symbol)
-    return {
-        r.symbol[-1]
-        for m in (model, *others)
-        for r in m.refs
-        if r.symbol is not None and _namespace(r.symbol) == ns and r.symbol != symbol
-    }
+    taken: set[str] = set()
+    for m in (model, *others):
+        taken |= _names_in(m, ns)
+    if not any(symbol in m.by_symbol for m in others):
+        taken.discard(symbol[-1])
+    return taken
 
 
 def other_file_edits(
@@ -129,12 +133,30 @@ def fixes_for(
     return fixes
 
 
+class _Without(Collection[str]):
+    """A set minus one name, without copying the set."""
+
+    def __init__(self, names: set[str], left_out: str) -> None:
+        self._names, self._left_out = names, left_out
+
+    def __contains__(self, name: object) -> bool:
+        return name != self._left_out and name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return (n for n in self._names if n != self._left_out)
+
+    def __len__(self) -> int:
+        return len(self._names) - (self._left_out in self._names)
+
+
 def fix_all(model: Model, diags: Iterable[Diagnostic]) -> list[TextEdit]:
     """Every preferred name fix at once, consistently: one new name per symbol, all
     distinct from each other and from the names that stay."""
     chosen: dict[Symbol | tuple[int, int], str] = {}
     edits: dict[tuple[int, int], TextEdit] = {}
     taken_by_ns: dict[tuple[str, ...], set[str]] = {}
+    for sym in model.by_symbol:
+        taken_by_ns.setdefault(_namespace(sym), set()).add(sym[-1])
     for diag in diags:
         if not diag.is_name_rule:
             continue
@@ -148,12 +170,11 @@ def fix_all(model: Model, diags: Iterable[Diagnostic]) -> list[TextEdit]:
             continue
         if ref.symbol is not None:
             ns = _namespace(ref.symbol)
-            if ns not in taken_by_ns:
-                taken_by_ns[ns] = taken_names(model, ref.symbol) | {ref.symbol[-1]}
-            taken = taken_by_ns[ns] - {ref.symbol[-1]}
+            taken_by_ns.setdefault(ns, set())
+            taken: Collection[str] = _Without(taken_by_ns[ns], ref.symbol[-1])
         else:
-            taken = set()
-        new = candidates(ref.text, ref.kind, taken)[0]
+            taken = ()
+        new = sanitize(ref.text, ref.kind, taken)
         chosen[key] = new
         if ref.symbol is not None:
             taken_by_ns[_namespace(ref.symbol)].add(new)

@@ -144,6 +144,7 @@ class Model:
     refs: list[NameRef]
     problems: list[StructureProblem]
     ref_starts: list[int]
+    _by_symbol: dict[Symbol, list[NameRef]] | None = None
 
     @property
     def root(self) -> Element | None:
@@ -157,7 +158,18 @@ class Model:
         return None
 
     def refs_to(self, symbol: Symbol) -> list[NameRef]:
-        return [r for r in self.refs if r.symbol == symbol]
+        return self.by_symbol.get(symbol, [])
+
+    @property
+    def by_symbol(self) -> dict[Symbol, list[NameRef]]:
+        """Every symbol's references in document order (built once, on first use)."""
+        if self._by_symbol is None:
+            index: dict[Symbol, list[NameRef]] = {}
+            for r in self.refs:
+                if r.symbol is not None:
+                    index.setdefault(r.symbol, []).append(r)
+            self._by_symbol = index
+        return self._by_symbol
 
     def trees(self) -> list[Element]:
         return [e for e in self.elements if e.zone == Zone.TREE]

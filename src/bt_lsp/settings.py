@@ -10,6 +10,7 @@ from typing import Any
 from bt_lsp.codes import CODES, Severity
 
 DEFAULT_MAX_DOCUMENT_BYTES = 8 * 1024 * 1024
+MAX_DEBOUNCE_MS = 60_000
 
 
 @dataclass(frozen=True)
@@ -41,11 +42,13 @@ class Settings:
             if (
                 isinstance(debounce, int | float)
                 and not isinstance(debounce, bool)
-                and debounce >= 0
+                and 0 <= debounce <= MAX_DEBOUNCE_MS  # also rejects NaN and infinity
             ):
                 kw["debounce_ms"] = int(debounce)
             else:
-                problems.append(f"debounceMs must be a number >= 0, not {debounce!r}")
+                problems.append(
+                    f"debounceMs must be a number from 0 to {MAX_DEBOUNCE_MS}, not {debounce!r}"
+                )
         sev = raw.get("severity")
         if isinstance(sev, Mapping):
             parsed: dict[str, Severity | None] = {}

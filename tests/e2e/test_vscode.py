@@ -20,6 +20,8 @@ import sys
 import time
 import urllib.request
 from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -47,7 +49,7 @@ FIXED = TREE.replace("Main Tree", "Main_Tree")
 CODE = "model-name-forbidden-char"
 FIX_TITLE = "Rename 'Main Tree' to 'Main_Tree'"
 
-DRIVER_TIMEOUT_S = 150
+DRIVER_TIMEOUT_S = 120
 
 
 def _missing_setup() -> list[str]:
@@ -124,15 +126,18 @@ def _logs(user_data: Path, log: Path) -> str:
     return "\n".join(parts)
 
 
-@pytest.fixture
-def code_server(tmp_path: Path) -> Iterator[dict[str, object]]:
-    missing = _missing_setup()
-    if missing:
-        pytest.fail(
-            f"the VS Code e2e setup is missing: {', '.join(missing)}. Run `bash {SETUP}` first.",
-            pytrace=False,
-        )
+@dataclass
+class CodeServer:
+    url: str
+    workspace: Path
+    user_data: Path
+    log: Path
+    env: dict[str, str]
 
+
+@contextmanager
+def _code_server(tmp_path: Path) -> Iterator[CodeServer]:
+    """code-server on 127.0.0.1 with the extension, an isolated user-data dir and a workspace."""
     workspace = tmp_path / "ws"
     workspace.mkdir()
     (workspace / "tree.xml").write_text(TREE, encoding="utf-8", newline="\n")
@@ -170,12 +175,17 @@ def code_server(tmp_path: Path) -> Iterator[dict[str, object]]:
     env.pop("VSCODE_IPC_HOOK_CLI", None)
     base = [
         str(CODE_SERVER),
-        "--user-data-dir", str(user_data),
-        "--extensions-dir", str(extensions),
+        "--user-data-dir",
+        str(user_data),
+        "--extensions-dir",
+        str(extensions),
     ]
     install = subprocess.run(
         [*base, "--install-extension", str(VSIX)],
-        env=env, capture_output=True, text=True, timeout=120,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert install.returncode == 0, install.stdout + install.stderr
 
@@ -187,72 +197,89 @@ def code_server(tmp_path: Path) -> Iterator[dict[str, object]]:
         proc = subprocess.Popen(
             [
                 *base,
-                "--config", str(config_file),
-                "--bind-addr", f"127.0.0.1:{port}",
-                "--auth", "none",
+                "--config",
+                str(config_file),
+                "--bind-addr",
+                f"127.0.0.1:{port}",
+                "--auth",
+                "none",
                 "--disable-telemetry",
                 "--disable-update-check",
                 "--disable-workspace-trust",
                 "--disable-getting-started-override",
                 str(workspace),
             ],
-            env=env, stdin=subprocess.DEVNULL, stdout=log_file, stderr=subprocess.STDOUT,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=log_file,
+            stderr=subprocess.STDOUT,
             start_new_session=True,
         )
     try:
         _wait_http(f"http://127.0.0.1:{port}/healthz", proc, log, timeout_s=60)
-        yield {
-            "url": f"http://127.0.0.1:{port}/?folder={workspace}",
-            "workspace": workspace,
-            "user_data": user_data,
-            "log": log,
-            "env": env,
-        }
+        yield CodeServer(
+            url=f"http://127.0.0.1:{port}/?folder={workspace}",
+            workspace=workspace,
+            user_data=user_data,
+            log=log,
+            env=env,
+        )
     finally:
         _kill_group(proc)
 
 
-def test_vscode_squiggle_problems_quick_fix_hover(
-    code_server: dict[str, object], tmp_path: Path
-) -> None:
-    workspace = code_server["workspace"]
-    user_data = code_server["user_data"]
-    log = code_server["log"]
-    assert isinstance(workspace, Path) and isinstance(user_data, Path) and isinstance(log, Path)
+def test_vscode_squiggle_problems_quick_fix_hover(tmp_path: Path) -> None:
+    missing = _missing_setup()
+    if missing:
+        pytest.fail(
+            f"the VS Code e2e setup is missing: {', '.join(missing)}. Run `bash {SETUP}` first.",
+            pytrace=False,
+        )
+    with _code_server(tmp_path) as code_server:
+        _drive_and_check(code_server, tmp_path)
+
+
+def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
+    def logs() -> str:
+        return _logs(code_server.user_data, code_server.log)
 
     shots = tmp_path / "shots"
     shots.mkdir()
-    line_text = TREE.splitlines()[1]
+    # 1-based line and column of the name in <BehaviorTree ID="Main Tree">.
+    line = 2
+    column = TREE.splitlines()[line - 1].index('ID="Main Tree"') + len('ID="') + 1
     drive_config = {
-        "url": code_server["url"],
+        "url": code_server.url,
         "file": "tree.xml",
-        "line": 2,  # 1-based, inside the name in <BehaviorTree ID="Main Tree">
-        "column": line_text.index('ID="Main Tree"') + len('ID="') + 3,
+        "line": line,
+        "column": column + 2,  # inside the name, where the hover and Ctrl+. happen
         "fixTitle": FIX_TITLE,
         "expectAfter": 'ID="Main_Tree"',
         "shotDir": str(shots),
         "chromium": shutil.which("chromium"),
     }
-    env = dict(code_server["env"])  # type: ignore[call-overload]
     try:
         run = subprocess.run(
             ["node", str(DRIVER), json.dumps(drive_config)],
-            env=env, capture_output=True, text=True, timeout=DRIVER_TIMEOUT_S,
+            env=code_server.env,
+            capture_output=True,
+            text=True,
+            timeout=DRIVER_TIMEOUT_S,
         )
     except subprocess.TimeoutExpired as e:
-        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr}\n{_logs(user_data, log)}")
+        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr!r}\n{logs()}")
     finally:
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         for shot in shots.glob("*.png"):
             shutil.copy(shot, ARTIFACTS / shot.name)
 
     lines = run.stdout.strip().splitlines()
-    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{_logs(user_data, log)}"
+    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs()}"
     result = json.loads(lines[-1])
     (ARTIFACTS / "result.json").write_text(json.dumps(result, indent=1))
     context = (
         f"\ndriver result: {json.dumps(result, indent=1)}\ndriver stderr:\n{run.stderr[-2000:]}\n"
-        f"{_logs(user_data, log)}\nscreenshots: {ARTIFACTS}"
+        f"{logs()}\nscreenshots: {ARTIFACTS}"
     )
     assert run.returncode == 0 and "error" not in result, context
 
@@ -261,6 +288,7 @@ def test_vscode_squiggle_problems_quick_fix_hover(
     problems = [row for row in result["problemsBefore"] if CODE in row]
     assert len(problems) == 1, context
     assert "bt-lsp" in problems[0] and "Main Tree" in problems[0], context
+    assert f"[Ln {line}, Col {column}]" in problems[0], context
 
     # The hover (our Markdown, not the problem's message above it) explains the character and
     # shows the replacement.
@@ -272,7 +300,7 @@ def test_vscode_squiggle_problems_quick_fix_hover(
     assert result["textAfter"].strip() == FIXED.strip(), context
     assert result["problemsAfter"] == [] and result["squigglesAfter"] == 0, context
     assert result["saved"], context
-    assert (workspace / "tree.xml").read_text(encoding="utf-8") == FIXED, context
+    assert (code_server.workspace / "tree.xml").read_text(encoding="utf-8") == FIXED, context
 
     for name in ("hover.png", "quickfix.png", "fixed.png"):
         assert (ARTIFACTS / name).stat().st_size > 10_000, name

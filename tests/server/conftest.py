@@ -14,10 +14,12 @@ the code under test.
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import itertools
+import json
 import re
 import sys
-from collections.abc import AsyncIterator, Awaitable, Callable, Sequence
+from collections.abc import AsyncIterator, Awaitable, Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -108,6 +110,7 @@ class BtClient(LanguageClient):
         self.published: dict[str, list[types.PublishDiagnosticsParams]] = {}
         self.configuration_requests = 0
         self.registrations: list[types.Registration] = []
+        self.opened: set[str] = set()
         self._waiters: list[asyncio.Event] = []
 
     # notifications from the server
@@ -160,6 +163,7 @@ class BtClient(LanguageClient):
 
     def open(self, text: str, *, version: int = 1, name: str = "doc", language: str = "xml") -> str:
         uri = fresh_uri(name)
+        self.opened.add(uri)
         self.text_document_did_open(
             types.DidOpenTextDocumentParams(
                 text_document=types.TextDocumentItem(
@@ -186,6 +190,7 @@ class BtClient(LanguageClient):
         self.change(uri, version, types.TextDocumentContentChangeWholeDocument(text=text))
 
     def close(self, uri: str) -> None:
+        self.opened.discard(uri)
         self.text_document_did_close(
             types.DidCloseTextDocumentParams(text_document=types.TextDocumentIdentifier(uri=uri))
         )
@@ -349,7 +354,44 @@ async def client(lsp_client: BtClient, request: pytest.FixtureRequest) -> AsyncI
     await lsp_client.shutdown_session()
 
 
+@pytest.fixture(autouse=True)
+def _close_documents(request: pytest.FixtureRequest) -> Iterator[None]:
+    """Close what a test opened, so that tests sharing a server do not see each other's
+    documents (open documents form one workspace)."""
+    yield
+    if "client" in request.fixturenames:
+        client = request.getfixturevalue("client")
+        if isinstance(client, BtClient) and client.error is None:
+            for uri in sorted(client.opened):
+                client.close(uri)
+
+
 _counter = itertools.count(1)
+
+
+def send_raw(client: BtClient, message: dict[str, Any] | bytes) -> None:
+    """Write one message as is (no validation by the client's types)."""
+    body = message if isinstance(message, bytes) else json.dumps(message).encode("utf-8")
+    writer = client.protocol.writer
+    assert writer is not None
+    writer.write(b"Content-Length: %d\r\n\r\n" % len(body) + body)
+
+
+async def raw_request(client: BtClient, method: str, params: Any) -> Any:
+    """Send a request whose params need not have the right shape; its response (or
+    JsonRpcException) within :data:`TIMEOUT`."""
+    msg_id = f"raw-{next(_counter)}"
+    future: concurrent.futures.Future[Any] = concurrent.futures.Future()
+    client.protocol._request_futures[msg_id] = future
+    send_raw(client, {"jsonrpc": "2.0", "id": msg_id, "method": method, "params": params})
+    try:
+        return await asyncio.wait_for(asyncio.wrap_future(future), TIMEOUT)
+    except TimeoutError:
+        raise AssertionError(f"no response to {method} within {TIMEOUT}s") from None
+
+
+def raw_notify(client: BtClient, method: str, params: Any) -> None:
+    send_raw(client, {"jsonrpc": "2.0", "method": method, "params": params})
 
 
 def fresh_uri(name: str = "doc") -> str:

@@ -22,6 +22,17 @@ CS_MARKER="$CS_DIR/.installed-$CODE_SERVER_VERSION"
 
 say() { printf '\n== %s\n' "$*"; }
 
+# `npm ci` in $1, skipped when node_modules was installed from the same package-lock.json.
+npm_ci() {
+  local stamp="$1/node_modules/.bt-lsp-installed-lock.json"
+  if cmp -s "$1/package-lock.json" "$stamp"; then
+    echo "$1: node_modules is up to date with package-lock.json"
+  else
+    (cd "$1" && npm ci)
+    cp "$1/package-lock.json" "$stamp"
+  fi
+}
+
 # --- 1. Debian packages -------------------------------------------------------------------
 apt_packages=(chromium build-essential pkg-config libkrb5-dev ripgrep python3)
 missing=()
@@ -54,9 +65,8 @@ export npm_config_audit=false npm_config_fund=false npm_config_update_notifier=f
 
 # --- 2. The extension -----------------------------------------------------------------------
 say "extension: npm ci && npm run package"
-cd "$EXT_DIR"
-npm ci
-npm run package
+npm_ci "$EXT_DIR"
+(cd "$EXT_DIR" && npm run package)
 
 # --- 3. code-server -----------------------------------------------------------------------
 if [ -f "$CS_MARKER" ] && [ -x "$CS_DIR/node_modules/.bin/code-server" ]; then
@@ -94,16 +104,15 @@ else
   ln -sfn browser-linux.sh bin/helpers/browser.sh
   (cd extensions && npm install --omit=dev --ignore-scripts)
 
-  # (code-server writes a default config file under XDG_CONFIG_HOME even for --version.)
+  # (code-server writes a default config and data folders under XDG_* even for --version.)
   scratch=$(mktemp -d)
-  XDG_CONFIG_HOME="$scratch" "$CS_DIR/node_modules/.bin/code-server" --version
+  XDG_CONFIG_HOME="$scratch" XDG_DATA_HOME="$scratch" "$CS_DIR/node_modules/.bin/code-server" --version
   rm -rf "$scratch"
   touch "$CS_MARKER"
 fi
 
 # --- 4. playwright-core -----------------------------------------------------------------------
 say "playwright-core: npm ci in $E2E_DIR"
-cd "$E2E_DIR"
-npm ci
+npm_ci "$E2E_DIR"
 
 say "done: extension $EXT_DIR/bt-lsp.vsix, code-server $CS_DIR/node_modules/.bin/code-server, browser $(command -v chromium)"

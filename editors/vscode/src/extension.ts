@@ -1,7 +1,15 @@
 // VS Code client for the bt-lsp language server (BehaviorTree.CPP XML).
 
 import * as vscode from 'vscode';
-import { Executable, LanguageClient, LanguageClientOptions, ServerOptions } from 'vscode-languageclient/node';
+import {
+  CloseAction,
+  ErrorAction,
+  ErrorHandler,
+  Executable,
+  LanguageClient,
+  LanguageClientOptions,
+  ServerOptions,
+} from 'vscode-languageclient/node';
 import { resolveServerCommand } from './serverCommand';
 
 const CLIENT_ID = 'btLsp'; // also the settings section; vscode-languageclient reads `btLsp.trace.server`
@@ -11,6 +19,18 @@ let log: vscode.LogOutputChannel;
 let client: LanguageClient | undefined;
 // Start, stop and restart run one after another, in the order they were asked for.
 let queue: Promise<void> = Promise.resolve();
+
+/**
+ * A LanguageClient that, until the server has started, only logs its errors: if the start fails,
+ * one notification that says how to install the server replaces the client's own three or four.
+ */
+class BtLspClient extends LanguageClient {
+  starting = true;
+
+  override error(message: string, data?: unknown, showNotification: boolean | 'force' = true): void {
+    super.error(message, data, this.starting ? false : showNotification);
+  }
+}
 
 function enqueue(work: () => Promise<void>): Promise<void> {
   queue = queue.then(work, work);
@@ -67,6 +87,19 @@ async function startClient(): Promise<void> {
   // No `transport` here: with TransportKind.stdio the client would append `--stdio` to argv.
   const executable: Executable = { command: server.command, args: server.args };
   const serverOptions: ServerOptions = { run: executable, debug: executable };
+  let candidate: BtLspClient | undefined = undefined;
+  let defaultErrorHandler: ErrorHandler | undefined;
+  // Until the first start has succeeded, a failure is reported once (below) and not retried.
+  const errorHandler: ErrorHandler = {
+    error: (error, message, count) =>
+      candidate?.starting !== false
+        ? { action: ErrorAction.Shutdown, handled: true }
+        : (defaultErrorHandler ??= candidate.createDefaultErrorHandler()).error(error, message, count),
+    closed: () =>
+      candidate?.starting !== false
+        ? { action: CloseAction.DoNotRestart, handled: true }
+        : (defaultErrorHandler ??= candidate.createDefaultErrorHandler()).closed(),
+  };
   const clientOptions: LanguageClientOptions = {
     documentSelector: [
       { scheme: 'file', language: 'xml' },
@@ -78,11 +111,14 @@ async function startClient(): Promise<void> {
     // The server reads the `btLsp` section through workspace/configuration; this makes the
     // client send workspace/didChangeConfiguration when it changes.
     synchronize: { configurationSection: CLIENT_ID },
+    errorHandler,
+    initializationFailedHandler: () => false,
   };
 
-  const candidate = new LanguageClient(CLIENT_ID, CLIENT_NAME, serverOptions, clientOptions);
+  candidate = new BtLspClient(CLIENT_ID, CLIENT_NAME, serverOptions, clientOptions);
   try {
     await candidate.start();
+    candidate.starting = false;
     client = candidate;
     log.info('The server is running.');
   } catch (error) {
@@ -92,7 +128,12 @@ async function startClient(): Promise<void> {
     } catch {
       // it never ran
     }
-    showInstallHelp(`could not start ${JSON.stringify(argv)} (${server.origin}): ${errorText(error)}`, []);
+    // When the process exits during startup (say, `No module named bt_lsp`), the client only
+    // knows that its pending request was dropped; what the process said is in the log.
+    const why = /connection got disposed/.test(errorText(error))
+      ? 'the server process exited before it answered (its messages are in the bt-lsp output)'
+      : errorText(error);
+    showInstallHelp(`could not start ${JSON.stringify(argv)} (${server.origin}): ${why}`, []);
   }
 }
 

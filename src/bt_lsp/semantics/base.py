@@ -48,6 +48,7 @@ class Resolved:
     ports: Mapping[str, PortModel]
     min_children: int
     max_children: int | None
+    required: tuple[str, ...] = ()  # ports that must be given (see ports.py)
 
     @property
     def exact(self) -> bool:
@@ -66,6 +67,7 @@ def resolve_builtin(type_id: str) -> Resolved | None:
         {p.name: p for p in m.ports},
         m.min_children,
         m.max_children,
+        tuple(p.name for p in m.ports if p.default is None and p.direction != "output"),
     )
 
 
@@ -117,8 +119,11 @@ class State:
         res: Resolved | None = None
         if decl is not None:
             lo, hi = decl.child_range
+            required = tuple(
+                p.name for p in decl.ports if p.default is None and p.direction != "output"
+            )
             res = Resolved(
-                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi
+                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
             )
         self._types[type_id] = res
         return res
@@ -128,11 +133,12 @@ class State:
         if tree_id in self._subtrees:
             return self._subtrees[tree_id]
         decl = self.ctx.subtree_models.get(tree_id)
-        res = (
-            None
-            if decl is None
-            else Resolved(decl.id, "subtree", "SubTree", {p.name: p for p in decl.ports}, 0, 0)
-        )
+        res = None
+        if decl is not None:
+            # BehaviorTree.CPP treats an empty default of a SubTree model port as none.
+            required = tuple(p.name for p in decl.ports if not p.default)
+            ports = {p.name: p for p in decl.ports}
+            res = Resolved(decl.id, "subtree", "SubTree", ports, 0, 0, required)
         self._subtrees[tree_id] = res
         return res
 

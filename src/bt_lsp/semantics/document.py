@@ -124,9 +124,9 @@ def _check_include(st: State, el: Element) -> None:
         s,
         e,
         "include-ros-pkg",
-        f"ROS package {quoted(pkg.value)} is unknown to bt-lsp, so the include cannot be "
-        "checked; BehaviorTree.CPP resolves ros_pkg only when built with ROS support (map "
-        "the package to its share directory in the settings)",
+        f"ROS package {quoted(pkg.value)} is unknown to bt-lsp, so this include cannot be "
+        "followed; BehaviorTree.CPP resolves ros_pkg only when built with ROS support (map "
+        "the package to its share directory in the btLsp.rosPackages setting)",
     )
 
 

@@ -35,6 +35,7 @@ reserved; everything else is silently ignored by BehaviorTree.CPP.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Final
 
 from bt_lsp.builtins import PortModel, convert_literal, is_blackboard_reference
@@ -72,6 +73,14 @@ _STRING_TYPES: Final = frozenset(
 _WEAK_TYPES: Final = frozenset(
     {"", "any", "Any", "BT::Any", "AnyTypeAllowed", "BT::AnyTypeAllowed"}
 )
+
+
+_allowed = lru_cache(maxsize=4096)(is_allowed_port_name)
+
+
+@lru_cache(maxsize=16384)
+def _convert(value: str, type_: str) -> str | None:
+    return convert_literal(value, type_)
 
 
 def canonical_type(type_: str) -> str | None:
@@ -117,7 +126,7 @@ def check_attributes(
             if is_subtree:
                 autoremap = _check_autoremap(st, el, a, value)
             continue
-        if is_allowed_port_name(an):
+        if _allowed(an):
             given.add(an)
             if res is not None:
                 _check_port(st, el, a, value, res, scope)
@@ -168,10 +177,10 @@ def _check_autoremap(st: State, el: Element, a: Attr, value: str) -> bool:
 
 def _owner(res: Resolved) -> str:
     if res.origin == "subtree":
-        return f"the <SubTree> model of tree {quoted(res.id)}"
+        return f"The <SubTree> model of tree {quoted(res.id)}"
     if res.origin == "custom":
-        return f"the <TreeNodesModel> entry of {quoted(res.id)}"
-    return f"the built-in node {quoted(res.id)}"
+        return f"The <TreeNodesModel> entry of {quoted(res.id)}"
+    return f"The built-in node {quoted(res.id)}"
 
 
 def _check_port(
@@ -192,7 +201,7 @@ def _check_port(
         return
     if not port.type:
         return
-    problem = convert_literal(value, port.type)
+    problem = _convert(value, port.type)
     if problem is not None:
         s, e = el.span_of_value(a)
         st.add(
@@ -227,16 +236,9 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
 
 
 def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: bool) -> None:
-    if res.origin == "subtree":
-        if autoremap:
-            return
-        missing = [p.name for p in res.ports.values() if not p.default and p.name not in given]
-    else:
-        missing = [
-            p.name
-            for p in res.ports.values()
-            if p.default is None and p.direction != "output" and p.name not in given
-        ]
+    if not res.required or (autoremap and res.origin == "subtree"):
+        return
+    missing = [p for p in res.required if p not in given]
     if not missing:
         return
     shown = ", ".join(quoted(m) for m in missing)

@@ -14,13 +14,14 @@ post-condition attributes (``_skipIf`` … ``_post``) on any node.
 from __future__ import annotations
 
 import re
+from functools import lru_cache
 from typing import Final
 
 from bt_lsp.codes import Severity
 from bt_lsp.model import Element
 from bt_lsp.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.scanner import Attr, decode_value
-from bt_lsp.script import check_script
+from bt_lsp.script import ScriptError, check_script
 from bt_lsp.semantics.base import State
 
 #: Attributes whose value is a script on every node.
@@ -74,15 +75,23 @@ def raw_span(raw: str, start: int, end: int) -> tuple[int, int]:
     return offs[min(start, last)], offs[min(end, last)]
 
 
+@lru_cache(maxsize=16384)
+def _parse(code: str) -> tuple[ScriptError | None, bool]:
+    """The first syntax error of ``code`` and whether the 4.0-4.9 parser accepts it."""
+    err = check_script(code)
+    if err is None:
+        return None, True
+    return err, check_script(code, legacy=True) is None
+
+
 def check(st: State, el: Element, a: Attr) -> None:
     """Check one attribute value as a script."""
     code = a.value
     if code is None:
         return
-    err = check_script(code)
+    err, legacy_ok = _parse(code)
     if err is None:
         return
-    legacy_ok = check_script(code, legacy=True) is None
     start, end = err.offset, err.end
     if start == end and code.strip():
         # An error at the end of the script: show it on the last character written.

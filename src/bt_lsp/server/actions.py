@@ -109,15 +109,23 @@ def register(server: BtServer) -> None:
         only = params.context.only
         diags = ls.diagnostics_of(od)
         actions: list[types.CodeAction | types.Command] = []
+        # A name that breaks several rules has one diagnostic per rule, all with the same
+        # fixes: offer each fix once, listing every diagnostic it fixes.
+        same_fix: dict[tuple[int, int, str], list[types.Diagnostic]] = {}
         if _wants(only, types.CodeActionKind.QuickFix):
             for d in diags:
                 if d.start > end or d.end < start:
                     continue
                 for i, fix in enumerate(_all_fixes(ls, od, d)):
+                    fixed = same_fix.get((d.start, d.end, fix.title))
+                    if fixed is not None:
+                        fixed.append(to_diagnostic(lines, d, enc))
+                        continue
+                    fixed = same_fix[(d.start, d.end, fix.title)] = [to_diagnostic(lines, d, enc)]
                     action = types.CodeAction(
                         title=fix.title,
                         kind=types.CodeActionKind.QuickFix,
-                        diagnostics=[to_diagnostic(lines, d, enc)],
+                        diagnostics=fixed,
                         is_preferred=fix.preferred,
                     )
                     if ls.resolve_edits:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import traceback
+from collections.abc import Mapping
 from typing import Any
 
 from lsprotocol import types
@@ -41,6 +42,7 @@ class BtServer(LanguageServer):
         )
         self.docs: dict[str, OpenDocument] = {}
         self.settings = Settings()
+        self.init_options: object = None  # the client's initializationOptions
         self.pull_diagnostics = False
         self.configuration_support = False
         self.refresh_support = False
@@ -188,8 +190,14 @@ class BtServer(LanguageServer):
     # -- settings ---------------------------------------------------------------------------
 
     def apply_settings(self, raw: object) -> None:
+        """Settings from the client's ``btLsp`` section over its initializationOptions: a
+        key the section leaves out keeps its initializationOptions value, and a missing
+        section (``null``) means the initializationOptions alone."""
         problems: list[str] = []
-        self.settings = Settings.parse(raw, problems)
+        if raw is not None and not isinstance(raw, Mapping):
+            problems.append("btLsp settings must be an object")
+        merged = {**_section(self.init_options), **_section(raw)}
+        self.settings = Settings.parse(merged, problems)
         for p in problems:
             self.log_message(f"bt-lsp settings: {p}", types.MessageType.Warning)
 
@@ -203,12 +211,19 @@ class BtServer(LanguageServer):
         except Exception:
             self.log_error("reading workspace/configuration")
             return
-        if result and result[0] is not None:
-            self.apply_settings(result[0])
+        self.apply_settings(result[0] if result else None)
+
+
+def _section(raw: object) -> Mapping[str, Any]:
+    """The ``btLsp`` settings in ``raw`` (the section itself, or an object holding it)."""
+    if not isinstance(raw, Mapping):
+        return {}
+    inner = raw.get(SECTION)
+    return inner if isinstance(inner, Mapping) else raw
 
 
 def create_server() -> BtServer:
-    from bt_lsp.server import actions, documents, hover
+    from bt_lsp.server import actions, completion, documents, hover, navigation
 
     server = BtServer()
 
@@ -227,6 +242,7 @@ def create_server() -> BtServer:
         )
         if params.initialization_options is not None:
             ls.apply_settings(params.initialization_options)
+            ls.init_options = params.initialization_options
         roots = [f.uri for f in params.workspace_folders or []]
         if not roots and params.root_uri:
             roots = [params.root_uri]
@@ -284,6 +300,8 @@ def create_server() -> BtServer:
     documents.register(server)
     actions.register(server)
     hover.register(server)
+    navigation.register(server)
+    completion.register(server)
     return server
 
 

@@ -11,11 +11,30 @@ from __future__ import annotations
 from collections.abc import Generator
 from typing import Any
 
+from cattrs import ClassValidationError, transform_error
 from lsprotocol import types
+from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
 
 class BtProtocol(LanguageServerProtocol):
+    def structure_message(self, data: dict[str, Any]) -> Any:
+        """A request whose params do not have its method's shape is answered with an
+        InvalidParams error; pygls only logs it, and the client would wait forever."""
+        try:
+            return super().structure_message(data)
+        except JsonRpcException as exc:
+            if isinstance(data, dict) and "id" in data and "method" in data:
+                cause = exc.__cause__
+                detail = (
+                    "; ".join(transform_error(cause))
+                    if isinstance(cause, ClassValidationError)
+                    else repr(cause)
+                )
+                error = JsonRpcInvalidParams(f"Invalid params for {data['method']}: {detail}")
+                self._send_response(data["id"], error=error.to_response_error())
+            raise
+
     def _forward(self, method: str, params: Any) -> Generator[Any, Any, None]:
         handler = self.fm.features.get(method)
         if handler is not None:

@@ -9,14 +9,15 @@
 --   "no-client" the file is plain XML: no client may start for it; then BT_LSP_E2E_OTHER
 --               (a BehaviorTree file) is opened to show that the plugin was working.
 
+local uv = vim.uv or vim.loop
 local TIMEOUT = tonumber(os.getenv("BT_LSP_E2E_WAIT_MS") or "") or 10000
 
-local started = vim.loop.hrtime()
+local started = uv.hrtime()
 
 local function emit(event, data)
   data = data or {}
   data.event = event
-  data.ms = math.floor((vim.loop.hrtime() - started) / 1e6)
+  data.ms = math.floor((uv.hrtime() - started) / 1e6)
   io.stdout:write("BTLSP-E2E " .. vim.fn.json_encode(data) .. "\n")
   io.stdout:flush()
 end
@@ -121,13 +122,13 @@ local function settled_diagnostics(bufnr, quiet_ms, differs_from)
     return #vim.diagnostic.get(bufnr) > 0 and now ~= differs_from
   end)
   local last = vim.fn.json_encode(diagnostics(bufnr))
-  local stable_since = vim.loop.now()
+  local stable_since = uv.now()
   vim.wait(quiet_ms * 4, function()
     local now = vim.fn.json_encode(diagnostics(bufnr))
     if now ~= last then
-      last, stable_since = now, vim.loop.now()
+      last, stable_since = now, uv.now()
     end
-    return vim.loop.now() - stable_since >= quiet_ms
+    return uv.now() - stable_since >= quiet_ms
   end, 20)
   return diagnostics(bufnr)
 end
@@ -190,7 +191,7 @@ local function quickfix_scenario()
   local client = wait_attached(bufnr)
   emit("attached", { client = client_info(client) })
 
-  local diags = settled_diagnostics(bufnr, 300)
+  local diags = settled_diagnostics(bufnr, 200)
   emit("diagnostics", { items = diags })
 
   local row, col = locate(bufnr, '<BehaviorTree ID="Main Tree"', "Main Tree")
@@ -246,7 +247,7 @@ local function quickfix_scenario()
     modified = vim.bo[bufnr].modified,
   })
 
-  emit("diagnostics_after", { items = settled_diagnostics(bufnr, 300, before) })
+  emit("diagnostics_after", { items = settled_diagnostics(bufnr, 200, before) })
 end
 
 local function no_client_scenario()
@@ -254,7 +255,7 @@ local function no_client_scenario()
   emit("start", { nvim = version(), mode = require("bt_lsp").mode(), filetype = vim.bo.filetype })
   -- Starting a client is synchronous on FileType (0.7-0.10) or one tick later (0.11); give
   -- it ample time to happen if it were going to.
-  vim.wait(1500, function()
+  vim.wait(1000, function()
     return #all_clients() > 0
   end, 20)
   local info = {}
@@ -313,7 +314,10 @@ local function main()
   vim.wait(3000, function()
     return #all_clients() == 0
   end, 20)
-  emit("done")
+  -- Warnings Neovim showed (e.g. deprecations) end up in :messages.
+  local messages = vim.api.nvim_exec2 and vim.api.nvim_exec2("messages", { output = true }).output
+    or vim.api.nvim_exec("messages", true)
+  emit("done", { messages = messages })
 end
 
 local ok, err = xpcall(main, debug.traceback)

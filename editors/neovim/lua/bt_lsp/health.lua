@@ -36,7 +36,7 @@ local function probe(cmd, timeout_ms)
   if not ok or job <= 0 then
     return nil, "could not start " .. table.concat(cmd, " ") .. (ok and "" or (": " .. tostring(job)))
   end
-  local root = vim.loop.cwd()
+  local root = (vim.uv or vim.loop).cwd()
   vim.fn.chansend(job, lsp_message({
     jsonrpc = "2.0",
     id = 1,

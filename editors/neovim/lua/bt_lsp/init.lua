@@ -357,6 +357,13 @@ local function create_commands()
   end, { desc = "Restart the bt-lsp language server" })
 end
 
+local function check(name, value, kind, optional)
+  if (value == nil and optional) or type(value) == kind then
+    return
+  end
+  error(("bt_lsp.setup: %s must be a %s, not %s"):format(name, kind, type(value)), 3)
+end
+
 --- Sets bt-lsp up. Options (all optional):
 ---   cmd           argv of the server (default: M.default_cmd())
 ---   filetypes     filetypes to look at (default {"xml"}); only buffers whose first 200
@@ -375,14 +382,15 @@ function M.setup(opts)
   if type(opts.cmd) == "string" then
     opts.cmd = { opts.cmd }
   end
-  vim.validate({
-    cmd = { opts.cmd, "table" },
-    filetypes = { opts.filetypes, "table" },
-    root_markers = { opts.root_markers, "table" },
-    settings = { opts.settings, "table" },
-    on_attach = { opts.on_attach, "function", true },
-    capabilities = { opts.capabilities, "table", true },
-  })
+  check("cmd", opts.cmd, "table")
+  check("filetypes", opts.filetypes, "table")
+  check("root_markers", opts.root_markers, "table")
+  check("settings", opts.settings, "table")
+  check("on_attach", opts.on_attach, "function", true)
+  check("capabilities", opts.capabilities, "table", true)
+  if #opts.cmd == 0 then
+    error("bt_lsp.setup: cmd is empty", 2)
+  end
   state.opts = opts
 
   local group = api.nvim_create_augroup("bt_lsp", { clear = true })

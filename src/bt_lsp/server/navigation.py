@@ -1,0 +1,321 @@
+"""Navigation features: definition, references, highlights, rename, document and workspace
+symbols, folding ranges and linked editing.  Each handler converts positions with the
+document's own line index in the negotiated encoding and calls :mod:`bt_lsp.navigation`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from lsprotocol import types
+from pygls.exceptions import JsonRpcException
+from pygls.uris import from_fs_path
+
+from bt_lsp import __version__, navigation
+from bt_lsp.edits import TextEdit
+from bt_lsp.navigation import BUILTIN_CATALOG, DocSymbol, Place, RenameRefused, SymbolKind
+from bt_lsp.server.convert import to_range, to_text_edit
+from bt_lsp.server.lookup import (
+    Source,
+    context_of,
+    includes_of,
+    source_at,
+    workspace_sources,
+)
+from bt_lsp.server.state import OpenDocument
+from bt_lsp.text import Encoding, LineIndex
+
+if TYPE_CHECKING:
+    from bt_lsp.server.app import BtServer
+
+_SYMBOL_KINDS = {
+    SymbolKind.TREE: types.SymbolKind.Class,
+    SymbolKind.NODE: types.SymbolKind.Function,
+    SymbolKind.SUBTREE: types.SymbolKind.Module,
+    SymbolKind.MODELS: types.SymbolKind.Namespace,
+    SymbolKind.MODEL: types.SymbolKind.Interface,
+    SymbolKind.PORT: types.SymbolKind.Property,
+    SymbolKind.INCLUDE: types.SymbolKind.File,
+}
+
+
+class RequestFailed(JsonRpcException):
+    """LSP's ``RequestFailed``: the request was valid but cannot be done (the message says
+    why, and editors show it)."""
+
+    CODE = types.LSPErrorCodes.RequestFailed.value
+
+
+# --- the built-in catalog file ------------------------------------------------------------
+
+_catalog: tuple[str, LineIndex] | None = None
+
+
+def _catalog_dirs() -> list[Path]:
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return [Path(cache) / "bt-lsp" / __version__]
+
+
+def catalog_file() -> tuple[str, LineIndex] | None:
+    """The URI and line index of the built-in catalog, written once per process to the
+    user's cache folder (or a private temporary folder) so that editors can open it."""
+    global _catalog
+    if _catalog is not None:
+        return _catalog
+    text = navigation.builtin_catalog().text
+    for folder in _catalog_dirs():
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / "builtins.xml"
+            if not path.is_file() or path.read_text(encoding="utf-8") != text:
+                path.write_text(text, encoding="utf-8")
+            break
+        except OSError:
+            continue
+    else:
+        try:
+            path = Path(tempfile.mkdtemp(prefix="bt-lsp-")) / "builtins.xml"
+            path.write_text(text, encoding="utf-8")
+        except OSError:
+            return None
+    uri = from_fs_path(str(path))
+    if uri is None:
+        return None
+    _catalog = (uri, LineIndex(text))
+    return _catalog
+
+
+# --- conversions --------------------------------------------------------------------------
+
+
+def _offset(ls: BtServer, od: OpenDocument, pos: types.Position) -> int:
+    return od.doc.lines.offset(pos.line, pos.character, ls.encoding)
+
+
+def _locations(
+    ls: BtServer, od: OpenDocument, places: Sequence[Place], sources: dict[str, Source]
+) -> list[types.Location]:
+    enc = ls.encoding
+    out: list[types.Location] = []
+    for p in places:
+        if p.path is None:
+            uri, lines = od.uri, od.doc.lines
+        elif p.path == BUILTIN_CATALOG:
+            found = catalog_file()
+            if found is None:
+                continue
+            uri, lines = found
+        else:
+            src = source_at(ls, sources, p.path)
+            if src is None:
+                continue
+            uri, lines = src.uri, src.doc.lines
+        out.append(types.Location(uri=uri, range=to_range(lines, p.start, p.end, enc)))
+    return out
+
+
+def rename_edit(
+    ls: BtServer,
+    od: OpenDocument,
+    edits: Sequence[TextEdit],
+    other_edits: dict[str, tuple[TextEdit, ...]],
+    sources: dict[str, Source],
+) -> types.WorkspaceEdit:
+    """A WorkspaceEdit over several documents, each converted with its own line index
+    (versioned for open documents when the client supports document changes)."""
+    enc = ls.encoding
+    per_uri: list[tuple[str, int | None, list[types.TextEdit]]] = [
+        (od.uri, od.version, [to_text_edit(od.doc.lines, e, enc) for e in edits])
+    ]
+    for key, file_edits in other_edits.items():
+        src = sources.get(key)
+        if src is None:
+            continue
+        per_uri.append(
+            (src.uri, src.version, [to_text_edit(src.doc.lines, e, enc) for e in file_edits])
+        )
+    if ls.versioned_edits:
+        return types.WorkspaceEdit(
+            document_changes=[
+                types.TextDocumentEdit(
+                    text_document=types.OptionalVersionedTextDocumentIdentifier(
+                        uri=uri, version=version
+                    ),
+                    edits=list(lsp_edits),
+                )
+                for uri, version, lsp_edits in per_uri
+            ]
+        )
+    return types.WorkspaceEdit(changes={uri: e for uri, _, e in per_uri})
+
+
+def _document_symbol(lines: LineIndex, s: DocSymbol, enc: Encoding) -> types.DocumentSymbol:
+    return types.DocumentSymbol(
+        name=s.name,
+        detail=s.detail or None,
+        kind=_SYMBOL_KINDS[s.kind],
+        range=to_range(lines, s.start, s.end, enc),
+        selection_range=to_range(lines, s.sel_start, s.sel_end, enc),
+        children=[_document_symbol(lines, c, enc) for c in s.children],
+    )
+
+
+# --- features -----------------------------------------------------------------------------
+
+
+def register(server: BtServer) -> None:
+    @server.feature(types.TEXT_DOCUMENT_DEFINITION)
+    def definition(ls: BtServer, params: types.DefinitionParams) -> list[types.Location] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        sources = workspace_sources(ls, od)
+        places = navigation.definition(
+            od.doc,
+            _offset(ls, od, params.position),
+            {k: s.doc for k, s in sources.items()},
+            ctx=context_of(ls, od),
+            includes=includes_of(ls, od),
+        )
+        return _locations(ls, od, places, sources) or None
+
+    @server.feature(types.TEXT_DOCUMENT_REFERENCES)
+    def references(ls: BtServer, params: types.ReferenceParams) -> list[types.Location] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        sources = workspace_sources(ls, od)
+        places = navigation.references(
+            od.doc,
+            _offset(ls, od, params.position),
+            {k: s.doc for k, s in sources.items()},
+            include_declaration=params.context.include_declaration,
+        )
+        return _locations(ls, od, places, sources)
+
+    @server.feature(types.TEXT_DOCUMENT_DOCUMENT_HIGHLIGHT)
+    def highlight(
+        ls: BtServer, params: types.DocumentHighlightParams
+    ) -> list[types.DocumentHighlight] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        enc = ls.encoding
+        lines = od.doc.lines
+        return [
+            types.DocumentHighlight(
+                range=to_range(lines, h.start, h.end, enc),
+                kind=types.DocumentHighlightKind.Text
+                if h.text
+                else types.DocumentHighlightKind.Write
+                if h.write
+                else types.DocumentHighlightKind.Read,
+            )
+            for h in navigation.highlights(od.doc, _offset(ls, od, params.position))
+        ]
+
+    @server.feature(types.TEXT_DOCUMENT_PREPARE_RENAME)
+    def prepare_rename(
+        ls: BtServer, params: types.PrepareRenameParams
+    ) -> types.PrepareRenamePlaceholder | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        try:
+            target = navigation.prepare_rename(od.doc, _offset(ls, od, params.position))
+        except RenameRefused as e:
+            raise RequestFailed(e.message) from None
+        if target is None:
+            return None
+        return types.PrepareRenamePlaceholder(
+            range=to_range(od.doc.lines, target.start, target.end, ls.encoding),
+            placeholder=target.placeholder,
+        )
+
+    @server.feature(types.TEXT_DOCUMENT_RENAME)
+    def rename(ls: BtServer, params: types.RenameParams) -> types.WorkspaceEdit | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        sources = workspace_sources(ls, od)
+        try:
+            plan = navigation.rename(
+                od.doc,
+                _offset(ls, od, params.position),
+                params.new_name,
+                {k: s.doc for k, s in sources.items()},
+            )
+        except RenameRefused as e:
+            raise RequestFailed(e.message) from None
+        if plan is None:
+            return None
+        return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources)
+
+    @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
+    def document_symbol(
+        ls: BtServer, params: types.DocumentSymbolParams
+    ) -> list[types.DocumentSymbol] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        enc = ls.encoding
+        symbols = navigation.document_symbols(od.doc, context_of(ls, od))
+        return [_document_symbol(od.doc.lines, s, enc) for s in symbols]
+
+    @server.feature(types.WORKSPACE_SYMBOL)
+    def workspace_symbol(
+        ls: BtServer, params: types.WorkspaceSymbolParams
+    ) -> list[types.WorkspaceSymbol]:
+        enc = ls.encoding
+        sources = workspace_sources(ls)
+        found = navigation.workspace_symbols(((k, s.doc) for k, s in sources.items()), params.query)
+        out: list[types.WorkspaceSymbol] = []
+        for s in found:
+            src = sources[s.path]
+            out.append(
+                types.WorkspaceSymbol(
+                    name=s.name,
+                    kind=_SYMBOL_KINDS[s.kind],
+                    location=types.Location(
+                        uri=src.uri, range=to_range(src.doc.lines, s.start, s.end, enc)
+                    ),
+                    container_name=f"{s.detail} in {os.path.basename(s.path)}",
+                )
+            )
+        return out
+
+    @server.feature(types.TEXT_DOCUMENT_FOLDING_RANGE)
+    def folding_range(
+        ls: BtServer, params: types.FoldingRangeParams
+    ) -> list[types.FoldingRange] | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        return [
+            types.FoldingRange(
+                start_line=f.start_line,
+                end_line=f.end_line,
+                kind=types.FoldingRangeKind.Comment if f.comment else types.FoldingRangeKind.Region,
+            )
+            for f in navigation.folding_ranges(od.doc)
+        ]
+
+    @server.feature(types.TEXT_DOCUMENT_LINKED_EDITING_RANGE)
+    def linked_editing_range(
+        ls: BtServer, params: types.LinkedEditingRangeParams
+    ) -> types.LinkedEditingRanges | None:
+        od = ls.get(params.text_document.uri)
+        if od is None or not od.is_bt:
+            return None
+        spans = navigation.linked_editing_ranges(od.doc, _offset(ls, od, params.position))
+        if spans is None:
+            return None
+        enc = ls.encoding
+        return types.LinkedEditingRanges(
+            ranges=[to_range(od.doc.lines, s, e, enc) for s, e in spans],
+            word_pattern=r"[^\s<>/=\"']+",
+        )

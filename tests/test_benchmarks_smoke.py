@@ -1,0 +1,117 @@
+"""The benchmark's parts work: the generator writes the intended XML, the client drives the
+real server, and the runner produces its table.  Correctness only, never timings."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import Counter
+from pathlib import Path
+
+import pytest
+from lxml import etree
+
+from bt_lsp.analysis import analyze
+from bt_lsp.document import Document
+
+BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+sys.path.insert(0, str(BENCH))
+
+import generate as bench_generate  # noqa: E402
+import lsp_client as bench_client  # noqa: E402
+import run as bench_run  # noqa: E402
+
+
+@pytest.mark.parametrize("size", [3_000, 40_000, 300_000])
+def test_generated_xml_parses_and_has_exactly_the_planted_bad_names(size: int) -> None:
+    g = bench_generate.generate(size, seed=7)
+    assert g.text == bench_generate.generate(size, seed=7).text  # deterministic
+    root = etree.fromstring(g.text.encode())
+    assert root.tag == "root"
+    assert len(root.findall("BehaviorTree")) == g.trees
+    if size >= 40_000:
+        assert abs(len(g.text) - size) < size * 0.05
+
+    diags = analyze(Document(g.text))
+    named = Counter((d.code, g.text[d.start : d.end]) for d in diags if d.is_name_rule)
+    assert named == Counter({(p.code, p.name): p.count for p in g.planted})
+    assert {p.code for p in g.planted} >= {
+        "model-name-forbidden-char",
+        "port-name-forbidden-char",
+        "port-name-reserved",
+    }
+    # Apart from the planted names the document is clean.
+    assert [d for d in diags if not d.is_name_rule] == []
+
+
+def test_generator_command_line(tmp_path: Path) -> None:
+    out = tmp_path / "g.xml"
+    assert bench_generate.main(["12K", str(out), "--seed", "2"]) == 0
+    assert out.read_text(encoding="utf-8") == bench_generate.generate(12 * 1024, 2).text
+
+
+async def test_client_drives_the_server(tmp_path: Path) -> None:
+    g = bench_generate.generate(3_000, seed=5)
+    path = tmp_path / "doc.xml"
+    path.write_text(g.text, encoding="utf-8")
+    uri = bench_client.path_uri(path)
+    client = await bench_client.LspClient.start(bench_run.SERVER)
+    try:
+        result, seconds = await client.initialize(
+            bench_client.path_uri(tmp_path), {"debounceMs": 0}
+        )
+        assert "capabilities" in result and seconds > 0
+        assert bench_client.rss_kib(client.pid) > 0
+
+        fut = client.expect_diagnostics(uri, 1)
+        client.notify(
+            "textDocument/didOpen",
+            {"textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": g.text}},
+        )
+        first = await fut
+        expected: Counter[str] = Counter()
+        for p in g.planted:
+            expected[p.code] += p.count
+        assert Counter(d["code"] for d in first.diagnostics) == expected
+
+        # An edit that breaks the main tree's name: the diagnostics of version 2 say so.
+        at = g.text.index('main_tree_to_execute="') + len('main_tree_to_execute="')
+        pos = bench_run._position(g.text, at)
+        fut = client.expect_diagnostics(uri, 2)
+        client.notify(
+            "textDocument/didChange",
+            {
+                "textDocument": {"uri": uri, "version": 2},
+                "contentChanges": [{"range": {"start": pos, "end": pos}, "text": "x"}],
+            },
+        )
+        second = await fut
+        assert second.version == 2
+        assert "unknown-main-tree" in {d["code"] for d in second.diagnostics}
+    finally:
+        await client.close()
+    assert client.proc.returncode is not None
+
+
+def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "r.json"
+    args = ["--sizes", "4K", "--repeat", "1", "--edits", "2", "--requests", "1"]
+    assert bench_run.main([*args, "--no-check", "--json", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "| open → first diagnostics" in printed and "Start to `initialize`" in printed
+    results = json.loads(out.read_text(encoding="utf-8"))
+    (size,) = results["sizes"].values()
+    samples = size["samples"]
+    assert len(samples["open"]) == 1 and len(samples["edit"]) == 4
+    assert len(samples["quick fix"]) == len(samples["fix-all"]) == len(samples["hover"]) == 1
+    assert all(x > 0 for v in samples.values() for x in v)
+    assert size["diagnostics"] > 0 and size["memory"]["idle"] > 0
+    assert results["startup"]["samples"]["bare pygls"]
+
+
+def test_runner_checks_a_corpus(tmp_path: Path) -> None:
+    (tmp_path / "a.xml").write_text(bench_generate.generate(2_000, 1).text, encoding="utf-8")
+    files = bench_run.corpus_files(tmp_path)
+    assert len(files) == 1
+    assert bench_run.lxml_corpus_seconds(files) > 0
+    assert bench_run.check_seconds(tmp_path) > 0
