@@ -261,3 +261,26 @@ def test_raw_offsets_follow_the_decoder(pieces: list[str]) -> None:
     for i, ch in enumerate(decoded):
         assert decode_value(raw[offs[i] : offs[i + 1]], 0, None) == ch
     assert raw_span(raw, 0, len(decoded)) == (0, len(raw))
+
+
+# --- never crash ------------------------------------------------------------------------------
+
+TOKENS = (
+    "<root", '<root BTCPP_format="4"', "<BehaviorTree", ' ID="A"', ' ID="B"', " ID=''",
+    "<SubTree", "<Sequence", "<Action", "<Inverter", "<Parallel", ' success_count="3"',
+    "<TreeNodesModel", "<input_port", ' name="x"', ' name="_y"', "<include", ' ros_pkg="p"',
+    ' _skipIf="a &amp;&amp; (b"', ' code="x :="', "<Script", "<ReactiveSequence", "<AsyncSequence",
+    ' _autoremap="maybe"', ' msec="-1"', "<Sleep", "<SequenceStar", " _skipif='1'", ' ID="Sleep"',
+    ">", "/>", "</BehaviorTree>", "</Sequence>", "</root>", "</TreeNodesModel>", "</SubTree>",
+    "</Inverter>", "<!-- c -->", " ", "\n", "&", "<", '"', "=",
+)  # fmt: skip
+
+
+@given(st.lists(st.sampled_from(TOKENS), max_size=60))
+def test_check_and_fixes_never_raise(tokens: list[str]) -> None:
+    doc = Document("".join(tokens))
+    ctx = Context.from_document(doc)
+    for diag in analyze(doc, ctx):
+        assert 0 <= diag.start <= diag.end <= len(doc.text)
+        for fix in semantics.fixes_for(doc, ctx, diag):
+            apply_edits(doc.text, fix.edits)

@@ -41,6 +41,8 @@ from bt_lsp.diagnostics import Diagnostic, with_severities
 from bt_lsp.document import Document
 from bt_lsp.edits import TextEdit, apply_edits
 from bt_lsp.fileio import DEFAULT_MAX_BYTES, Decoded, FileError, read_text, write_text_atomic
+from bt_lsp.settings import Settings
+from bt_lsp.workspace import Workspace, normalize
 
 __all__ = [
     "FORMATS",
@@ -199,9 +201,12 @@ def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
 # -- checking and fixing -----------------------------------------------------------------
 
 
-def _analyze(doc: Document) -> list[Diagnostic]:
-    """Every diagnostic of ``doc``, before severity settings."""
-    return analysis.analyze(doc)
+def _analyze(doc: Document, workspace: Workspace | None = None) -> list[Diagnostic]:
+    """Every diagnostic of ``doc``, before severity settings; with a workspace, its
+    includes, models and trees count too."""
+    if workspace is None or doc.path is None:
+        return analysis.analyze(doc)
+    return workspace.diagnostics(normalize(doc.path), doc)
 
 
 def _findings(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[Finding]:
@@ -272,7 +277,11 @@ class _Fixed:
 
 
 def _fix(
-    decoded: Decoded, doc: Document, raw: list[Diagnostic], diags: list[Diagnostic]
+    decoded: Decoded,
+    doc: Document,
+    raw: list[Diagnostic],
+    diags: list[Diagnostic],
+    workspace: Workspace | None = None,
 ) -> _Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
     fix)."""
@@ -293,7 +302,7 @@ def _fix(
         char = e.object[e.start]
         return f"U+{ord(char):04X} cannot be written in {decoded.encoding.upper()}"
     new_doc = Document(new_text, doc.path)
-    new_raw = _analyze(new_doc)
+    new_raw = _analyze(new_doc, workspace)
     before, after = _xml_counts(raw), _xml_counts(new_raw)
     worse = sorted(code for code in after if after[code] > before[code])
     if worse:
@@ -317,8 +326,8 @@ def _fix(
     return _Fixed(new_doc, new_raw)
 
 
-def check_file(path: str, options: Options) -> FileResult:
-    """Read, analyze and (with ``options.fix``) fix one file."""
+def check_file(path: str, options: Options, workspace: Workspace | None = None) -> FileResult:
+    """Read, analyze and (with ``options.fix``) fix one file, in ``workspace`` if given."""
     result = FileResult(path)
     try:
         decoded = read_text(path, options.max_bytes)
@@ -327,16 +336,18 @@ def check_file(path: str, options: Options) -> FileResult:
         return result
     try:
         doc = Document(decoded.text, path)
-        raw = _analyze(doc)
+        raw = _analyze(doc, workspace)
         diags = with_severities(raw, options.severities)
         if options.fix:
-            outcome = _fix(decoded, doc, raw, diags)
+            outcome = _fix(decoded, doc, raw, diags, workspace)
             if isinstance(outcome, str):
                 result.not_fixed = outcome
             elif outcome is not None:
                 write_text_atomic(
                     path, outcome.doc.text, decoded.encoding, decoded.bom, expect=decoded.stamp
                 )
+                if workspace is not None:
+                    workspace.file_changed(path)
                 fixed_diags = with_severities(outcome.raw, options.severities)
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
                 doc, diags = outcome.doc, fixed_diags
@@ -610,10 +621,15 @@ def run(
         say(err, "bt-lsp: no XML files to check\n")
         return 2 if walk_errors else 0
 
+    # The folders named on the command line are the workspace: includes resolve as
+    # BehaviorTree.CPP resolves them, and every file's models and trees are known.
+    workspace = Workspace(
+        [p for p in paths if os.path.isdir(p)], Settings(max_document_bytes=options.max_bytes)
+    )
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        r = check_file(path, options)
+        r = check_file(path, options, workspace)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

@@ -146,8 +146,8 @@ CODES: dict[str, Code] = {
         Code(
             "unknown-node",
             Severity.ERROR,
-            "a node type that is neither built in nor declared (a hint when no custom "
-            "models are known)",
+            "a node type that is neither built in nor declared (a hint unless a catalog "
+            "of the custom nodes is configured)",
             _BT,
         ),
         Code("unknown-subtree", Severity.ERROR, "a `<SubTree ID>` that names no tree", _BT),

@@ -2,7 +2,8 @@
 
 An edit re-scans only the tokens around it (:func:`bt_lsp.scanner.rescan`) and updates the
 line index in place of rebuilding it; the model and diagnostics are derived lazily from
-the tokens when first asked for.
+the tokens when first asked for, the model from the previous one (only the sections around
+the tokens replaced since are built again, see :mod:`bt_lsp.model`).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import re
 
 from bt_lsp.diagnostics import Diagnostic, compute
 from bt_lsp.model import Model, build
-from bt_lsp.scanner import Scan, rescan, scan
+from bt_lsp.scanner import Rescan, Scan, rescan, scan
 from bt_lsp.text import LineIndex
 
 
@@ -23,6 +24,9 @@ class Document:
         self.scan: Scan = scan(text)
         self._model: Model | None = None
         self._diagnostics: list[Diagnostic] | None = None
+        # The last model built and the tokens replaced since, for the next model.
+        self._base: Model | None = None
+        self._change: Rescan | None = None
 
     def edit(self, start: int, end: int, new_text: str) -> None:
         """Replace ``text[start:end]`` (code-point offsets, clamped) with ``new_text``."""
@@ -31,8 +35,12 @@ class Document:
         end = min(max(end, start), n)
         new_full = self.text[:start] + new_text + self.text[end:]
         self.lines = self.lines.edited(start, end, new_text, new_full)
-        self.scan, _ = rescan(self.scan, new_full, start, end, len(new_text))
+        self.scan, change = rescan(self.scan, new_full, start, end, len(new_text))
         self.text = new_full
+        if self._model is not None:
+            self._base, self._change = self._model, change
+        elif self._change is not None:
+            self._change = self._change.then(change)
         self._model = None
         self._diagnostics = None
 
@@ -42,7 +50,8 @@ class Document:
     @property
     def model(self) -> Model:
         if self._model is None:
-            self._model = build(self.scan, self.text)
+            self._model = build(self.scan, self.text, self._base, self._change)
+            self._base = self._change = None
         return self._model
 
     @property

@@ -8,17 +8,30 @@ reserved attributes of nodes) nothing is a name.
 
 A *symbol* identifies what a name denotes, so that renaming one occurrence can rename all:
 ``("tree", id)``, ``("model", id)`` and ``("port", "tree"|"model", owner_id, port)``.
+
+Sections keep an edit cheap.  Each child of the root element, with everything inside it
+and the root-level tokens after it (whitespace, comments, stray end tags), is a
+:class:`Section` built on its own, in coordinates relative to its first token: offsets
+from its start, token indexes from its first token, element indexes local to it (0 is the
+root).  After an edit, :func:`build` re-runs only the sections from the first changed
+token until a section boundary lines up with an old one again; the other sections are the
+same objects as before, and so is everything derived from them and cached on them
+(diagnostics, declarations, semantic checks).  The whole-document views (``elements``,
+``refs``, ``problems``) are made of absolute copies, built when first asked for.
 """
 
 from __future__ import annotations
 
 import re
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
+from itertools import accumulate
+from typing import Any, overload
 
 from bt_lsp.names import RESERVED_PORT_NAMES, NameKind
-from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Scan, Token
+from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Rescan, Scan, Token
 
 Symbol = tuple[str, ...]
 
@@ -138,20 +151,311 @@ class StructureProblem:
     message: str
 
 
-@dataclass(slots=True)
+# --- sections -------------------------------------------------------------------------------
+
+OPEN, CLOSED, EOF = 0, 1, 2  # how a section ends: at root level, closing the root, at the end
+
+
+class Section:
+    """One child of the root element and the root-level tokens after it, relative to its
+    first token (see the module docstring).  ``elements`` are local element ``1..n``
+    (local element 0 is the root); ``lexical`` are the problems of its tokens.
+
+    ``cache`` holds what the layers above derive from the section alone (or validate
+    themselves), by their own keys; a section is immutable otherwise, so that it can be
+    shared by the models of successive versions of a document.
+    """
+
+    __slots__ = (
+        "cache",
+        "elements",
+        "end",
+        "length",
+        "lexical",
+        "ntokens",
+        "problems",
+        "refs",
+        "root_end",
+    )
+
+    def __init__(
+        self,
+        ntokens: int,
+        length: int,
+        elements: list[Element],
+        refs: list[NameRef],
+        problems: list[StructureProblem],
+        lexical: list[StructureProblem],
+        end: int,
+        root_end: tuple[int, int, int] | None,
+    ) -> None:
+        self.ntokens = ntokens
+        self.length = length
+        self.elements = elements
+        self.refs = refs
+        self.problems = problems
+        self.lexical = lexical
+        self.end = end
+        self.root_end = root_end
+        self.cache: dict[str, Any] = {}
+
+    @property
+    def top(self) -> Element:
+        """The root's child that starts the section (local element 1)."""
+        return self.elements[0]
+
+    def local_model(self, root: Element | None) -> Model:
+        """The section as a model of its own, in its coordinates; element 0 is ``root``
+        (the document's, in document coordinates: only its attributes and its number of
+        children mean anything here)."""
+        model: Model | None = self.cache.get("local_model")
+        if model is None or model.elements[0] is not root:
+            model = Model([root or _STAND_IN, *self.elements], self.refs, self.problems)
+            self.cache["local_model"] = model
+        return model
+
+    def ref_at(self, offset: int) -> NameRef | None:
+        """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
+        starts: list[int] | None = self.cache.get("ref_starts")
+        if starts is None:
+            starts = self.cache["ref_starts"] = [r.start for r in self.refs]
+        i = bisect_right(starts, offset) - 1
+        if i >= 0 and self.refs[i].start <= offset <= self.refs[i].end:
+            return self.refs[i]
+        return None
+
+    def by_symbol(self) -> dict[Symbol, list[NameRef]]:
+        index: dict[Symbol, list[NameRef]] | None = self.cache.get("by_symbol")
+        if index is None:
+            index = {}
+            for r in self.refs:
+                if r.symbol is not None:
+                    index.setdefault(r.symbol, []).append(r)
+            self.cache["by_symbol"] = index
+        return index
+
+
+class Part:
+    """Where a section (or the head or tail of a document) sits in a document: its offset,
+    its first token and its first element there."""
+
+    __slots__ = ("elem_base", "origin", "section", "tok_origin")
+
+    def __init__(self, section: Section, origin: int, tok_origin: int, elem_base: int) -> None:
+        self.section = section
+        self.origin = origin
+        self.tok_origin = tok_origin
+        self.elem_base = elem_base
+
+    def element_index(self, local: int) -> int:
+        """The document index of local element ``local`` (0 is the root, -1 none)."""
+        if local <= 0:
+            return local
+        return self.elem_base + local - 1
+
+    def element(self, el: Element) -> Element:
+        """An element of the section in document coordinates."""
+        o = self.origin
+        g = self.element_index
+        return Element(
+            el.name,
+            el.zone,
+            el.token_start + o,
+            el.token_index + self.tok_origin,
+            g(el.parent),
+            el.depth,
+            el.attrs,
+            el.self_closing,
+            el.closed,
+            el.end + o if el.end >= 0 else -1,
+            el.end_name_start + o if el.end_name_start >= 0 else -1,
+            el.end_name_end + o if el.end_name_end >= 0 else -1,
+            [g(c) for c in el.children],
+        )
+
+    def ref(self, r: NameRef) -> NameRef:
+        o = self.origin
+        return NameRef(
+            r.start + o,
+            r.end + o,
+            r.text,
+            r.kind,
+            r.role,
+            r.symbol,
+            self.element_index(r.element),
+            r.quote,
+        )
+
+    def problem(self, p: StructureProblem) -> StructureProblem:
+        return StructureProblem(p.start + self.origin, p.end + self.origin, p.code, p.message)
+
+
+class _Lazy(Sequence[Any]):
+    """A read-only list whose items are made on first access."""
+
+    __slots__ = ("_bases", "_items", "_make", "_n")
+
+    def __init__(self, n: int, bases: list[int], make: Callable[[int, int], Any]) -> None:
+        self._n = n
+        self._bases = bases  # first index of each chunk
+        self._make = make  # (chunk, index in chunk) -> item
+        self._items: list[Any] = [None] * n
+
+    def __len__(self) -> int:
+        return self._n
+
+    @overload
+    def __getitem__(self, i: int) -> Any: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[Any]: ...
+    def __getitem__(self, i: int | slice) -> Any:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(self._n))]
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError(i)
+        item = self._items[i]
+        if item is None:
+            chunk = bisect_right(self._bases, i) - 1
+            item = self._items[i] = self._make(chunk, i - self._bases[chunk])
+        return item
+
+    def __iter__(self) -> Iterator[Any]:
+        for i in range(self._n):
+            yield self[i]
+
+
+class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
+    """Every symbol's references in document order, made from the sections' own indexes;
+    the references of a symbol are put in document coordinates when asked for."""
+
+    __slots__ = ("_cache", "_chunks", "_keys")
+
+    def __init__(self, chunks: list[tuple[Part, dict[Symbol, list[NameRef]]]]) -> None:
+        self._chunks = chunks
+        keys: dict[Symbol, None] = {}
+        for _, index in chunks:
+            keys.update(dict.fromkeys(index))
+        self._keys = keys
+        self._cache: dict[Symbol, list[NameRef]] = {}
+
+    def __getitem__(self, symbol: Symbol) -> list[NameRef]:
+        refs = self._cache.get(symbol)
+        if refs is None:
+            if symbol not in self._keys:
+                raise KeyError(symbol)
+            refs = [part.ref(r) for part, index in self._chunks for r in index.get(symbol, ())]
+            self._cache[symbol] = refs
+        return refs
+
+    def __contains__(self, symbol: object) -> bool:
+        return symbol in self._keys
+
+    def __iter__(self) -> Iterator[Symbol]:
+        return iter(self._keys)
+
+    def __len__(self) -> int:
+        return len(self._keys)
+
+
 class Model:
-    elements: list[Element]
-    refs: list[NameRef]
-    problems: list[StructureProblem]
-    ref_starts: list[int]
-    _by_symbol: dict[Symbol, list[NameRef]] | None = None
+    """The model of a document, or of one section (in its coordinates).
+
+    ``elements``, ``refs`` and ``problems`` are in document order; a model made of
+    sections (:func:`build`) makes them on first use from its ``head`` (the root element,
+    and everything when the root has no child), its ``sections`` and its ``tail`` (from
+    the root's end tag on).  Section ``k`` starts at offset ``origins[k]`` and token
+    ``firsts[k]``; its top element is element ``bases[k]`` of the document.
+    """
+
+    __slots__ = (
+        "_by_symbol",
+        "_elements",
+        "_problems",
+        "_ref_starts",
+        "_refs",
+        "bases",
+        "firsts",
+        "head",
+        "head_ntokens",
+        "origins",
+        "root_element",
+        "sections",
+        "sections_end",
+        "tail",
+        "tail_base",
+        "tail_start",
+    )
+
+    def __init__(
+        self,
+        elements: Sequence[Element],
+        refs: Sequence[NameRef],
+        problems: Sequence[StructureProblem],
+        ref_starts: Sequence[int] | None = None,
+    ) -> None:
+        self._elements: Sequence[Element] | None = elements
+        self._refs: Sequence[NameRef] | None = refs
+        self._problems: Sequence[StructureProblem] | None = problems
+        self._ref_starts = ref_starts
+        self._by_symbol: Mapping[Symbol, list[NameRef]] | None = None
+        self.root_element: Element | None = None
+        self.head: Section | None = None  # None for a model that is not made of sections
+        self.head_ntokens = 0
+        self.sections: list[Section] = []
+        self.origins: list[int] = []
+        self.firsts: list[int] = []
+        self.bases: list[int] = []
+        self.sections_end = 0
+        self.tail: Section | None = None
+        self.tail_base = 0
+        self.tail_start = 0
+
+    # -- the whole document -----------------------------------------------------------------
+
+    @property
+    def elements(self) -> Sequence[Element]:
+        if self._elements is None:
+            self._elements = self._make_elements()
+        return self._elements
+
+    @property
+    def refs(self) -> Sequence[NameRef]:
+        if self._refs is None:
+            parts = self.parts()
+            lengths = [len(p.section.refs) for p in parts]
+            bases = [0, *accumulate(lengths)]
+            self._refs = _Lazy(
+                bases[-1], bases[:-1], lambda c, j: parts[c].ref(parts[c].section.refs[j])
+            )
+        return self._refs
+
+    @property
+    def problems(self) -> Sequence[StructureProblem]:
+        if self._problems is None:
+            self._problems = [p.problem(x) for p in self.parts() for x in p.section.problems]
+        return self._problems
+
+    @property
+    def ref_starts(self) -> Sequence[int]:
+        if self._ref_starts is None:
+            self._ref_starts = [r.start for r in self.refs]
+        return self._ref_starts
 
     @property
     def root(self) -> Element | None:
-        return self.elements[0] if self.elements and self.elements[0].zone == Zone.ROOT else None
+        if self.head is not None:
+            return self.root_element
+        els = self.elements
+        return els[0] if len(els) and els[0].zone == Zone.ROOT else None
 
     def ref_at(self, offset: int) -> NameRef | None:
         """The name token containing ``offset`` (its end counts: a cursor after a name)."""
+        if self.head is not None:
+            part = self.part_at(offset)
+            local = part.section.ref_at(offset - part.origin)
+            return part.ref(local) if local is not None else None
         i = bisect_right(self.ref_starts, offset) - 1
         if i >= 0 and self.refs[i].start <= offset <= self.refs[i].end:
             return self.refs[i]
@@ -161,19 +465,77 @@ class Model:
         return self.by_symbol.get(symbol, [])
 
     @property
-    def by_symbol(self) -> dict[Symbol, list[NameRef]]:
+    def by_symbol(self) -> Mapping[Symbol, list[NameRef]]:
         """Every symbol's references in document order (built once, on first use)."""
         if self._by_symbol is None:
-            index: dict[Symbol, list[NameRef]] = {}
-            for r in self.refs:
-                if r.symbol is not None:
-                    index.setdefault(r.symbol, []).append(r)
-            self._by_symbol = index
+            if self.head is not None:
+                self._by_symbol = _SymbolIndex([(p, p.section.by_symbol()) for p in self.parts()])
+            else:
+                index: dict[Symbol, list[NameRef]] = {}
+                for r in self.refs:
+                    if r.symbol is not None:
+                        index.setdefault(r.symbol, []).append(r)
+                self._by_symbol = index
         return self._by_symbol
 
     def trees(self) -> list[Element]:
-        return [e for e in self.elements if e.zone == Zone.TREE]
+        return [e for e in self.root_children() if e.zone == Zone.TREE]
 
+    def root_children(self) -> list[Element]:
+        """The root's child elements (in document coordinates)."""
+        root = self.root
+        if root is None:
+            return []
+        els = self.elements
+        return [els[i] for i in root.children]
+
+    # -- sections ---------------------------------------------------------------------------
+
+    def part(self, k: int) -> Part:
+        """Section ``k`` and where it sits."""
+        return Part(self.sections[k], self.origins[k], self.firsts[k], self.bases[k])
+
+    def parts(self) -> list[Part]:
+        """The head, every section and the tail, with where they sit."""
+        if self.head is None:
+            return []
+        out = [Part(self.head, 0, 0, 1)]
+        out.extend(map(Part, self.sections, self.origins, self.firsts, self.bases))
+        if self.tail is not None:
+            out.append(Part(self.tail, 0, 0, self.tail_base))
+        return out
+
+    def part_at(self, offset: int) -> Part:
+        """The part (head, section or tail) that holds ``offset``."""
+        assert self.head is not None
+        if self.tail is not None and offset >= self.tail_start:
+            return Part(self.tail, 0, 0, self.tail_base)
+        k = bisect_right(self.origins, offset) - 1
+        if k < 0:
+            return Part(self.head, 0, 0, 1)
+        return self.part(k)
+
+    def _make_elements(self) -> Sequence[Element]:
+        root = self.root_element
+        if root is None:
+            return []
+        parts = self.parts()
+        bases = [p.elem_base for p in parts]
+        n = bases[-1] + len(parts[-1].section.elements)
+        lazy = _Lazy(n, bases, lambda c, j: parts[c].element(parts[c].section.elements[j]))
+        if n:
+            lazy._items[0] = root
+        return lazy
+
+
+# The root of a section's own model when the document's is not at hand.
+_STAND_IN = Element("", Zone.ROOT, 0, 0, -1, 0, (), False, True)
+
+
+# --- XML names --------------------------------------------------------------------------------
+
+
+# --- XML names --------------------------------------------------------------------------------
 
 # An XML 1.0 (5th edition) Name.
 _NAME_START = (
@@ -181,8 +543,39 @@ _NAME_START = (
     "\u2070-\u218f\u2c00-\u2fef\u3001-\ud7ff\uf900-\ufdcf\ufdf0-\ufffd\U00010000-\U000effff"
 )
 _NAME_CHAR = _NAME_START + r"\-.0-9\u00b7\u0300-\u036f\u203f-\u2040"
-XML_NAME_RE = re.compile(f"[{_NAME_START}][{_NAME_CHAR}]*")
-_NOT_NAME_CHAR = re.compile(f"[^{_NAME_CHAR}]")
+
+
+class _LazyPattern:
+    """A regular expression compiled on first use (these character classes take tens of
+    milliseconds to compile, which the server's start should not pay)."""
+
+    __slots__ = ("_compiled", "_source")
+
+    def __init__(self, source: str) -> None:
+        self._source = source
+        self._compiled: re.Pattern[str] | None = None
+
+    @property
+    def pattern(self) -> re.Pattern[str]:
+        if self._compiled is None:
+            self._compiled = re.compile(self._source)
+        return self._compiled
+
+    def match(self, text: str) -> re.Match[str] | None:
+        return self.pattern.match(text)
+
+    def fullmatch(self, text: str) -> re.Match[str] | None:
+        return self.pattern.fullmatch(text)
+
+    def finditer(self, text: str) -> Iterator[re.Match[str]]:
+        return self.pattern.finditer(text)
+
+
+XML_NAME_RE = _LazyPattern(f"[{_NAME_START}][{_NAME_CHAR}]*")
+_NOT_NAME_CHAR = _LazyPattern(f"[^{_NAME_CHAR}]")
+# The same for ASCII names (the common case), cheap to compile.
+_ASCII_NAME_RE = re.compile(r"[:A-Z_a-z][-.0-9:A-Z_a-z]*")
+_ASCII_NOT_NAME_CHAR = re.compile(r"[^-.0-9:A-Z_a-z]")
 # Characters the name rules already report (so an XML-name error would only repeat it).
 _RULE_FORBIDDEN = set(" \t\n\r<>&\"'/\\:*?|.") | {chr(c) for c in range(32)} | {"\x7f"}
 
@@ -190,21 +583,44 @@ _RULE_FORBIDDEN = set(" \t\n\r<>&\"'/\\:*?|.") | {chr(c) for c in range(32)} | {
 def xml_name_problem(name: str, checked: bool, port: bool = False) -> tuple[int, str] | None:
     """First character that makes ``name`` an invalid XML name, unless the name rules
     already report it (``checked``; for a ``port``, a leading digit too): (index, message)."""
-    if XML_NAME_RE.fullmatch(name):
-        return None
-    if name and not XML_NAME_RE.match(name[0]) and _NOT_NAME_CHAR.match(name[0]) is None:
+    if name.isascii():
+        if _ASCII_NAME_RE.fullmatch(name):
+            return None
+        name_re: Any = _ASCII_NAME_RE
+        not_name: Any = _ASCII_NOT_NAME_CHAR
+    else:
+        name_re, not_name = XML_NAME_RE, _NOT_NAME_CHAR
+        if name_re.fullmatch(name):
+            return None
+    if name and not name_re.match(name[0]) and not_name.match(name[0]) is None:
         if port and checked and name[0] in "0123456789":
             return None
         if not checked or name[0] not in _RULE_FORBIDDEN:
             return 0, f"An XML name cannot start with {name[0]!r}"
         return None
-    for m in _NOT_NAME_CHAR.finditer(name):
+    for m in not_name.finditer(name):
         ch = m.group(0)
         if checked and ch in _RULE_FORBIDDEN:
             continue
         shown = repr(ch) if ch.isprintable() else f"U+{ord(ch):04X}"
         return m.start(), f"{shown} is not allowed in an XML name ('{name}')"
     return None
+
+
+# Names repeat: their XML-name check is remembered (bounded; cleared when full).
+_XML_NAME_CACHE: dict[tuple[str, bool, bool], tuple[int, str] | None] = {}
+
+
+def _xml_name_problem(name: str, checked: bool, port: bool) -> tuple[int, str] | None:
+    key = (name, checked, port)
+    try:
+        return _XML_NAME_CACHE[key]
+    except KeyError:
+        pass
+    if len(_XML_NAME_CACHE) >= 65536:
+        _XML_NAME_CACHE.clear()
+    found = _XML_NAME_CACHE[key] = xml_name_problem(name, checked, port)
+    return found
 
 
 def _zone_of(name: str, parent: Element | None, has_root: bool) -> Zone:
@@ -331,85 +747,277 @@ def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
 def _check_xml_names(
     tstart: int, tok: Token, checked: bool, problems: list[StructureProblem]
 ) -> None:
-    xp = xml_name_problem(tok.name, checked and tok.name not in EXPLICIT_TAGS)
+    xp = _xml_name_problem(tok.name, checked and tok.name not in EXPLICIT_TAGS, False)
     if xp is not None:
         at = tstart + 1 + xp[0]
         problems.append(StructureProblem(at, at + 1, XML_SYNTAX, xp[1]))
     for a in tok.attrs:
-        xp = xml_name_problem(a.name, checked, port=True)
+        xp = _xml_name_problem(a.name, checked, True)
         if xp is not None:
             at = tstart + a.name_start + xp[0]
             problems.append(StructureProblem(at, at + 1, XML_SYNTAX, xp[1]))
 
 
-def build(scan: Scan, text: str) -> Model:
-    """The model of a scanned text.  One pass, an explicit stack, no recursion."""
-    elements: list[Element] = []
-    refs: list[NameRef] = []
-    problems: list[StructureProblem] = []
-    stack: list[int] = []
-    has_root = False
-    for ti, (tstart, tok) in enumerate(zip(scan.starts, scan.tokens, strict=True)):
-        kind = tok.kind
-        if kind == Kind.TEXT:
-            if not stack and not text[tstart : tstart + tok.length].isspace():
-                m = _NON_SPACE.search(text, tstart, tstart + tok.length)
-                at = m.start() if m else tstart
-                problems.append(
-                    StructureProblem(
-                        at,
-                        tstart + tok.length,
-                        XML_SYNTAX,
-                        "Text outside the root element"
-                        if has_root
-                        else "Text before the root element",
-                    )
-                )
-            continue
-        if kind == Kind.START:
-            parent = elements[stack[-1]] if stack else None
-            zone = _zone_of(tok.name, parent, has_root)
-            if parent is None:
-                if has_root:
-                    problems.append(
-                        StructureProblem(
-                            tstart + 1,
-                            tstart + 1 + len(tok.name),
-                            XML_SYNTAX,
-                            f"Extra top-level element '<{tok.name}>'; a document has one root",
-                        )
-                    )
-                has_root = True
-            idx = len(elements)
-            el = Element(
-                tok.name,
-                zone,
-                tstart,
-                ti,
-                stack[-1] if stack else -1,
-                len(stack),
-                tok.attrs,
-                tok.self_closing,
-                tok.closed,
-            )
-            elements.append(el)
-            if parent is not None:
-                parent.children.append(idx)
-            refs.extend(_name_refs(el, idx, parent))
-            _check_xml_names(tstart, tok, zone == Zone.NODE, problems)
-            if tok.self_closing:
-                el.end = tstart + tok.length
-            else:
-                stack.append(idx)
-        elif kind == Kind.END:
-            _close(tstart, tok, elements, stack, refs, problems)
-    while stack:
-        _report_unclosed(elements[stack.pop()], problems, closed_by=None)
-    refs.sort(key=lambda r: r.start)
-    return Model(elements, refs, problems, [r.start for r in refs])
-
-
 _NON_SPACE = re.compile(r"[^ \t\r\n]")
+
+_HEAD, _SECTION, _TAIL = 0, 1, 2
+
+
+class _Builder:
+    """Runs the element stack over tokens.  Offsets are stored relative to ``origin``,
+    token indexes relative to ``tok_origin``; elements are numbered in ``els`` (where,
+    for a section or the tail, element 0 is the root)."""
+
+    __slots__ = (
+        "els",
+        "has_root",
+        "lexical",
+        "origin",
+        "problems",
+        "refs",
+        "stack",
+        "text",
+        "tok_origin",
+    )
+
+    def __init__(
+        self,
+        text: str,
+        origin: int,
+        tok_origin: int,
+        els: list[Element],
+        stack: list[int],
+        has_root: bool,
+    ) -> None:
+        self.text = text
+        self.origin = origin
+        self.tok_origin = tok_origin
+        self.els = els
+        self.stack = stack
+        self.has_root = has_root
+        self.refs: list[NameRef] = []
+        self.problems: list[StructureProblem] = []
+        self.lexical: list[StructureProblem] = []
+
+    def run(self, tokens: list[Token], starts: list[int], i: int, mode: int) -> tuple[int, int]:
+        """Process tokens from ``i``; returns where it stopped and how (``OPEN``: at a
+        start tag with only the root open, or, for a section, at the root's end tag;
+        ``CLOSED``: a section closed the root; ``EOF``)."""
+        n = len(tokens)
+        text, origin = self.text, self.origin
+        els, stack, refs, problems, lexical = (
+            self.els,
+            self.stack,
+            self.refs,
+            self.problems,
+            self.lexical,
+        )
+        first = i
+        start_kind, end_kind, text_kind = Kind.START, Kind.END, Kind.TEXT
+        node_zone = Zone.NODE
+        while i < n:
+            tok = tokens[i]
+            kind = tok.kind
+            at_root = len(stack) == 1 and stack[0] == 0
+            if at_root and mode != _TAIL:
+                if kind == start_kind and (mode == _HEAD or i != first):
+                    return i, OPEN
+                if mode == _SECTION and kind == end_kind and tok.name == els[0].name:
+                    return i, OPEN
+            tstart = starts[i] - origin
+            if tok.problems:
+                for p in tok.problems:
+                    lexical.append(
+                        StructureProblem(tstart + p.start, tstart + p.end, p.code, p.message)
+                    )
+            if kind == text_kind:
+                if not stack:
+                    a = starts[i]
+                    if not text[a : a + tok.length].isspace():
+                        m = _NON_SPACE.search(text, a, a + tok.length)
+                        at = (m.start() if m else a) - origin
+                        problems.append(
+                            StructureProblem(
+                                at,
+                                tstart + tok.length,
+                                XML_SYNTAX,
+                                "Text outside the root element"
+                                if self.has_root
+                                else "Text before the root element",
+                            )
+                        )
+            elif kind == start_kind:
+                parent = els[stack[-1]] if stack else None
+                zone = _zone_of(tok.name, parent, self.has_root)
+                if parent is None:
+                    if self.has_root:
+                        problems.append(
+                            StructureProblem(
+                                tstart + 1,
+                                tstart + 1 + len(tok.name),
+                                XML_SYNTAX,
+                                f"Extra top-level element '<{tok.name}>'; a document has one root",
+                            )
+                        )
+                    self.has_root = True
+                idx = len(els)
+                el = Element(
+                    tok.name,
+                    zone,
+                    tstart,
+                    i - self.tok_origin,
+                    stack[-1] if stack else -1,
+                    len(stack),
+                    tok.attrs,
+                    tok.self_closing,
+                    tok.closed,
+                )
+                els.append(el)
+                if parent is not None:
+                    parent.children.append(idx)
+                refs.extend(_name_refs(el, idx, parent))
+                _check_xml_names(tstart, tok, zone == node_zone, problems)
+                if tok.self_closing:
+                    el.end = tstart + tok.length
+                else:
+                    stack.append(idx)
+            elif kind == end_kind:
+                _close(tstart, tok, els, stack, refs, problems)
+                if mode == _SECTION and not stack:
+                    return i + 1, CLOSED
+            i += 1
+        return i, EOF
+
+    def finish(self, keep_root: bool) -> None:
+        """Report the elements left open at the end (the root too unless ``keep_root``)."""
+        stack = self.stack
+        while len(stack) > (1 if keep_root else 0):
+            _report_unclosed(self.els[stack.pop()], self.problems, closed_by=None)
+
+    def section(self, ntokens: int, length: int, end: int) -> Section:
+        self.refs.sort(key=_start)
+        root_end = None
+        if end == CLOSED:
+            root = self.els[0]
+            root_end = (root.end, root.end_name_start, root.end_name_end)
+        return Section(
+            ntokens,
+            length,
+            self.els[1:],
+            self.refs,
+            self.problems,
+            self.lexical,
+            end,
+            root_end,
+        )
+
+
+def _start(r: NameRef) -> int:
+    return r.start
+
+
+def _section(
+    tokens: list[Token], starts: list[int], text: str, i: int, root_name: str
+) -> tuple[Section, int, int]:
+    """The section that starts at token ``i`` (a start tag with only the root open)."""
+    origin = starts[i]
+    stand_in = Element(root_name, Zone.ROOT, -origin, -i, -1, 0, (), False, True)
+    b = _Builder(text, origin, i, [stand_in], [0], True)
+    j, end = b.run(tokens, starts, i, _SECTION)
+    if end == EOF:
+        b.finish(keep_root=True)
+    length = (starts[j] if j < len(starts) else len(text)) - origin
+    return b.section(j - i, length, end), j, end
+
+
+def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None = None) -> Model:
+    """The model of a scanned text.  One pass, an explicit stack, no recursion.
+
+    With the model ``old`` of the previous text and ``change``, the tokens an edit
+    replaced since (see :func:`bt_lsp.scanner.rescan`), the sections that the edit cannot
+    have changed are reused.
+    """
+    tokens, starts = scan.tokens, scan.starts
+    n = len(tokens)
+    hb = _Builder(text, 0, 0, [], [], False)
+    i, state = hb.run(tokens, starts, 0, _HEAD)
+    root = hb.els[0] if hb.els else None
+    model = Model([], [], [])
+    model._elements = model._refs = model._problems = None
+    model.root_element = root
+    model.head_ntokens = i
+    sections: list[Section] = []
+    origins: list[int] = []
+    firsts: list[int] = []
+    bases: list[int] = []
+    if state == OPEN and root is not None:
+        base = 1
+        shift = 0
+        reuse = (
+            old is not None
+            and change is not None
+            and bool(old.sections)
+            and change.first >= old.head_ntokens
+        )
+        if reuse:
+            assert old is not None and change is not None
+            ends = old.firsts[1:]
+            ends.append(old.sections_end)
+            k = bisect_left(ends, change.first)
+            if k:
+                sections = old.sections[:k]
+                origins = old.origins[:k]
+                firsts = old.firsts[:k]
+                bases = old.bases[:k]
+                i = ends[k - 1]
+                state = sections[-1].end
+                base = bases[-1] + len(sections[-1].elements)
+            shift = change.new_stop - change.old_stop
+        while state == OPEN and i < n and tokens[i].kind == Kind.START:
+            if reuse and i >= change.new_stop:  # type: ignore[union-attr]
+                assert old is not None
+                m = bisect_left(old.firsts, i - shift)
+                if m < len(old.firsts) and old.firsts[m] == i - shift:
+                    # The rest lines up with the old sections again.
+                    dchar = starts[i] - old.origins[m]
+                    dbase = base - old.bases[m]
+                    sections.extend(old.sections[m:])
+                    origins.extend(map(dchar.__add__, old.origins[m:]))
+                    firsts.extend(map(shift.__add__, old.firsts[m:]))
+                    bases.extend(map(dbase.__add__, old.bases[m:]))
+                    i = old.sections_end + shift
+                    state = old.sections[-1].end
+                    base = bases[-1] + len(sections[-1].elements)
+                    break
+            sec, j, state = _section(tokens, starts, text, i, root.name)
+            sections.append(sec)
+            origins.append(starts[i])
+            firsts.append(i)
+            bases.append(base)
+            base += len(sec.elements)
+            i = j
+        model.sections, model.origins, model.firsts, model.bases = sections, origins, firsts, bases
+        model.sections_end = i
+        root.children = list(bases)
+        if state == CLOSED:
+            re_ = sections[-1].root_end
+            assert re_ is not None
+            o = origins[-1]
+            root.end, root.end_name_start, root.end_name_end = (
+                re_[0] + o,
+                re_[1] + o if re_[1] >= 0 else -1,
+                re_[2] + o if re_[2] >= 0 else -1,
+            )
+        tb = _Builder(text, 0, 0, [root], [0] if state != CLOSED else [], True)
+        tb.run(tokens, starts, i, _TAIL)
+        tb.finish(keep_root=False)
+        model.tail_start = starts[i] if i < n else len(text)
+        model.tail = tb.section(n - i, len(text) - model.tail_start, EOF)
+        model.tail_base = base
+    else:
+        hb.finish(keep_root=False)
+    model.head = hb.section(i if sections else n, 0, EOF)
+    return model
 
 
 def _close(

@@ -446,9 +446,6 @@ class RenamePlan:
         return len(self.edits) + sum(len(e) for e in self.other_edits.values())
 
 
-_WHAT = {"tree": "tree", "model": "node type"}
-
-
 def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
     """The name a rename at ``offset`` would change, ``None`` when there is none there.
 

@@ -572,6 +572,14 @@ class Rescan:
     old_stop: int
     new_stop: int
 
+    def then(self, later: Rescan) -> Rescan:
+        """The tokens replaced by this re-scan followed by ``later`` (a re-scan of this
+        one's result): a range that holds both, possibly with unchanged tokens too."""
+        d1 = self.new_stop - self.old_stop
+        d2 = later.new_stop - later.old_stop
+        new_stop = max(later.new_stop, self.new_stop + d2)
+        return Rescan(min(self.first, later.first), new_stop - d1 - d2, new_stop)
+
 
 def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> tuple[Scan, Rescan]:
     """Update ``old`` for the edit that replaced old ``[start, old_end)`` with ``new_len``
@@ -604,7 +612,7 @@ def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> 
                 while k < nold and starts[k] < old_pos:
                     k += 1
                 if k < nold and starts[k] == old_pos:
-                    tail_starts = [s + delta for s in starts[k:]] if delta else starts[k:]
+                    tail_starts = list(map(delta.__add__, starts[k:])) if delta else starts[k:]
                     result = Scan(
                         tokens[:first] + new_tokens + tokens[k:],
                         starts[:first] + new_starts + tail_starts,

@@ -306,3 +306,27 @@ async def test_entity_references_are_part_of_the_range(client: BtClient) -> None
     # Columns count characters of the name as BehaviorTree.CPP sees it ("A&B\tC").
     assert "'&' (ampersand) at column 2" in tree.message
     assert "U+0009 (tab) at column 4" in tree.message
+
+
+@clients(*PULL_CLIENTS)
+async def test_unchanged_only_when_nothing_changed(client: BtClient) -> None:
+    """Another document can change a document's diagnostics (models declared elsewhere
+    count): a report is "unchanged" only if the items really are the same."""
+    user = client.open(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><MyAction/></BehaviorTree></root>\n',
+        name="user",
+    )
+    first = await client.pull_report(user)
+    assert isinstance(first, types.RelatedFullDocumentDiagnosticReport)
+    client.open(
+        '<root BTCPP_format="4"><TreeNodesModel><Action ID="MyAction">'
+        '<input_port name="target"/></Action></TreeNodesModel></root>\n',
+        name="models",
+    )
+    again = await client.pull_report(user, previous=first.result_id)
+    now = await client.pull_report(user)
+    assert isinstance(now, types.RelatedFullDocumentDiagnosticReport)
+    if isinstance(again, types.RelatedUnchangedDocumentDiagnosticReport):
+        assert summary(now.items) == summary(first.items)
+    else:
+        assert summary(again.items) == summary(now.items)

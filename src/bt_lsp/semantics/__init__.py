@@ -1,7 +1,8 @@
 """BehaviorTree.CPP's semantic rules over one document and its workspace context.
 
 :func:`check` runs every rule family in one pass over the document's elements (the
-context, which holds what the document itself declares, is built before it):
+context, which holds what the document itself declares, is built before it), section by
+section with each section's results remembered (:mod:`~bt_lsp.semantics.sections`):
 
 * :mod:`~bt_lsp.semantics.document`: ``<root>``, sections, includes, nesting depth;
 * :mod:`~bt_lsp.semantics.trees`: tree IDs, ``<SubTree>`` calls, the main tree, cycles;
@@ -16,14 +17,16 @@ Each module's docstring lists its codes with their severity and range.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.model import Zone
+from bt_lsp.model import Element, Zone
 from bt_lsp.semantics import document, models, nodes, ports, trees
 from bt_lsp.semantics.base import State, TreeScope
 from bt_lsp.semantics.fixes import fixes_for
+from bt_lsp.semantics.sections import check_sections
 
 if TYPE_CHECKING:
     from bt_lsp.document import Document
@@ -36,8 +39,23 @@ def check(doc: Document, ctx: Context) -> list[Diagnostic]:
     model = doc.model
     st = State(doc, ctx, model, doc.text)
     document.check_root(st)
+    if model.head is not None:
+        check_sections(st, check_elements)  # each child of <root>, remembered
+    else:
+        check_elements(st, model.elements)
+    trees.check_duplicate_ids(st)
+    trees.check_main_tree(st)
+    trees.check_recursion(st)
+    st.out.sort(key=lambda d: (d.start, d.end, d.code))
+    return st.out
+
+
+def check_elements(st: State, elements: Sequence[Element]) -> None:
+    """The rules of single elements, in document order (``<BehaviorTree>`` elements start
+    the scope of the nodes that follow).  They run section by section: see
+    :mod:`bt_lsp.semantics.sections` for what they may read."""
     scope = TreeScope(None)
-    for el in model.elements:
+    for el in elements:
         zone = el.zone
         if zone == Zone.NODE:
             document.check_depth(st, el, scope.depth_flagged)
@@ -53,7 +71,3 @@ def check(doc: Document, ctx: Context) -> list[Diagnostic]:
             models.check_entry(st, el)
         elif zone == Zone.PORT_DECL:
             models.check_port_decl(st, el)
-    trees.check_main_tree(st)
-    trees.check_recursion(st)
-    st.out.sort(key=lambda d: (d.start, d.end, d.code))
-    return st.out

@@ -92,6 +92,17 @@ class State:
     v4: bool = False  # <root> declares BTCPP_format
     _types: dict[str, Resolved | None] = field(default_factory=dict)
     _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
+    # A run over one section of the document (see sections.py) has the section's model and
+    # text, in coordinates that start at document offset ``origin``.
+    origin: int = 0
+    uses_lines: bool = False  # whether a message names a line (see line_of)
+
+    def line_of(self, offset: int) -> int:
+        """The 0-based document line of ``offset`` (in this run's coordinates).  Messages
+        that name a line depend on where their section is: the section's results are kept
+        only as long as it starts on the same line."""
+        self.uses_lines = True
+        return self.doc.lines.line_of(self.origin + offset)
 
     def add(
         self,

@@ -6,13 +6,15 @@
   ("Attribute [ID] is not allowed").  Range: the attribute name.  Fix: remove it.
 * ``unknown-node``: a compact element name or explicit ``ID`` that is neither a built-in
   nor declared in a ``<TreeNodesModel>`` of the context ("Node not recognized").  An error
-  when the workspace knows custom models, else a hint (nodes registered only in C++ are
-  normal).  BehaviorTree.CPP 3 names (``SequenceStar``, ``SubTreePlus``, the
-  ``RetryUntilSuccesful`` typo) and tree IDs used as node types are errors in a document
-  with ``BTCPP_format``, warnings without; a case-insensitive match of a built-in is an
-  error.  Range: the element name (compact) or the ``ID`` value (explicit).  Fixes: rename
-  to the suggested name, declare the node in ``<TreeNodesModel>``.  Names that break the
-  name rules are left to those.
+  when a catalog of the custom nodes is configured (``ctx.workspace_has_custom_models``),
+  else a hint: nodes registered only in C++ are normal.  BehaviorTree.CPP 3 names
+  (``SequenceStar``, ``SubTreePlus``), the ``RetryUntilSuccesful`` typo and tree IDs used
+  as node types are errors in a document with ``BTCPP_format`` and warnings without; a
+  case-insensitive match of a built-in is an error; the version 3 built-ins
+  ``BlackboardCheck*`` follow the general rule (version 4 still ships the class for users
+  to register).  Range: the element name (compact) or the ``ID`` value (explicit).
+  Fixes: rename to the suggested type, call a tree with ``<SubTree>``, declare the node in
+  ``<TreeNodesModel>``.  Names that break the name rules are left to those.
 * ``child-count`` (error): built-in child rules (decorators 1, controls 1 or more, leaves
   and ``<SubTree>`` 0, ``TryCatch`` 2 or more, ``IfThenElse``/``WhileDoElse`` 2 or 3,
   ``SwitchN`` N+1); for declared custom nodes the rule of their category.  Range: the

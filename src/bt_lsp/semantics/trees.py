@@ -37,7 +37,7 @@ from bt_lsp.semantics.base import State, TreeScope, quoted
 
 def _where(st: State, decl: TreeDecl) -> str:
     if st.ctx.is_own(decl):
-        return f"line {st.doc.lines.line_of(decl.start) + 1}"
+        return f"line {st.line_of(decl.start) + 1}"
     return os.path.basename(decl.path) if decl.path else "another document"
 
 
@@ -83,7 +83,6 @@ def begin_tree(st: State, el: Element) -> None:
     elif a.value:
         s, e = el.span_of_value(a)
         _registered_name(st, "BehaviorTree", a.value, s, e)
-        _duplicate(st, a.value, s, e)
     n = len(el.children)
     if n != 1:
         tid = el.value("ID") or ""
@@ -95,6 +94,16 @@ def begin_tree(st: State, el: Element) -> None:
             f"The <BehaviorTree> with ID {quoted(tid)} has {what}; it must have exactly 1 "
             "(wrap several nodes in a <Sequence> or another control node)",
         )
+
+
+def check_duplicate_ids(st: State) -> None:
+    """``duplicate-tree-id`` for this document's trees.  A document-wide rule: it compares
+    the positions of the definitions, which every edit before them moves."""
+    for tree_id, decls in st.ctx.trees.items():
+        if len(decls) > 1:
+            for d in decls:
+                if st.ctx.is_own(d):
+                    _duplicate(st, tree_id, d.start, d.end)
 
 
 def _duplicate(st: State, tree_id: str, start: int, end: int) -> None:
@@ -138,7 +147,7 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
             scope.subtree_names[name.value] = el
         else:
             s, e = el.span_of_value(name)
-            line = st.doc.lines.line_of(first.name_start) + 1
+            line = st.line_of(first.name_start) + 1
             st.add(
                 s,
                 e,

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from lsprotocol import types
+from pygls.exceptions import JsonRpcException, JsonRpcInternalError, JsonRpcMethodNotFound
 from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
@@ -181,7 +182,15 @@ class BtServer(LanguageServer):
 
     def report_server_error(self, error: Exception, source: Any) -> None:
         """Log internal errors to the client's log instead of popping up messages; requests
-        are answered with a JSON-RPC error by pygls itself."""
+        are answered with a JSON-RPC error by pygls itself.  Deliberate error answers (a
+        refused rename, an unknown method, malformed params) are not internal errors."""
+        if isinstance(error, JsonRpcException) and not isinstance(error, JsonRpcInternalError):
+            refusal = isinstance(error, JsonRpcMethodNotFound) or error.code == types.LSPErrorCodes.RequestFailed
+            self.log_message(
+                f"bt-lsp: {type(error).__name__}: {error}",
+                types.MessageType.Log if refusal else types.MessageType.Warning,
+            )
+            return
         self.log_message(
             f"bt-lsp: internal error ({getattr(source, '__name__', source)}): {error!r}",
             types.MessageType.Error,

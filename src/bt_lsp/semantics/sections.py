@@ -1,0 +1,171 @@
+"""The section pass of the semantic checks, remembered on each section of the model.
+
+:func:`bt_lsp.semantics.check` runs the document-wide rules (the root and its sections,
+tree IDs across the document, the main tree, recursion) over the whole model, and the
+rules that look at one element and at what the context says about the names it uses over
+each section of the model (:class:`bt_lsp.model.Section`: one child of ``<root>``), in
+the section's coordinates.  A section's results are kept on it with everything they read
+besides the section: the context entries looked up (through mappings that record every
+lookup, compared by their position-free content), the context's settings, the root's
+``BTCPP_format`` and whether the root has more than one child, and, when a message names
+a line, the line the section starts on.  They are used again while all of that is the same,
+so that an edit re-checks its own section, and the sections that use a declaration it
+changed.
+
+A rule of the section pass must therefore read nothing else outside its section: not the
+positions of this document's declarations in the context (every edit before them moves
+them; such rules belong to the document-wide pass), nor the root's other children.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Final, TypeVar
+
+from bt_lsp.context import Context, ModelDecl, TreeDecl
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.model import Element, Section
+from bt_lsp.semantics.base import State
+
+if TYPE_CHECKING:
+    from bt_lsp.text import LineIndex
+
+__all__ = ["check_sections"]
+
+V = TypeVar("V")
+# A context lookup: (field, key); key None stands for the whole mapping (iterated).
+Dep = tuple[str, str | None]
+
+_FIELDS: Final = ("models", "subtree_models", "trees", "workspace_trees")
+_KEY: Final = "semantics"
+
+
+class _Recording(Mapping[str, V]):
+    """A mapping of the context that notes which keys a rule looked up."""
+
+    __slots__ = ("_deps", "_field", "_inner")
+
+    def __init__(self, inner: Mapping[str, V], field: str, deps: set[Dep]) -> None:
+        self._inner = inner
+        self._field = field
+        self._deps = deps
+
+    def __getitem__(self, key: str) -> V:
+        self._deps.add((self._field, key))
+        return self._inner[key]
+
+    def __contains__(self, key: object) -> bool:
+        if isinstance(key, str):
+            self._deps.add((self._field, key))
+        return key in self._inner
+
+    def __iter__(self) -> Iterator[str]:
+        self._deps.add((self._field, None))
+        return iter(self._inner)
+
+    def __len__(self) -> int:
+        self._deps.add((self._field, None))
+        return len(self._inner)
+
+
+def _content(value: ModelDecl | tuple[TreeDecl, ...]) -> object:
+    """A context entry without positions."""
+    if isinstance(value, ModelDecl):
+        return (value.id, value.category, value.ports, value.path)
+    return tuple((d.id, d.path, d.calls) for d in value)
+
+
+def _signature(ctx: Context, dep: Dep) -> object:
+    field, key = dep
+    mapping: Mapping[str, ModelDecl | tuple[TreeDecl, ...]] = getattr(ctx, field)
+    if key is None:
+        return tuple((k, _content(v)) for k, v in mapping.items())
+    value = mapping.get(key)
+    return None if value is None else _content(value)
+
+
+@dataclasses.dataclass(slots=True)
+class _Entry:
+    """The results of one section and what they depend on."""
+
+    settings: tuple[object, ...]
+    line: int | None  # the line the section starts on, when a message names a line
+    deps: dict[Dep, object]
+    out: list[Diagnostic]
+
+
+def check_sections(st: State, check: Callable[[State, Sequence[Element]], None]) -> None:
+    """Add the section pass's diagnostics of every section of ``st.model`` to ``st.out``:
+    ``check`` runs over the elements of the sections whose remembered results are out of
+    date."""
+    model, ctx = st.model, st.ctx
+    root = model.root
+    settings = (
+        ctx.path,
+        ctx.workspace_has_custom_models,
+        tuple(sorted(ctx.ros_pkg_paths.items())),
+        ctx.included_by,
+        st.v4,
+        root is not None and len(root.children) > 1,
+    )
+    memo: dict[Dep, object] = {}
+
+    def current(dep: Dep) -> object:
+        try:
+            return memo[dep]
+        except KeyError:
+            sig = memo[dep] = _signature(ctx, dep)
+            return sig
+
+    lines = st.doc.lines
+    out = st.out
+    for sec, origin in zip(model.sections, model.origins, strict=True):
+        entry: _Entry | None = sec.cache.get(_KEY)
+        if (
+            entry is None
+            or entry.settings != settings
+            or (entry.line is not None and entry.line != lines.line_of(origin))
+            or any(current(d) != sig for d, sig in entry.deps.items())
+        ):
+            entry = _run(st, sec, origin, root, settings, check, current, lines)
+            sec.cache[_KEY] = entry
+        if entry.out:
+            out.extend(
+                Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
+                for d in entry.out
+            )
+
+
+def _run(
+    st: State,
+    sec: Section,
+    origin: int,
+    root: Element | None,
+    settings: tuple[object, ...],
+    check: Callable[[State, Sequence[Element]], None],
+    current: Callable[[Dep], object],
+    lines: LineIndex,
+) -> _Entry:
+    deps: set[Dep] = set()
+    ctx = st.ctx
+    recording = dataclasses.replace(
+        ctx,
+        models=_Recording(ctx.models, "models", deps),
+        subtree_models=_Recording(ctx.subtree_models, "subtree_models", deps),
+        trees=_Recording(ctx.trees, "trees", deps),
+        workspace_trees=_Recording(ctx.workspace_trees, "workspace_trees", deps),
+    )
+    local = sec.local_model(root)
+    run = State(
+        st.doc,
+        recording,
+        local,
+        st.text[origin : origin + sec.length],
+        v4=st.v4,
+        origin=origin,
+    )
+    elements = local.elements
+    check(run, elements[1:] if isinstance(elements, list) else list(elements)[1:])
+    line = lines.line_of(origin) if run.uses_lines else None
+    return _Entry(settings, line, {d: current(d) for d in deps}, run.out)
