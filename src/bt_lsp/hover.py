@@ -114,9 +114,6 @@ def _port_info(ref: NameRef, ctx: Context | None) -> list[str]:
 def hover_at(doc: Document, offset: int, ctx: Context | None = None) -> HoverText | None:
     model = doc.model
     ref = model.ref_at(offset)
-    with open("/tmp/hover_dbg.log", "a") as f:
-        part = model.part_at(offset)
-        f.write(f"{offset} {ref} origins={model.origins} tail={model.tail_start} part={part.origin} refs={[(r.start, r.end) for r in part.section.refs]}\n")
     if ref is None:
         return None
     lines: list[str] = []

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from lsprotocol import types
+from pygls.uris import to_fs_path
 
 from bt_lsp.document import Document
 from bt_lsp.server.convert import to_offsets
@@ -18,10 +20,20 @@ def register(server: BtServer) -> None:
     @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
     def did_open(ls: BtServer, params: types.DidOpenTextDocumentParams) -> None:
         item = params.text_document
-        od = OpenDocument(item.uri, Document(item.text, item.uri), item.version, item.language_id)
+        path = to_fs_path(item.uri) if item.uri.startswith("file:") else None
+        od = OpenDocument(
+            item.uri,
+            Document(item.text, path or item.uri),
+            item.version,
+            item.language_id,
+            Path(path) if path else None,
+        )
         od.refresh_kind()
         ls.docs[item.uri] = od
-        ls.schedule(item.uri)
+        if od.path is not None:
+            ls.project.open(od.path, od.doc)
+        ls.edits += 1
+        ls.schedule_all(item.uri)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
     def did_change(ls: BtServer, params: types.DidChangeTextDocumentParams) -> None:
