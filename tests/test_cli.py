@@ -761,10 +761,10 @@ def test_internal_error_names_the_file_and_goes_on(
 
     real = analysis.analyze
 
-    def flaky(doc: Any) -> Any:
+    def flaky(doc: Any, *context: Any) -> Any:
         if doc.path == "boom.xml":
             raise RuntimeError("kaboom")
-        return real(doc)
+        return real(doc, *context)
 
     monkeypatch.setattr(analysis, "analyze", flaky)
     _put(work / "boom.xml", CLEAN)

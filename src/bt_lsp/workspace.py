@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from bt_lsp.analysis import analyze
+from bt_lsp import analysis
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic, make
 from bt_lsp.document import Document, looks_like_bt
@@ -174,13 +174,17 @@ class Workspace:
                     found.add(p)
                     if len(found) >= MAX_WORKSPACE_FILES:
                         break
-            for m in self.settings.model_files:
-                mp = Path(m)
-                found.add(
-                    normalize(mp if mp.is_absolute() or not self.roots else self.roots[0] / mp)
-                )
+            found.update(self.model_files())
             self._files = sorted(found)
         return self._files
+
+    def model_files(self) -> list[Path]:
+        """The model files named in the settings (relative to the first workspace folder)."""
+        out = []
+        for m in self.settings.model_files:
+            mp = Path(m)
+            out.append(normalize(mp if mp.is_absolute() or not self.roots else self.roots[0] / mp))
+        return out
 
     def bt_documents(self) -> Iterator[tuple[Path, Document]]:
         paths = set(self.files()) | set(self._open)
@@ -292,19 +296,30 @@ class Workspace:
             if d is not None:
                 others.append((str(p), d, True))
         included_by: list[str] = []
+        model_paths = set(self.model_files())
+        model_files: list[tuple[str, Document]] = []
         for p, d in self.bt_documents():
             if p == path or p in in_closure:
+                continue
+            if p in model_paths:
+                model_files.append((str(p), d))
                 continue
             others.append((str(p), d, False))
             if any(inc.target == path for inc in self.includes(p, d)):
                 included_by.append(str(p))
-        return Context.combine(doc, others, path=str(path),
-                               ros_pkg_paths=self.settings.ros_packages,
-                               included_by=included_by)
+        return Context.combine(
+            doc,
+            others,
+            path=str(path),
+            ros_pkg_paths=self.settings.ros_packages,
+            model_files=model_files,
+            included_by=included_by,
+        )
+
 
     def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
         """Every diagnostic of ``doc`` in this workspace."""
-        out = analyze(doc, self.context_for(path, doc))
+        out = analysis.analyze(doc, self.context_for(path, doc))
         out.extend(self.include_diagnostics(path, doc))
         out.sort(key=lambda d: (d.start, d.end, d.code))
         return out

@@ -358,12 +358,12 @@ async def client(lsp_client: BtClient, request: pytest.FixtureRequest) -> AsyncI
 def _close_documents(request: pytest.FixtureRequest) -> Iterator[None]:
     """Close what a test opened, so that tests sharing a server do not see each other's
     documents (open documents form one workspace)."""
+    client = request.getfixturevalue("client") if "client" in request.fixturenames else None
+    before = set(client.opened) if isinstance(client, BtClient) else set()
     yield
-    if "client" in request.fixturenames:
-        client = request.getfixturevalue("client")
-        if isinstance(client, BtClient) and client.error is None:
-            for uri in sorted(client.opened):
-                client.close(uri)
+    if isinstance(client, BtClient) and client.error is None:
+        for uri in sorted(client.opened - before):
+            client.close(uri)
 
 
 _counter = itertools.count(1)

@@ -22,20 +22,11 @@ from tests.server.conftest import (
     workspace_edits,
 )
 
-pytestmark = [
-    pytest.mark.asyncio(loop_scope="module"),
-    clients(
-        "vscode",
-        "vscode-utf8",
-        "vscode-utf32",
-        "nvim-0.7",
-        "nvim-0.11",
-        "nvim-0.11-utf16",
-        "emacs",
-        "unknown-encodings",
-        "utf32-after-unknown",
-    ),
-]
+pytestmark = pytest.mark.asyncio(loop_scope="module")
+
+# utf-16 (offered nothing, or only it), utf-8 and utf-32; push and pull.
+PROFILES_UNDER_TEST = ["vscode", "vscode-utf8", "vscode-utf32", "nvim-0.11", "nvim-0.11-utf16", "emacs"]
+each_encoding = clients(*PROFILES_UNDER_TEST)
 
 NEGOTIATED = {
     "vscode": "utf-16",
@@ -73,6 +64,7 @@ DOC_CODES = [
 ]
 
 
+@clients(*PROFILES_UNDER_TEST, "nvim-0.7", "unknown-encodings", "utf32-after-unknown")
 async def test_the_encoding_is_negotiated(client: BtClient) -> None:
     want = NEGOTIATED[client.profile_name]
     assert PROFILES[client.profile_name].expected_encoding() == want
@@ -81,6 +73,7 @@ async def test_the_encoding_is_negotiated(client: BtClient) -> None:
     assert got in (want, None) if want == "utf-16" else got == want
 
 
+@each_encoding
 async def test_diagnostic_ranges_are_exact(client: BtClient) -> None:
     uri = client.open(DOC.text)
     diags = names_only(await client.diags(uri, 1))
@@ -90,6 +83,7 @@ async def test_diagnostic_ranges_are_exact(client: BtClient) -> None:
     assert summary(diags) == want
 
 
+@each_encoding
 async def test_edits_after_astral_characters_and_lone_cr(client: BtClient) -> None:
     text = DOC.text
     uri = client.open(text)
@@ -122,6 +116,7 @@ async def test_edits_after_astral_characters_and_lone_cr(client: BtClient) -> No
     assert [d.range for d in inst] == [client.range(text, start, start + len("𝔘&#1;\t😋"))]
 
 
+@each_encoding
 async def test_a_replacement_spanning_lines(client: BtClient) -> None:
     text = DOC.text
     uri = client.open(text)
@@ -140,6 +135,7 @@ async def test_a_replacement_spanning_lines(client: BtClient) -> None:
     assert "'𝔘 Tree'" in tree[0].message
 
 
+@each_encoding
 async def test_hover_ranges_and_positions(client: BtClient) -> None:
     text = DOC.text
     uri = client.open(text)
@@ -156,6 +152,7 @@ async def test_hover_ranges_and_positions(client: BtClient) -> None:
     assert await client.hover(uri, client.pos(text, start - 2)) is None
 
 
+@each_encoding
 async def test_quick_fix_edits_are_exact(client: BtClient) -> None:
     text = DOC.text
     uri = client.open(text)

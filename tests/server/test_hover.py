@@ -9,9 +9,12 @@ import pytest
 import pytest_asyncio
 from lsprotocol import types
 
-from tests.server.conftest import BtClient
+from tests.server.conftest import BtClient, clients
 
-pytestmark = pytest.mark.asyncio(loop_scope="module")
+pytestmark = [
+    pytest.mark.asyncio(loop_scope="module"),
+    clients("vscode", "nvim-0.11", "emacs"),  # utf-16, utf-8 and utf-32
+]
 
 DOC = (
     '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\n'  # line 1

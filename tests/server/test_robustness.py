@@ -25,7 +25,9 @@ from tests.server.conftest import (
     syntax_and_names,
 )
 
-pytestmark = [pytest.mark.asyncio(loop_scope="module"), clients("vscode", "nvim-0.11", "emacs")]
+pytestmark = pytest.mark.asyncio(loop_scope="module")
+
+each_client = clients("vscode", "nvim-0.11", "emacs")  # utf-16 push, utf-8 pull, utf-32 push
 
 DOC = (
     '<root BTCPP_format="4">\r\n'
@@ -54,6 +56,7 @@ def _error_code(exc: BaseException) -> int:
     return int(exc.code)
 
 
+@each_client
 async def test_unknown_documents(client: BtClient) -> None:
     uri = fresh_uri("never-opened")
     doc = types.TextDocumentIdentifier(uri=uri)
@@ -78,6 +81,7 @@ async def test_unknown_documents(client: BtClient) -> None:
     await _still_serving(client)
 
 
+@each_client
 async def test_positions_past_the_end(client: BtClient) -> None:
     uri = client.open(DOC)
     await client.diags(uri, 1)
@@ -113,6 +117,7 @@ async def test_positions_past_the_end(client: BtClient) -> None:
     assert summary(got) == summary(syntax_and_names(await client.diags(fresh, 2)))
 
 
+@each_client
 async def test_reversed_and_overlapping_changes(client: BtClient) -> None:
     uri = client.open(DOC)
     await client.diags(uri, 1)
@@ -166,6 +171,7 @@ async def test_reversed_and_overlapping_changes(client: BtClient) -> None:
         (types.CODE_ACTION_RESOLVE, [1, 2, 3]),
     ],
 )
+@each_client
 async def test_malformed_params_get_an_error_response(
     client: BtClient, method: str, params: Any
 ) -> None:
@@ -175,6 +181,7 @@ async def test_malformed_params_get_an_error_response(
     await _still_serving(client)
 
 
+@each_client
 async def test_malformed_notifications_are_logged(client: BtClient) -> None:
     seen = len(client.log_messages)
     raw_notify(client, types.TEXT_DOCUMENT_DID_OPEN, {"textDocument": {"uri": 1}})
@@ -191,6 +198,7 @@ async def test_malformed_notifications_are_logged(client: BtClient) -> None:
     await _still_serving(client)
 
 
+@each_client
 async def test_unknown_methods(client: BtClient) -> None:
     with pytest.raises(JsonRpcException) as info:
         await raw_request(client, "bt-lsp/noSuchRequest", {"x": 1})
@@ -200,6 +208,7 @@ async def test_unknown_methods(client: BtClient) -> None:
     await _still_serving(client)
 
 
+@each_client
 async def test_invalid_json(client: BtClient) -> None:
     seen = len(client.log_messages)
     for body in [b"{not json", b'{"jsonrpc": "2.0", "id": 1', b"[]", b'"x"']:
@@ -208,6 +217,7 @@ async def test_invalid_json(client: BtClient) -> None:
     assert len(client.log_messages) > seen
 
 
+@each_client
 async def test_a_huge_and_deep_document(client: BtClient) -> None:
     depth = 3000
     text = (
@@ -262,6 +272,7 @@ SWEEP = (
 )
 
 
+@clients("vscode", "nvim-0.11")  # positions can fall inside a character
 async def test_every_request_at_every_position(client: BtClient) -> None:
     """Each advertised request, on an unknown document, past the end, and at every
     position of a half-typed document, is answered without an error."""
@@ -281,6 +292,12 @@ async def test_every_request_at_every_position(client: BtClient) -> None:
     }
     offsets = sorted(o for o in near | set(range(0, len(SWEEP) + 1, 3)) if 0 <= o <= len(SWEEP))
     positions = [client.pos(SWEEP, i) for i in offsets]
+    # Positions inside a character: half a surrogate pair, the middle of a UTF-8 sequence.
+    positions += [
+        types.Position(p.line, p.character + 1)
+        for i, p in zip(offsets, positions, strict=True)
+        if i < len(SWEEP) and not SWEEP[i].isascii()
+    ]
     positions += [types.Position(3, 10_000), types.Position(10_000, 0)]
     requests: list[tuple[str, Any]] = []
     for method, extra in methods.items():

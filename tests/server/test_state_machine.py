@@ -246,7 +246,7 @@ def test_random_edits_match_a_fresh_open(
     run_state_machine_as_test(
         Edits,
         settings=settings(
-            max_examples=12,
+            max_examples=10,
             stateful_step_count=12,
             deadline=None,
             suppress_health_check=[HealthCheck.too_slow],

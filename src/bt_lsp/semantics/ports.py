@@ -119,6 +119,9 @@ def check_attributes(
         value = a.value
         if value is None or an == "ID" or an == "name":
             continue
+        # Present counts as given even when the name breaks a rule: the name rules say why
+        # BehaviorTree.CPP would not read it, and saying "missing" too would mislead.
+        given.add(an)
         if an in scripts.CONDITION_ATTRS:
             scripts.check(st, el, a)
             continue
@@ -127,7 +130,6 @@ def check_attributes(
                 autoremap = _check_autoremap(st, el, a, value)
             continue
         if _allowed(an):
-            given.add(an)
             if res is not None:
                 _check_port(st, el, a, value, res, scope)
             continue

@@ -78,7 +78,9 @@ def register(server: BtServer) -> None:
         od = ls.get(params.text_document.uri)
         if od is None:
             return types.RelatedFullDocumentDiagnosticReport(items=[], result_id=None)
-        result_id = f"{od.version}:{ls.generation}"
+        # Everything the diagnostics depend on (see BtServer.diagnostics_of), other
+        # documents included: those can change this one's diagnostics.
+        result_id = f"{od.version}:{ls.generation}:{ls.project.generation + ls.edits}"
         if params.previous_result_id == result_id and od.cache_key is not None:
             return types.RelatedUnchangedDocumentDiagnosticReport(result_id=result_id)
         return types.RelatedFullDocumentDiagnosticReport(
