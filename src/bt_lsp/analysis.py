@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from bt_lsp import semantics
 from bt_lsp.context import Context
-from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.diagnostics import Diagnostic, limited
 from bt_lsp.document import Document
 
 
@@ -18,4 +18,4 @@ def analyze(doc: Document, ctx: Context | None = None) -> list[Diagnostic]:
     out = list(doc.diagnostics)
     out.extend(semantics.check(doc, ctx if ctx is not None else Context.from_document(doc)))
     out.sort(key=lambda d: (d.start, d.end, d.code))
-    return out
+    return limited(out)

@@ -260,8 +260,13 @@ def _xml_counts(diags: Iterable[Diagnostic]) -> Counter[str]:
 def _well_formed(data: bytes) -> bool:
     from lxml import etree
 
+    # Nothing is expanded, loaded or fetched; libxml2's default size limits stay on.
     parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=True
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        dtd_validation=False,
+        huge_tree=False,
     )
     try:
         etree.fromstring(data, parser)

@@ -230,6 +230,12 @@ CODES: dict[str, Code] = {
             "analysis limited because the document is larger than the configured maximum",
             _XML,
         ),
+        Code(
+            "too-many-problems",
+            Severity.INFORMATION,
+            "more problems than a client can usefully show; only the first are reported",
+            _XML,
+        ),
         # Includes, resolved by the workspace layer.
         Code(
             "include-not-found",

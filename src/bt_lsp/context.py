@@ -251,9 +251,57 @@ def facts_of(doc: Document, path: str | None = None) -> DocumentFacts:
     hit = _CACHE.get(doc)
     if hit is not None and hit[0] is model and hit[1] == path:
         return hit[2]
-    facts = extract(model, path)
+    facts = extract_sections(model, path) if model.head is not None else extract(model, path)
     _CACHE[doc] = (model, path, facts)
     return facts
+
+
+def extract_sections(model: Model, path: str | None) -> DocumentFacts:
+    """:func:`extract` for a model made of sections: each section's declarations are
+    extracted once (they are kept on the section, in its coordinates) and moved here."""
+    trees: list[TreeDecl] = []
+    models: list[ModelDecl] = []
+    subtree_models: list[ModelDecl] = []
+    root = model.root
+    for section, o in zip(model.sections, model.origins, strict=True):
+        # The section's declarations where it is now (kept while it does not move).
+        placed: tuple[int, str | None, DocumentFacts] | None = section.cache.get("placed facts")
+        if placed is None or placed[0] != o or placed[1] != path:
+            local: DocumentFacts | None = section.cache.get("facts")
+            if local is None:
+                local = section.cache["facts"] = extract(section.local_model(root), None)
+            placed = (o, path, _moved(local, path, o))
+            section.cache["placed facts"] = placed
+        facts = placed[2]
+        trees.extend(facts.trees)
+        models.extend(facts.models)
+        subtree_models.extend(facts.subtree_models)
+    return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
+
+
+def _moved(local: DocumentFacts, path: str | None, o: int) -> DocumentFacts:
+    """Declarations extracted in a section's coordinates, in the document's."""
+    return DocumentFacts(
+        path,
+        tuple(
+            TreeDecl(
+                t.id,
+                path,
+                t.start + o,
+                t.end + o,
+                t.calls,
+                tuple((s + o, e + o) for s, e in t.call_spans),
+            )
+            for t in local.trees
+        ),
+        tuple(
+            ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o) for m in local.models
+        ),
+        tuple(
+            ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o)
+            for m in local.subtree_models
+        ),
+    )
 
 
 def _id_span(el: Element) -> tuple[str | None, int, int]:

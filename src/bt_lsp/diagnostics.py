@@ -11,7 +11,7 @@ from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 from bt_lsp.codes import CODES, Severity
-from bt_lsp.model import Model, NameRef, Role
+from bt_lsp.model import Model, NameRef, Role, Section
 from bt_lsp.names import NameKind, Violation, check_name
 from bt_lsp.scanner import Scan
 
@@ -53,8 +53,12 @@ def name_violations(ref: NameRef) -> tuple[Violation, ...]:
 
 
 def name_diagnostics(model: Model) -> list[Diagnostic]:
+    return _ref_diagnostics(model.refs)
+
+
+def _ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
     out: list[Diagnostic] = []
-    for ref in model.refs:
+    for ref in refs:
         if ref.kind is None:
             continue
         for v in _violations(ref.text, ref.kind, ref.role == Role.PORT_DECL):
@@ -79,12 +83,42 @@ def lexical_diagnostics(scan: Scan) -> list[Diagnostic]:
     return out
 
 
+def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
+    return d.start, d.end, d.code
+
+
+def _own(section: Section) -> list[Diagnostic]:
+    """The diagnostics of one section (in its coordinates), computed once."""
+    out: list[Diagnostic] | None = section.cache.get("diagnostics")
+    if out is None:
+        out = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
+        out.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
+        out.extend(_ref_diagnostics(section.refs))
+        section.cache["diagnostics"] = out
+    return out
+
+
 def compute(doc: Document) -> list[Diagnostic]:
     model = doc.model
-    out = lexical_diagnostics(doc.scan)
-    out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
-    out.extend(name_diagnostics(model))
-    out.sort(key=lambda d: (d.start, d.end, d.code))
+    if model.head is None:
+        out = lexical_diagnostics(doc.scan)
+        out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
+        out.extend(name_diagnostics(model))
+    else:
+        # Each section's own diagnostics are kept on it; they are only moved here.
+        out = list(_own(model.head))
+        for section, origin in zip(model.sections, model.origins, strict=True):
+            found = _own(section)
+            if found:
+                out.extend(
+                    Diagnostic(
+                        d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data
+                    )
+                    for d in found
+                )
+        if model.tail is not None:
+            out.extend(_own(model.tail))
+    out.sort(key=_sort_key)
     return out
 
 
@@ -103,3 +137,24 @@ def with_severities(
             d = replace(d, severity=sev)
         out.append(d)
     return out
+
+
+MAX_DIAGNOSTICS = 2000
+
+
+def limited(diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS) -> list[Diagnostic]:
+    """At most ``maximum`` diagnostics (the first by position), plus one that says how many
+    were left out: hostile or binary input must not flood the client."""
+    if len(diags) <= maximum:
+        return diags
+    kept = diags[:maximum]
+    kept.append(
+        make(
+            0,
+            0,
+            "too-many-problems",
+            f"{len(diags) - maximum} more problems are not shown "
+            f"(only the first {maximum} are reported)",
+        )
+    )
+    return kept

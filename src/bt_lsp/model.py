@@ -273,6 +273,17 @@ class Part:
             [g(c) for c in el.children],
         )
 
+    def top(self) -> Element:
+        """The section's top element in document coordinates (kept on the section while
+        it stays where it is)."""
+        sec = self.section
+        hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
+        if hit is not None and hit[:3] == (self.origin, self.tok_origin, self.elem_base):
+            return hit[3]
+        el = self.element(sec.elements[0])
+        sec.cache["top"] = (self.origin, self.tok_origin, self.elem_base, el)
+        return el
+
     def ref(self, r: NameRef) -> NameRef:
         o = self.origin
         return NameRef(
@@ -371,6 +382,7 @@ class Model:
 
     __slots__ = (
         "_by_symbol",
+        "_cache",
         "_elements",
         "_problems",
         "_ref_starts",
@@ -400,6 +412,7 @@ class Model:
         self._problems: Sequence[StructureProblem] | None = problems
         self._ref_starts = ref_starts
         self._by_symbol: Mapping[Symbol, list[NameRef]] | None = None
+        self._cache: dict[Zone, list[Element]] = {}
         self.root_element: Element | None = None
         self.head: Section | None = None  # None for a model that is not made of sections
         self.head_ntokens = 0
@@ -481,13 +494,23 @@ class Model:
     def trees(self) -> list[Element]:
         return [e for e in self.root_children() if e.zone == Zone.TREE]
 
-    def root_children(self) -> list[Element]:
-        """The root's child elements (in document coordinates)."""
+    def root_children(self, zone: Zone | None = None) -> list[Element]:
+        """The root's child elements (in document coordinates); only those in ``zone``
+        when given (cheap for a model made of sections: the others are not made)."""
         root = self.root
         if root is None:
             return []
+        if zone is not None and self.head is not None:
+            found: list[Element] | None = self._cache.get(zone)
+            if found is None:
+                found = self._cache[zone] = [
+                    self.part(k).top()
+                    for k, sec in enumerate(self.sections)
+                    if sec.elements[0].zone == zone
+                ]
+            return found
         els = self.elements
-        return [els[i] for i in root.children]
+        return [els[i] for i in root.children if zone is None or els[i].zone == zone]
 
     # -- sections ---------------------------------------------------------------------------
 
@@ -522,7 +545,15 @@ class Model:
         parts = self.parts()
         bases = [p.elem_base for p in parts]
         n = bases[-1] + len(parts[-1].section.elements)
-        lazy = _Lazy(n, bases, lambda c, j: parts[c].element(parts[c].section.elements[j]))
+        last = len(parts) - 1 if self.tail is not None else len(parts)
+
+        def make(c: int, j: int) -> Element:
+            part = parts[c]
+            if j == 0 and 0 < c < last:
+                return part.top()
+            return part.element(part.section.elements[j])
+
+        lazy = _Lazy(n, bases, make)
         if n:
             lazy._items[0] = root
         return lazy

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from bt_lsp import analysis
 from bt_lsp.context import Context
-from bt_lsp.diagnostics import Diagnostic, make
+from bt_lsp.diagnostics import Diagnostic, limited, make
 from bt_lsp.document import Document, looks_like_bt
 from bt_lsp.fileio import FileError, read_text
 from bt_lsp.model import Model, Zone
@@ -64,9 +64,7 @@ class Include:
 
 def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
     out: list[Include] = []
-    for el in doc.model.elements:
-        if el.zone != Zone.INCLUDE:
-            continue
+    for el in doc.model.root_children(Zone.INCLUDE):
         a = el.attr("path")
         if a is None or a.value is None or not a.value.strip():
             continue  # include-missing-path is a semantic rule of the document itself
@@ -322,7 +320,7 @@ class Workspace:
         out = analysis.analyze(doc, self.context_for(path, doc))
         out.extend(self.include_diagnostics(path, doc))
         out.sort(key=lambda d: (d.start, d.end, d.code))
-        return out
+        return limited(out)
 
     def other_models(self, path: Path) -> dict[str, Model]:
         """The models of the other BT documents of the workspace, by path (for renames)."""

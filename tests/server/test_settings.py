@@ -69,12 +69,17 @@ async def _levels_now(client: BtClient, uri: str, want: set[tuple[str, Any]]) ->
             f"pulled severities {want}",
         )
     else:
-        await client.wait_until(
-            lambda: True
-            if (last := client.latest(uri)) is not None and _levels(list(last.diagnostics)) == want
-            else None,
-            f"pushed severities {want}",
-        )
+        try:
+            await client.wait_until(
+                lambda: True
+                if (last := client.latest(uri)) is not None
+                and _levels(list(last.diagnostics)) == want
+                else None,
+                f"pushed severities {want}",
+            )
+        except AssertionError as exc:
+            seen = [(p.version, _levels(list(p.diagnostics))) for p in client.published[uri]]
+            raise AssertionError(f"{exc}; pushed: {seen}") from None
 
 
 async def _no_debounce(client: BtClient, uri: str, text: str, version: int) -> int:

@@ -20,6 +20,7 @@ them; such rules belong to the document-wide pass), nor the root's other childre
 from __future__ import annotations
 
 import dataclasses
+import weakref
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Final, TypeVar
 
@@ -29,6 +30,7 @@ from bt_lsp.model import Element, Section
 from bt_lsp.semantics.base import State
 
 if TYPE_CHECKING:
+    from bt_lsp.document import Document
     from bt_lsp.text import LineIndex
 
 __all__ = ["check_sections"]
@@ -91,8 +93,21 @@ class _Entry:
 
     settings: tuple[object, ...]
     line: int | None  # the line the section starts on, when a message names a line
-    deps: dict[Dep, object]
+    deps: dict[Dep, object]  # the signature of each context entry looked up
     out: list[Diagnostic]
+    generation: int = 0  # the last check of its document that found it valid
+
+
+@dataclasses.dataclass(slots=True)
+class _History:
+    """The last check of a document: its number and the signature of every context entry
+    looked up by its sections, so that the next check compares each entry once."""
+
+    generation: int = 0
+    sigs: dict[Dep, object] = dataclasses.field(default_factory=dict)
+
+
+_HISTORY: weakref.WeakKeyDictionary[Document, _History] = weakref.WeakKeyDictionary()
 
 
 def check_sections(st: State, check: Callable[[State, Sequence[Element]], None]) -> None:
@@ -118,23 +133,41 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
             sig = memo[dep] = _signature(ctx, dep)
             return sig
 
+    hist = _HISTORY.get(st.doc)
+    if hist is None:
+        hist = _HISTORY[st.doc] = _History()
+    previous = hist.generation
+    generation = previous + 1
+    # The context entries that changed since the last check: a section that was valid
+    # then is valid now unless it looked one of them up.
+    changed = {d for d, sig in hist.sigs.items() if current(d) != sig}
     lines = st.doc.lines
     out = st.out
     for sec, origin in zip(model.sections, model.origins, strict=True):
         entry: _Entry | None = sec.cache.get(_KEY)
-        if (
-            entry is None
-            or entry.settings != settings
-            or (entry.line is not None and entry.line != lines.line_of(origin))
-            or any(current(d) != sig for d, sig in entry.deps.items())
-        ):
+        valid = (
+            entry is not None
+            and entry.settings == settings
+            and (entry.line is None or entry.line == lines.line_of(origin))
+        )
+        if valid:
+            assert entry is not None
+            if entry.generation == previous:
+                valid = changed.isdisjoint(entry.deps)
+            else:
+                valid = all(current(d) == sig for d, sig in entry.deps.items())
+        if not valid:
             entry = _run(st, sec, origin, root, settings, check, current, lines)
             sec.cache[_KEY] = entry
+        assert entry is not None
+        entry.generation = generation
         if entry.out:
             out.extend(
                 Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
                 for d in entry.out
             )
+    hist.generation = generation
+    hist.sigs = memo  # every entry looked up by a section now valid, and a few more
 
 
 def _run(
