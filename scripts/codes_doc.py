@@ -1,7 +1,7 @@
 """Print (or check) the README's diagnostic-code section, generated from bt_lsp.codes.
 
-    python scripts/codes_doc.py          # print the section
-    python scripts/codes_doc.py --write  # replace it in README.md
+python scripts/codes_doc.py          # print the section
+python scripts/codes_doc.py --write  # replace it in README.md
 """
 
 from __future__ import annotations

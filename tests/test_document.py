@@ -14,11 +14,27 @@ BASE = (
     '    <Sequence name="s&#7;">\t<Open.Door door.id="{d}" 😋="1"/>\r'
     '      <SubTree ID="Sub" p="1"/></Sequence>\n'
     "  </BehaviorTree>\n"
-    "  <TreeNodesModel><Action ID=\"Open.Door\"><input_port name=\"door.id\"/></Action>"
+    '  <TreeNodesModel><Action ID="Open.Door"><input_port name="door.id"/></Action>'
     "</TreeNodesModel>\n</root>\n"
 )
-INSERTS = ["<", ">", '"', " ", ".", "\r\n", "\n", "<A ", "</Sequence>", "&amp;", "😋", "x",
-           '="', "<!--", "-->", "/>"]
+INSERTS = [
+    "<",
+    ">",
+    '"',
+    " ",
+    ".",
+    "\r\n",
+    "\n",
+    "<A ",
+    "</Sequence>",
+    "&amp;",
+    "😋",
+    "x",
+    '="',
+    "<!--",
+    "-->",
+    "/>",
+]
 
 
 @given(st.data())

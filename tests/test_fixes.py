@@ -55,9 +55,9 @@ def test_model_rename_reaches_compact_end_tag_explicit_id_and_model_entry() -> N
 
 
 def test_port_rename_reaches_declaration_and_uses_of_that_model_only() -> None:
-    title, text = preferred_fix(Document(DOC), "door.id")
+    title, _ = preferred_fix(Document(DOC), "door.id")
     assert title == "Rename 'door.id' to 'door_id' (3 places)"
-    title, text = preferred_fix(Document(DOC), "1st")
+    title, _ = preferred_fix(Document(DOC), "1st")
     assert title == "Rename '1st' to 'p_1st' (2 places)"
 
 
@@ -95,7 +95,7 @@ def test_fix_all_gives_distinct_names_to_distinct_symbols() -> None:
 
 
 def test_escape_value() -> None:
-    assert escape_value('a&b<c"d\'', '"') == "a&amp;b&lt;c&quot;d'"
+    assert escape_value("a&b<c\"d'", '"') == "a&amp;b&lt;c&quot;d'"
     assert escape_value("it's", "'") == "it&apos;s"
 
 

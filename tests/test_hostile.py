@@ -119,10 +119,16 @@ def test_checker_reads_no_entity_file_and_connects_nowhere(
 ) -> None:
     secret, doc, listener = hostile
     code = AUDIT + "from bt_lsp.cli import main\nsys.exit(main(sys.argv[1:]))\n"
-    for args in (["check", str(doc.parent)], ["check", "--fix", str(doc)],
-                 ["check", "--format", "sarif", str(doc)]):
+    for args in (
+        ["check", str(doc.parent)],
+        ["check", "--fix", str(doc)],
+        ["check", "--format", "sarif", str(doc)],
+    ):
         proc = subprocess.run(
-            [sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=120,
+            [sys.executable, "-c", code, *args],
+            capture_output=True,
+            text=True,
+            timeout=120,
             env={"BT_SECRET": str(secret), "PATH": "/usr/bin:/bin"},
         )
         assert proc.returncode in (0, 1), proc.stderr
@@ -145,24 +151,49 @@ def test_server_reads_no_entity_file_and_connects_nowhere(
     uri = doc.as_uri()
     text = doc.read_text(encoding="utf-8")
     messages = [
-        {"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": {
-            "capabilities": {}, "processId": None, "rootUri": doc.parent.as_uri(),
-            "initializationOptions": {"debounceMs": 0}}},
+        {
+            "jsonrpc": "2.0",
+            "id": 1,
+            "method": "initialize",
+            "params": {
+                "capabilities": {},
+                "processId": None,
+                "rootUri": doc.parent.as_uri(),
+                "initializationOptions": {"debounceMs": 0},
+            },
+        },
         {"jsonrpc": "2.0", "method": "initialized", "params": {}},
-        {"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument": {
-            "uri": uri, "languageId": "xml", "version": 1, "text": text}}},
-        {"jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params": {
-            "textDocument": {"uri": uri}, "position": {"line": 6, "character": 50}}},
-        {"jsonrpc": "2.0", "id": 3, "method": "textDocument/codeAction", "params": {
-            "textDocument": {"uri": uri},
-            "range": {"start": {"line": 0, "character": 0}, "end": {"line": 8, "character": 0}},
-            "context": {"diagnostics": []}}},
+        {
+            "jsonrpc": "2.0",
+            "method": "textDocument/didOpen",
+            "params": {
+                "textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": text}
+            },
+        },
+        {
+            "jsonrpc": "2.0",
+            "id": 2,
+            "method": "textDocument/hover",
+            "params": {"textDocument": {"uri": uri}, "position": {"line": 6, "character": 50}},
+        },
+        {
+            "jsonrpc": "2.0",
+            "id": 3,
+            "method": "textDocument/codeAction",
+            "params": {
+                "textDocument": {"uri": uri},
+                "range": {"start": {"line": 0, "character": 0}, "end": {"line": 8, "character": 0}},
+                "context": {"diagnostics": []},
+            },
+        },
         {"jsonrpc": "2.0", "id": 4, "method": "shutdown"},
         {"jsonrpc": "2.0", "method": "exit"},
     ]
     proc = subprocess.run(
-        [sys.executable, "-c", code], input=b"".join(_message(m) for m in messages),
-        capture_output=True, timeout=120,
+        [sys.executable, "-c", code],
+        input=b"".join(_message(m) for m in messages),
+        capture_output=True,
+        timeout=120,
         env={"BT_SECRET": str(secret), "PATH": "/usr/bin:/bin"},
     )
     out, err = proc.stdout.decode(), proc.stderr.decode()

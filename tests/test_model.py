@@ -22,9 +22,9 @@ POSITIONS = [
     '<root><BehaviorTree ID="⟦T⟧"><⟦Foo⟧ _skipIf="a" _while="b" _onSuccess="c" _post="d" '
     '_description="x" __shared_blackboard="y" _autoremap="1"/></BehaviorTree></root>',
     # TreeNodesModel entry IDs and port declarations
-    "<root><TreeNodesModel><Action ID=\"⟦Go⟧\"><input_port name=\"⟦to⟧\" type=\"int\"/>"
-    "<output_port name=\"⟦out⟧\"/></Action><SubTree ID=\"⟦Sub⟧\">"
-    "<inout_port name=\"⟦io⟧\" default=\"1\"/></SubTree></TreeNodesModel></root>",
+    '<root><TreeNodesModel><Action ID="⟦Go⟧"><input_port name="⟦to⟧" type="int"/>'
+    '<output_port name="⟦out⟧"/></Action><SubTree ID="⟦Sub⟧">'
+    '<inout_port name="⟦io⟧" default="1"/></SubTree></TreeNodesModel></root>',
     # not names: root attributes, include path, comments, CDATA, BehaviorTree attributes
     '<root BTCPP_format="4" main_tree_to_execute="T"><include path="a b.xml"/>'
     '<!-- <Bad.Name/> --><BehaviorTree ID="⟦T⟧" _description="d.e"><![CDATA[<X.Y/>]]>'
@@ -63,9 +63,16 @@ def test_symbols_link_references_to_their_targets() -> None:
     assert by_symbol[("tree", "Main")] == [Role.MAIN_TREE, Role.TREE_DEF]
     assert by_symbol[("tree", "Sub")] == [Role.SUBTREE_CALL, Role.TREE_DEF, Role.MODEL_DEF]
     assert by_symbol[("model", "Go")] == [
-        Role.NODE_TYPE, Role.NODE_TYPE_END, Role.NODE_ID, Role.MODEL_DEF,
+        Role.NODE_TYPE,
+        Role.NODE_TYPE_END,
+        Role.NODE_ID,
+        Role.MODEL_DEF,
     ]
-    assert by_symbol[("port", "model", "Go", "to")] == [Role.PORT_USE, Role.PORT_USE, Role.PORT_DECL]
+    assert by_symbol[("port", "model", "Go", "to")] == [
+        Role.PORT_USE,
+        Role.PORT_USE,
+        Role.PORT_DECL,
+    ]
     assert by_symbol[("port", "tree", "Sub", "p")] == [Role.PORT_USE, Role.PORT_DECL]
 
 
@@ -77,17 +84,24 @@ def test_zones() -> None:
     )
     zones = [(e.name, e.zone) for e in Document(text).model.elements]
     assert zones == [
-        ("root", Zone.ROOT), ("include", Zone.INCLUDE), ("BehaviorTree", Zone.TREE),
-        ("A", Zone.NODE), ("B", Zone.NODE), ("TreeNodesModel", Zone.MODELS),
-        ("Action", Zone.MODEL_ENTRY), ("input_port", Zone.PORT_DECL),
-        ("MetadataFields", Zone.OTHER), ("Other", Zone.OTHER),
+        ("root", Zone.ROOT),
+        ("include", Zone.INCLUDE),
+        ("BehaviorTree", Zone.TREE),
+        ("A", Zone.NODE),
+        ("B", Zone.NODE),
+        ("TreeNodesModel", Zone.MODELS),
+        ("Action", Zone.MODEL_ENTRY),
+        ("input_port", Zone.PORT_DECL),
+        ("MetadataFields", Zone.OTHER),
+        ("Other", Zone.OTHER),
     ]
 
 
 def xml_errors(text: str) -> list[tuple[str, str]]:
     doc = Document(text)
-    return [(doc.text[d.start : d.end], d.message) for d in doc.diagnostics
-            if d.code == "xml-syntax"]
+    return [
+        (doc.text[d.start : d.end], d.message) for d in doc.diagnostics if d.code == "xml-syntax"
+    ]
 
 
 def test_structure_errors_do_not_cascade() -> None:
@@ -112,8 +126,9 @@ def test_well_formed_documents_have_no_syntax_errors() -> None:
 
 
 def test_raw_amp_and_lt_in_values_are_warnings_only() -> None:
-    doc = Document('<root><BehaviorTree ID="T"><A _while="a && b&lt;1" _skipIf="x<1.0"/>'
-                   "</BehaviorTree></root>")
+    doc = Document(
+        '<root><BehaviorTree ID="T"><A _while="a && b&lt;1" _skipIf="x<1.0"/></BehaviorTree></root>'
+    )
     assert {d.code for d in doc.diagnostics} == {"xml-unescaped-char"}
 
 
