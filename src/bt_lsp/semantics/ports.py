@@ -52,7 +52,11 @@ from bt_lsp.scanner import Attr
 from bt_lsp.semantics import scripts
 from bt_lsp.semantics.base import BlackboardUse, Resolved, State, TreeScope, edit_distance, quoted
 
-SILENT_ATTRIBUTES: Final[frozenset[str]] = frozenset({"_description", "_uid", "_fullpath"})
+# Underscore attributes that editors and BehaviorTree.CPP itself write on purpose:
+# descriptions, WriteTreeToXML's metadata, and the editors' collapsed-node flag.
+SILENT_ATTRIBUTES: Final[frozenset[str]] = frozenset(
+    {"_description", "_uid", "_fullpath", "_collapsed"}
+)
 _UNDERSCORE_RESERVED: Final[tuple[str, ...]] = (*PRECONDITIONS, *POSTCONDITIONS, "_autoremap")
 _RESERVED_LOWER: Final[dict[str, str]] = {n.lower(): n for n in _UNDERSCORE_RESERVED}
 V3_ATTRIBUTES: Final[dict[str, str]] = {
