@@ -8,12 +8,15 @@ notification on to ours.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 from collections.abc import Generator
 from typing import Any
 
 from cattrs import ClassValidationError, transform_error
 from lsprotocol import types
-from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams
+from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams, JsonRpcInvalidRequest
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
 
@@ -34,6 +37,34 @@ class BtProtocol(LanguageServerProtocol):
                 error = JsonRpcInvalidParams(f"Invalid params for {data['method']}: {detail}")
                 self._send_response(data["id"], error=error.to_response_error())
             raise
+
+    @lsp_method(types.EXIT)
+    def lsp_exit(self, *args: Any) -> Generator[Any, Any, None]:
+        """End the process at once: status 0 after ``shutdown``, 1 otherwise (LSP).  pygls
+        exits from a callback whose SystemExit can be lost, which ends the process with 0."""
+        handler = self.fm.features.get(types.EXIT)
+        if handler is not None:
+            yield handler, args, None
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(OSError, ValueError):
+                stream.flush()
+        os._exit(0 if self._shutdown else 1)
+
+    def handle_message(self, message: Any) -> None:
+        """After ``shutdown``, answer requests with InvalidRequest as LSP asks (pygls drops
+        them silently, which leaves a client waiting); notifications other than ``exit``
+        are ignored."""
+        if (
+            self._shutdown
+            and getattr(message, "method", types.EXIT) != types.EXIT
+            and getattr(message, "id", None) is not None
+        ):
+            self._send_response(
+                message.id,
+                error=JsonRpcInvalidRequest("the server is shut down").to_response_error(),
+            )
+            return
+        super().handle_message(message)
 
     def _forward(self, method: str, params: Any) -> Generator[Any, Any, None]:
         handler = self.fm.features.get(method)
