@@ -3,8 +3,8 @@
 Every test talks to ``bt-lsp serve`` through a :class:`BtClient` initialized with one of
 pytest-lsp's bundled capability sets (VS Code, Neovim 0.7 and 0.11, Emacs), optionally
 with its ``general.positionEncodings`` replaced.  Servers are module-scoped: one per
-profile per test module.  Tests open documents under fresh URIs so they never see each
-other's state.
+profile per test module.  Tests open documents under fresh URIs, and what a test opens is
+closed after it (open documents form one workspace), so tests do not see each other.
 
 Positions are computed here from code-point offsets by encoding the prefix of each line,
 independently of the server's :class:`bt_lsp.text.LineIndex`, so the tests do not trust
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import contextlib
 import itertools
 import json
 import re
@@ -78,7 +79,6 @@ PROFILES: dict[str, Profile] = {
     "vscode-utf8": Profile("visual-studio-code", encodings=("utf-8",)),
     "vscode-utf32": Profile("visual-studio-code", encodings=("utf-32",)),
     "nvim-0.11-utf16": Profile("neovim@v0.11.0", encodings=("utf-16",)),
-    "nvim-0.11-utf32": Profile("neovim@v0.11.0", encodings=("utf-32",)),
     "unknown-encodings": Profile("visual-studio-code", encodings=("latin-1", "utf-7")),
     "utf32-after-unknown": Profile("emacs", encodings=("ucs-2", "utf-32", "utf-8")),
 }
@@ -109,6 +109,7 @@ class BtClient(LanguageClient):
         super().__init__(*args, **kwargs)
         self.published: dict[str, list[types.PublishDiagnosticsParams]] = {}
         self.configuration_requests = 0
+        self.configuration_gate: asyncio.Event | None = None
         self.registrations: list[types.Registration] = []
         self.opened: set[str] = set()
         self._waiters: list[asyncio.Event] = []
@@ -134,10 +135,8 @@ class BtClient(LanguageClient):
                 raise AssertionError(f"timed out after {TIMEOUT}s waiting for {what}")
             ev = asyncio.Event()
             self._waiters.append(ev)
-            try:
+            with contextlib.suppress(TimeoutError):
                 await asyncio.wait_for(ev.wait(), remaining)
-            except TimeoutError:
-                pass
 
     # session
 
@@ -161,8 +160,20 @@ class BtClient(LanguageClient):
 
     # documents
 
-    def open(self, text: str, *, version: int = 1, name: str = "doc", language: str = "xml") -> str:
+    def open(
+        self,
+        text: str,
+        *,
+        version: int = 1,
+        name: str = "doc",
+        language: str = "xml",
+        untitled: bool = False,
+    ) -> str:
+        """Open ``text`` under a new URI: a file URI, or an ``untitled:`` one, which is not
+        part of the workspace (so it neither sees nor is seen by other documents)."""
         uri = fresh_uri(name)
+        if untitled:
+            uri = "untitled:" + uri.rsplit("/", 1)[1]
         self.opened.add(uri)
         self.text_document_did_open(
             types.DidOpenTextDocumentParams(
@@ -308,10 +319,12 @@ def _on_log(client: BtClient, params: types.LogMessageParams) -> None:
     client._notify_waiters()
 
 
-def _on_configuration(client: BtClient, params: types.ConfigurationParams) -> list[Any]:
+async def _on_configuration(client: BtClient, params: types.ConfigurationParams) -> list[Any]:
     client.configuration_requests += 1
     result = DEFAULT_CLIENT_FEATURES[types.WORKSPACE_CONFIGURATION](client, params)
     client._notify_waiters()
+    if client.configuration_gate is not None:  # a test holds the answer back
+        await client.configuration_gate.wait()
     return list(result)
 
 
@@ -343,6 +356,33 @@ def make_client() -> BtClient:
 
 
 CONFIG = ClientServerConfig(server_command=SERVER_COMMAND, client_factory=make_client)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run each module's tests grouped by client profile, so that each module starts one
+    server per profile.  (pytest groups module-scoped parameters by their index, and the
+    tests here use different lists of profiles.)"""
+    here = [i for i, item in enumerate(items) if item.nodeid.startswith(_NODEID_PREFIX)]
+    by_module: dict[str, list[pytest.Item]] = {}
+    for i in here:
+        by_module.setdefault(items[i].nodeid.split("::")[0], []).append(items[i])
+    ordered: list[pytest.Item] = []
+    for module_items in by_module.values():
+        rank: dict[object, int] = {}
+        for item in module_items:
+            rank.setdefault(_profile_of(item), len(rank))
+        ordered.extend(sorted(module_items, key=lambda it: rank[_profile_of(it)]))
+    for i, item in zip(here, ordered, strict=True):
+        items[i] = item
+
+
+_NODEID_PREFIX = "tests/server/"
+
+
+def _profile_of(item: pytest.Item) -> object:
+    callspec = getattr(item, "callspec", None)
+    return callspec.params.get("client") if callspec is not None else None
 
 
 @pytest_lsp.fixture(config=CONFIG, scope="module", params=CLIENTS)
@@ -502,7 +542,9 @@ def workspace_edits(edit: types.WorkspaceEdit, uri: str) -> list[types.TextEdit]
     return out
 
 
-def partial(text: str, start: int, end: int, new: str, encoding: str) -> types.TextDocumentContentChangePartial:
+def partial(
+    text: str, start: int, end: int, new: str, encoding: str
+) -> types.TextDocumentContentChangePartial:
     """A didChange replacing ``text[start:end]`` with ``new``."""
     return types.TextDocumentContentChangePartial(
         range=lsp_range(text, start, end, encoding), text=new

@@ -91,8 +91,10 @@ async def _preferred(
         a
         for a in actions
         if a.kind == types.CodeActionKind.QuickFix
-        and any(d.code in {"model-name-forbidden-char", "port-name-forbidden-char"}
-                for d in a.diagnostics or [])
+        and any(
+            d.code in {"model-name-forbidden-char", "port-name-forbidden-char"}
+            for d in a.diagnostics or []
+        )
     ]
     preferred = [a for a in named if a.is_preferred]
     assert len(preferred) == 1, [a.title for a in named]
@@ -114,10 +116,10 @@ async def _send_edits(
     action = await client.with_edit(action)
     assert action.edit is not None
     edits = workspace_edits(action.edit, uri)
-    order = sorted(
-        edits, key=lambda e: (e.range.start.line, e.range.start.character), reverse=True
-    )
-    changes = [types.TextDocumentContentChangePartial(range=e.range, text=e.new_text) for e in order]
+    order = sorted(edits, key=lambda e: (e.range.start.line, e.range.start.character), reverse=True)
+    changes = [
+        types.TextDocumentContentChangePartial(range=e.range, text=e.new_text) for e in order
+    ]
     client.change(uri, version, *changes)
     return await client.diags(uri, version)
 
@@ -194,7 +196,7 @@ async def test_one_preferred_fix_then_alternatives(client: BtClient) -> None:
         '<root BTCPP_format="4">\n'
         '  <BehaviorTree ID="T">\n'
         '    <Sequence name="a&#7;b">\n'
-        '      <AlwaysSuccess/>\n'
+        "      <AlwaysSuccess/>\n"
         "    </Sequence>\n"
         "  </BehaviorTree>\n"
         "  <TreeNodesModel>\n"
@@ -229,9 +231,7 @@ async def test_one_preferred_fix_then_alternatives(client: BtClient) -> None:
         assert new == text.replace("1st.goal", m.group(2))
     # The instance name fix removes the control character.
     inst = [
-        a
-        for a in await client.code_actions(uri, _at(client, text, "a&#7;b"))
-        if a.is_preferred
+        a for a in await client.code_actions(uri, _at(client, text, "a&#7;b")) if a.is_preferred
     ]
     assert [a.title for a in inst] == ["Rename 'aU+0007b' to 'a b' (1 place)"]
     assert await _apply(client, uri, text, inst[0]) == text.replace("a&#7;b", "a b")
@@ -325,7 +325,7 @@ MANY = (
     '    <AlwaysSuccess name="r\x7f"/>\n'
     "  </BehaviorTree>\n"
     '  <BehaviorTree ID="Sub/Tree">\n'
-    "    <Wait.For ms=\"1\"/>\n"
+    '    <Wait.For ms="1"/>\n'
     "  </BehaviorTree>\n"
     "  <TreeNodesModel>\n"
     '    <Action ID="Do.It">\n'

@@ -47,7 +47,9 @@ def _find(text: str, needle: str, nth: int) -> int:
     return start
 
 
-async def _hover(client: BtClient, uri: str, needle: str, nth: int = 0, into: int = 1) -> types.Hover:
+async def _hover(
+    client: BtClient, uri: str, needle: str, nth: int = 0, into: int = 1
+) -> types.Hover:
     start = _find(DOC, needle, nth)
     hover = await client.hover(uri, client.pos(DOC, start + into))
     assert hover is not None, needle

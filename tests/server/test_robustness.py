@@ -17,10 +17,10 @@ from tests.server.conftest import (
     apply_changes,
     clients,
     fresh_uri,
+    names_only,
     raw_notify,
     raw_request,
     send_raw,
-    names_only,
     summary,
     syntax_and_names,
 )
@@ -75,9 +75,7 @@ async def test_unknown_documents(client: BtClient) -> None:
     client.change(uri, 2, types.TextDocumentContentChangeWholeDocument(text=DOC))
     client.text_document_did_close(types.DidCloseTextDocumentParams(text_document=doc))
     await client.barrier()
-    assert uri not in client.published or all(
-        not p.diagnostics for p in client.published[uri]
-    )
+    assert uri not in client.published or all(not p.diagnostics for p in client.published[uri])
     await _still_serving(client)
 
 
@@ -110,9 +108,7 @@ async def test_positions_past_the_end(client: BtClient) -> None:
     client.change(
         uri, 3, types.TextDocumentContentChangePartial(range=types.Range(end, end), text="<x")
     )
-    client.change(
-        fresh, 2, types.TextDocumentContentChangeWholeDocument(text=expected + "<x")
-    )
+    client.change(fresh, 2, types.TextDocumentContentChangeWholeDocument(text=expected + "<x"))
     got = syntax_and_names(await client.diags(uri, 3))
     assert summary(got) == summary(syntax_and_names(await client.diags(fresh, 2)))
 
@@ -162,8 +158,10 @@ async def test_reversed_and_overlapping_changes(client: BtClient) -> None:
     [
         (types.TEXT_DOCUMENT_HOVER, {"textDocument": 5, "position": {"line": 0}}),
         (types.TEXT_DOCUMENT_HOVER, {"textDocument": {"uri": "file:///x.xml"}, "position": []}),
-        (types.TEXT_DOCUMENT_HOVER, {"textDocument": {"uri": "file:///x.xml"},
-                                     "position": {"line": -1, "character": 0}}),
+        (
+            types.TEXT_DOCUMENT_HOVER,
+            {"textDocument": {"uri": "file:///x.xml"}, "position": {"line": -1, "character": 0}},
+        ),
         (types.TEXT_DOCUMENT_CODE_ACTION, {"textDocument": {"uri": "file:///x.xml"}}),
         (types.TEXT_DOCUMENT_CODE_ACTION, None),
         (types.TEXT_DOCUMENT_DIAGNOSTIC, {"textDocument": "file:///x.xml"}),
@@ -263,7 +261,7 @@ SWEEP = (
     '\t<BehaviorTree ID="A&amp;B">\r'
     "\t\t<Sequence name='😋&#7;'>\n"
     '\t\t\t<SubTree ID="A&amp;B" 1p="{x}"/>\n'
-    "\t\t\t<Script code=\"<![CDATA[ x:=1 ]]>\"/>\n"
+    '\t\t\t<Script code="<![CDATA[ x:=1 ]]>"/>\n'
     '\t\t\t<Do.It a.b="1" <Action ID="\n'
     "\t\t</Sequence>\r\n"
     "\t</BehaviorTree>\n"
@@ -325,4 +323,22 @@ async def test_every_request_at_every_position(client: BtClient) -> None:
             ):
                 failures.append(f"{method} {params}: {answer!r}")
     assert failures == [], failures[:10]
+    await _still_serving(client)
+
+
+@each_client
+async def test_a_nul_character_in_an_include_path(client: BtClient) -> None:
+    """A path that the file system cannot even look up is an include that is not found."""
+    text = (
+        '<root BTCPP_format="4">\n'
+        '  <include path="sub/a\x00b.xml"/>\n'
+        '  <BehaviorTree ID="T"><AlwaysSuccess/></BehaviorTree>\n'
+        "</root>\n"
+    )
+    seen = len(client.log_messages)
+    uri = client.open(text)
+    diags = await client.diags(uri, 1)
+    assert "include-not-found" in {d.code for d in diags}
+    errors = [m.message for m in client.log_messages[seen:] if m.type == types.MessageType.Error]
+    assert errors == []
     await _still_serving(client)

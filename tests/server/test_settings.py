@@ -64,17 +64,21 @@ async def _levels_now(client: BtClient, uri: str, want: set[tuple[str, Any]]) ->
     if client.pull:
         await eventually(
             lambda: client.pull_report(uri),
-            lambda r: isinstance(r, types.RelatedFullDocumentDiagnosticReport)
-            and _levels(list(r.items)) == want,
+            lambda r: (
+                isinstance(r, types.RelatedFullDocumentDiagnosticReport)
+                and _levels(list(r.items)) == want
+            ),
             f"pulled severities {want}",
         )
     else:
         try:
             await client.wait_until(
-                lambda: True
-                if (last := client.latest(uri)) is not None
-                and _levels(list(last.diagnostics)) == want
-                else None,
+                lambda: (
+                    True
+                    if (last := client.latest(uri)) is not None
+                    and _levels(list(last.diagnostics)) == want
+                    else None
+                ),
                 f"pushed severities {want}",
             )
         except AssertionError as exc:
@@ -97,9 +101,7 @@ def _configure(client: BtClient, section: dict[str, Any] | None) -> None:
     """Send didChangeConfiguration: with the btLsp section, or null (the server re-reads
     workspace/configuration)."""
     settings = {"btLsp": section} if section is not None else None
-    client.workspace_did_change_configuration(
-        types.DidChangeConfigurationParams(settings=settings)
-    )
+    client.workspace_did_change_configuration(types.DidChangeConfigurationParams(settings=settings))
 
 
 @clients("init-options")
@@ -135,7 +137,9 @@ async def test_did_change_configuration_rereads_the_section(client: BtClient) ->
         )
         _configure(client, None)
         await _levels_now(
-            client, uri, {("port-name-reserved", Sev.Warning), ("model-name-forbidden-char", Sev.Hint)}
+            client,
+            uri,
+            {("port-name-reserved", Sev.Warning), ("model-name-forbidden-char", Sev.Hint)},
         )
         assert client.configuration_requests > before
         if first is not None:
@@ -151,7 +155,11 @@ async def test_did_change_configuration_rereads_the_section(client: BtClient) ->
 
 
 def _expected_at_start(client: BtClient) -> set[tuple[str, Any]]:
-    return OVERRIDDEN if client.profile.configuration or client.profile_name == "init-options" else DEFAULTS
+    return (
+        OVERRIDDEN
+        if client.profile.configuration or client.profile_name == "init-options"
+        else DEFAULTS
+    )
 
 
 @clients("nvim-0.7", "vscode")
@@ -168,6 +176,36 @@ async def test_did_change_configuration_with_the_settings(client: BtClient) -> N
             {("port-name-reserved", Sev.Error), ("instance-name-control-char", Sev.Error)},
         )
     finally:
+        _configure(client, {"debounceMs": 0})
+    await _levels_now(client, uri, DEFAULTS)
+
+
+@clients("vscode")
+async def test_a_late_configuration_answer_does_not_undo_newer_settings(client: BtClient) -> None:
+    uri = client.open(DOC)
+    assert _levels(await client.pushed(uri, 1)) == DEFAULTS
+    old = client.get_configuration(section="btLsp")
+    client.configuration_gate = asyncio.Event()
+    try:
+        asked = client.configuration_requests
+        client.set_configuration(
+            {"severity": {"model-name-forbidden-char": "off"}}, section="btLsp"
+        )
+        _configure(client, None)  # the server asks; the answer is held back ...
+        await client.wait_until(
+            lambda: True if client.configuration_requests > asked else None,
+            "workspace/configuration",
+        )
+        _configure(client, {"debounceMs": 0, "severity": SEVERITY})  # ... newer settings
+        await _levels_now(client, uri, OVERRIDDEN)
+        client.configuration_gate.set()  # now the old answer arrives
+        await client.barrier()
+        client.change(uri, 2, partial(DOC, 0, 0, " ", client.encoding))
+        assert _levels(await client.pushed(uri, 2)) == OVERRIDDEN
+    finally:
+        client.configuration_gate.set()
+        client.configuration_gate = None
+        client.set_configuration(old, section="btLsp")
         _configure(client, {"debounceMs": 0})
     await _levels_now(client, uri, DEFAULTS)
 
@@ -219,7 +257,11 @@ async def test_bad_settings_are_logged_and_ignored(client: BtClient) -> None:
 
 
 @clients("vscode")
-@pytest.mark.parametrize("value", [float("inf"), float("nan"), 10**400, -5, True, 1e300])
+@pytest.mark.parametrize(
+    "value",
+    [float("inf"), float("nan"), 10**400, -5, True, 1e300],
+    ids=["inf", "nan", "10**400", "-5", "true", "1e300"],
+)
 async def test_absurd_debounce_values(client: BtClient, value: object) -> None:
     uri = client.open(DOC)
     await client.pushed(uri, 1)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from lsprotocol import types
 
@@ -79,13 +81,18 @@ async def fresh(client: BtClient, text: str) -> list[types.Diagnostic]:
 
 async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
     uri = client.open(TREE.text)
-    diags = names_only(await client.diags(uri, 1))
+    every = await client.diags(uri, 1)
+    diags = names_only(every)
     assert summary(diags) == expected(client, TREE, TREE_CODES)
-    for d in diags:
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    for d in every:
         assert d.source == "bt-lsp"
-        assert d.severity == types.DiagnosticSeverity.Error
         assert d.code_description is not None
+        # The link goes to the code's row in the README's table of codes.
         assert d.code_description.href == f"{README}#{d.code}"
+        assert f'<a id="{d.code}"></a>' in readme, d.code
+    for d in diags:
+        assert d.severity == types.DiagnosticSeverity.Error
         assert isinstance(d.data, dict)
     by_code = {(d.code, d.range.start.line): d for d in diags}
     period = by_code[("model-name-forbidden-char", 3)]
@@ -132,7 +139,7 @@ async def test_several_changes_in_one_notification(client: BtClient) -> None:
     for needle, new in [
         ('name="ok"', 'name="o\x01k" bad.port="1"'),
         ("MainTree", "Main Tree 😋"),
-        ("<Sequence", "<Sequence\tfoo:bar=\"2\""),
+        ("<Sequence", '<Sequence\tfoo:bar="2"'),
         ("</root>\n", "</root>\r\n<!-- 𝔘 -->\r\n"),
     ]:
         start = text.index(needle)
