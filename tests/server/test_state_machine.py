@@ -5,8 +5,9 @@ part of the workspace, so the two documents cannot see each other)."""
 from __future__ import annotations
 
 import asyncio
+import os
 import threading
-from collections.abc import Coroutine, Iterator
+from collections.abc import Callable, Coroutine, Iterator
 from typing import Any, TypeVar
 
 import pytest
@@ -20,10 +21,24 @@ from hypothesis.stateful import (
     run_state_machine_as_test,
 )
 from lsprotocol import types
+from pygls.exceptions import JsonRpcException
 
 from tests.server.conftest import CONFIG, TIMEOUT, BtClient, apply_changes, key, lsp_range
 
 T = TypeVar("T")
+
+REQUESTS = [
+    "hover",
+    "codeAction",
+    "completion",
+    "definition",
+    "references",
+    "documentSymbol",
+    "foldingRange",
+    "prepareRename",
+    "rename",
+]
+NEW_NAMES = ["Good", "bad name", "a.b", "", "Root", "x😋", "1st"]
 
 SEEDS = [
     (
@@ -218,6 +233,67 @@ def test_random_edits_match_a_fresh_open(server: tuple[ServerThread, BtClient]) 
         def whole_document(self, text: str) -> None:
             self._send([types.TextDocumentContentChangeWholeDocument(text=text)])
 
+        @rule()
+        def close_and_reopen(self) -> None:
+            edited.close(self.uri)
+            self.version = 1
+            self.uri = edited.open(self.text, name="edited")
+
+        @rule(data=st.data(), method=st.sampled_from(REQUESTS))
+        def request(self, data: st.DataObject, method: str) -> None:
+            """Every request at a random position answers: a result, or (rename only) a
+            refusal with a reason; never an internal error."""
+            start, end = self._span(data)
+            rng = lsp_range(self.text, start, end, enc)
+            doc = types.TextDocumentIdentifier(uri=self.uri)
+            pos = rng.start
+            calls: dict[str, Callable[[], Coroutine[Any, Any, Any]]] = {
+                "hover": lambda: edited.text_document_hover_async(
+                    types.HoverParams(text_document=doc, position=pos)
+                ),
+                "codeAction": lambda: edited.text_document_code_action_async(
+                    types.CodeActionParams(
+                        text_document=doc,
+                        range=rng,
+                        context=types.CodeActionContext(diagnostics=[]),
+                    )
+                ),
+                "completion": lambda: edited.text_document_completion_async(
+                    types.CompletionParams(text_document=doc, position=pos)
+                ),
+                "definition": lambda: edited.text_document_definition_async(
+                    types.DefinitionParams(text_document=doc, position=pos)
+                ),
+                "references": lambda: edited.text_document_references_async(
+                    types.ReferenceParams(
+                        text_document=doc,
+                        position=pos,
+                        context=types.ReferenceContext(include_declaration=True),
+                    )
+                ),
+                "documentSymbol": lambda: edited.text_document_document_symbol_async(
+                    types.DocumentSymbolParams(text_document=doc)
+                ),
+                "foldingRange": lambda: edited.text_document_folding_range_async(
+                    types.FoldingRangeParams(text_document=doc)
+                ),
+                "prepareRename": lambda: edited.text_document_prepare_rename_async(
+                    types.PrepareRenameParams(text_document=doc, position=pos)
+                ),
+                "rename": lambda: edited.text_document_rename_async(
+                    types.RenameParams(
+                        text_document=doc,
+                        position=pos,
+                        new_name=data.draw(st.sampled_from(NEW_NAMES)),
+                    )
+                ),
+            }
+            try:
+                thread.run(calls[method]())
+            except JsonRpcException as e:
+                assert method in ("rename", "prepareRename"), (method, e)
+                assert e.code == types.LSPErrorCodes.RequestFailed, (method, e)
+
         # -- the property -----------------------------------------------------------------
 
         @invariant()
@@ -243,7 +319,7 @@ def test_random_edits_match_a_fresh_open(server: tuple[ServerThread, BtClient]) 
     run_state_machine_as_test(
         Edits,
         settings=settings(
-            max_examples=25,
+            max_examples=int(os.environ.get("BT_LSP_SERVER_FUZZ_EXAMPLES", "25")),
             stateful_step_count=15,
             deadline=None,
             suppress_health_check=[HealthCheck.too_slow],
