@@ -40,9 +40,13 @@ def main() -> int:
         total.update(codes)
         top = ", ".join(f"`{c}` {n}" for c, n in codes.most_common(4))
         name = project.name.replace("__", "/")
-        rows.append(f"| {name} | {len(files)} | {sev[Severity.ERROR]} | {sev[Severity.WARNING]} "
-                    f"| {sev[Severity.HINT] + sev[Severity.INFORMATION]} | {top} |")
-    print("| project | files | errors | warnings | hints/info | most frequent (errors and warnings) |")
+        rows.append(
+            f"| {name} | {len(files)} | {sev[Severity.ERROR]} | {sev[Severity.WARNING]} "
+            f"| {sev[Severity.HINT] + sev[Severity.INFORMATION]} | {top} |"
+        )
+    print(
+        "| project | files | errors | warnings | hints/info | most frequent (errors and warnings) |"
+    )
     print("|---|---|---|---|---|---|")
     print("\n".join(rows))
     return 0

@@ -18,7 +18,7 @@ import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Final, cast
+from typing import TYPE_CHECKING, Final, NamedTuple, cast
 
 from bt_lsp.builtins import BUILTINS, Category, Direction, PortModel
 from bt_lsp.model import Element, Model, Zone
@@ -41,8 +41,7 @@ _DIRECTIONS: Final[Mapping[str, Direction]] = MappingProxyType(
 _ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "description"})
 
 
-@dataclass(frozen=True, slots=True)
-class ModelDecl:
+class ModelDecl(NamedTuple):
     """A node model (or the port list of a tree) declared in a ``<TreeNodesModel>``.
 
     ``category`` is the entry's tag.  ``ports`` are :class:`~bt_lsp.builtins.PortModel`
@@ -75,13 +74,15 @@ class ModelDecl:
         return 0, 0
 
 
-@dataclass(frozen=True, slots=True)
-class TreeDecl:
+class TreeDecl(NamedTuple):
     """A ``<BehaviorTree ID>``: where it is and which trees it calls.
 
     ``start``/``end`` span the ``ID`` value.  ``calls`` are the IDs of its ``<SubTree>``
     elements in document order (empty IDs left out) and ``call_spans`` the spans of those
     ``ID`` values, index for index.
+
+    Declarations are named tuples (immutable, and cheap to make: a document's are made
+    again for the part of it that an edit moved).
     """
 
     id: str
@@ -138,6 +139,10 @@ class Context:
         default_factory=lambda: cast("Mapping[str, str]", _EMPTY)
     )
     included_by: tuple[str, ...] = ()
+    # What the context was combined from besides its own document's declarations (the
+    # other documents' declarations, by identity, and the settings): equal sources mean
+    # that only this document's own declarations can differ (see semantics/sections.py).
+    sources: tuple[object, ...] = field(default=(), compare=False, repr=False)
 
     def is_own(self, decl: TreeDecl | ModelDecl) -> bool:
         """Whether ``decl`` is declared in this context's document."""
@@ -203,10 +208,12 @@ class Context:
 
         add_models(own_facts)
         included: list[DocumentFacts] = []
+        sources: list[object] = [own_path]
         for other_path, other, in_closure in others:
             if other_path == own_path:
                 continue
             f = facts_of(other, other_path)
+            sources.append((f, in_closure))
             add_models(f)
             if in_closure:
                 included.append(f)
@@ -219,6 +226,7 @@ class Context:
         catalog = False
         for model_path, model_doc in model_files:
             f = facts_of(model_doc, model_path)
+            sources.append(f)
             add_models(f)
             catalog = catalog or any(m.id not in BUILTINS for m in f.models)
         has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
@@ -231,6 +239,7 @@ class Context:
             workspace_has_custom_models=has_custom,
             ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
             included_by=tuple(included_by),
+            sources=(*sources, workspace_has_custom_models),
         )
 
 
@@ -265,24 +274,35 @@ def extract_sections(model: Model, path: str | None) -> DocumentFacts:
     root = model.root
     for section, o in zip(model.sections, model.origins, strict=True):
         # The section's declarations where it is now (kept while it does not move).
-        placed: tuple[int, str | None, DocumentFacts] | None = section.cache.get("placed facts")
+        placed: _Placed | None = section.cache.get("placed facts")
         if placed is None or placed[0] != o or placed[1] != path:
             local: DocumentFacts | None = section.cache.get("facts")
             if local is None:
                 local = section.cache["facts"] = extract(section.local_model(root), None)
-            placed = (o, path, _moved(local, path, o))
-            section.cache["placed facts"] = placed
-        facts = placed[2]
-        trees.extend(facts.trees)
-        models.extend(facts.models)
-        subtree_models.extend(facts.subtree_models)
+            placed = section.cache["placed facts"] = (o, path, *_moved(local, path, o))
+        if placed[2]:
+            trees.extend(placed[2])
+        if placed[3]:
+            models.extend(placed[3])
+        if placed[4]:
+            subtree_models.extend(placed[4])
     return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
 
 
-def _moved(local: DocumentFacts, path: str | None, o: int) -> DocumentFacts:
+_Placed = tuple[
+    int, str | None, tuple["TreeDecl", ...], tuple["ModelDecl", ...], tuple["ModelDecl", ...]
+]
+
+
+def _moved(
+    local: DocumentFacts, path: str | None, o: int
+) -> tuple[tuple[TreeDecl, ...], tuple[ModelDecl, ...], tuple[ModelDecl, ...]]:
     """Declarations extracted in a section's coordinates, in the document's."""
-    return DocumentFacts(
-        path,
+    if not local.models and not local.subtree_models and len(local.trees) == 1:
+        t = local.trees[0]  # the usual section: one tree
+        spans = tuple([(s + o, e + o) for s, e in t.call_spans]) if t.call_spans else ()
+        return (TreeDecl(t.id, path, t.start + o, t.end + o, t.calls, spans),), (), ()
+    return (
         tuple(
             TreeDecl(
                 t.id,
@@ -290,17 +310,23 @@ def _moved(local: DocumentFacts, path: str | None, o: int) -> DocumentFacts:
                 t.start + o,
                 t.end + o,
                 t.calls,
-                tuple((s + o, e + o) for s, e in t.call_spans),
+                tuple([(s + o, e + o) for s, e in t.call_spans]) if t.call_spans else (),
             )
             for t in local.trees
-        ),
+        )
+        if local.trees
+        else (),
         tuple(
             ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o) for m in local.models
-        ),
+        )
+        if local.models
+        else (),
         tuple(
             ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o)
             for m in local.subtree_models
-        ),
+        )
+        if local.subtree_models
+        else (),
     )
 
 

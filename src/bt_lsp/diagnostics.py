@@ -41,9 +41,16 @@ def make(
     return Diagnostic(start, end, code, message, CODES[code].severity, data)
 
 
-@lru_cache(maxsize=65536)
-def _violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
+@lru_cache(maxsize=16384)
+def _cached_violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
     return check_name(text, kind, declaration=declaration)
+
+
+def _violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
+    # Model and port names repeat; instance names rarely do (and their rule is quick).
+    if kind == NameKind.INSTANCE:
+        return check_name(text, kind, declaration=declaration)
+    return _cached_violations(text, kind, declaration)
 
 
 def name_violations(ref: NameRef) -> tuple[Violation, ...]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 
+from bt_lsp.bulk import bulk, in_bulk
 from bt_lsp.diagnostics import Diagnostic, compute
 from bt_lsp.model import Model, build
 from bt_lsp.scanner import Rescan, Scan, rescan, scan
@@ -17,6 +18,7 @@ from bt_lsp.text import LineIndex
 
 
 class Document:
+    @in_bulk
     def __init__(self, text: str, path: str | None = None) -> None:
         self.path = path
         self.text = text
@@ -27,6 +29,8 @@ class Document:
         # The last model built and the tokens replaced since, for the next model.
         self._base: Model | None = None
         self._change: Rescan | None = None
+        self._is_bt: bool | None = None
+        self._utf8_size: int | None = None
 
     def edit(self, start: int, end: int, new_text: str) -> None:
         """Replace ``text[start:end]`` (code-point offsets, clamped) with ``new_text``."""
@@ -43,6 +47,8 @@ class Document:
             self._change = self._change.then(change)
         self._model = None
         self._diagnostics = None
+        self._is_bt = None
+        self._utf8_size = None
 
     def replace_all(self, text: str) -> None:
         self.__init__(text, self.path)  # type: ignore[misc]
@@ -50,9 +56,27 @@ class Document:
     @property
     def model(self) -> Model:
         if self._model is None:
-            self._model = build(self.scan, self.text, self._base, self._change)
+            with bulk():
+                self._model = build(self.scan, self.text, self._base, self._change)
             self._base = self._change = None
         return self._model
+
+    @property
+    def is_bt(self) -> bool:
+        """Whether the text :func:`looks_like_bt` (remembered until the next edit)."""
+        if self._is_bt is None:
+            self._is_bt = looks_like_bt(self.text)
+        return self._is_bt
+
+    @property
+    def utf8_size(self) -> int:
+        """The size of the text in UTF-8 bytes (remembered until the next edit)."""
+        if self._utf8_size is None:
+            text = self.text
+            self._utf8_size = (
+                len(text) if text.isascii() else len(text.encode("utf-8", "surrogatepass"))
+            )
+        return self._utf8_size
 
     @property
     def diagnostics(self) -> list[Diagnostic]:

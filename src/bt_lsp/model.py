@@ -17,19 +17,24 @@ root).  After an edit, :func:`build` re-runs only the sections from the first ch
 token until a section boundary lines up with an old one again; the other sections are the
 same objects as before, and so is everything derived from them and cached on them
 (diagnostics, declarations, semantic checks).  The whole-document views (``elements``,
-``refs``, ``problems``) are made of absolute copies, built when first asked for.
+``refs``, ``problems``) are made of absolute copies, built when first asked for.  Name
+tokens are not kept at all: a section makes them from its elements when asked (they
+outnumber the elements), and keeps only the set of symbols they refer to.
 """
 
 from __future__ import annotations
 
 import re
 from bisect import bisect_left, bisect_right
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections import OrderedDict
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
 from itertools import accumulate
-from typing import Any, overload
+from typing import Any, NamedTuple, overload
 
+from bt_lsp.bulk import bulk
+from bt_lsp.lazyre import LazyPattern
 from bt_lsp.names import RESERVED_PORT_NAMES, NameKind
 from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Rescan, Scan, Token
 
@@ -70,8 +75,7 @@ class Role(StrEnum):
 DECLARING_ROLES = frozenset({Role.TREE_DEF, Role.MODEL_DEF, Role.PORT_DECL})
 
 
-@dataclass(frozen=True, slots=True)
-class NameRef:
+class NameRef(NamedTuple):
     """One name token.  ``start``/``end`` are absolute code-point offsets of the name as
     written: an element or attribute name, or a value between its quotes (entity
     references included).  ``kind`` is ``None`` for references that the name rules do
@@ -143,8 +147,7 @@ class Element:
         return self.name
 
 
-@dataclass(frozen=True, slots=True)
-class StructureProblem:
+class StructureProblem(NamedTuple):
     start: int
     end: int
     code: str
@@ -174,7 +177,7 @@ class Section:
         "lexical",
         "ntokens",
         "problems",
-        "refs",
+        "root",
         "root_end",
     )
 
@@ -183,16 +186,16 @@ class Section:
         ntokens: int,
         length: int,
         elements: list[Element],
-        refs: list[NameRef],
         problems: list[StructureProblem],
         lexical: list[StructureProblem],
         end: int,
         root_end: tuple[int, int, int] | None,
+        root: Element | None = None,
     ) -> None:
         self.ntokens = ntokens
         self.length = length
         self.elements = elements
-        self.refs = refs
+        self.root = root  # the root element, for the head of a document (its refs)
         self.problems = problems
         self.lexical = lexical
         self.end = end
@@ -208,31 +211,82 @@ class Section:
         """The section as a model of its own, in its coordinates; element 0 is ``root``
         (the document's, in document coordinates: only its attributes and its number of
         children mean anything here)."""
-        model: Model | None = self.cache.get("local_model")
-        if model is None or model.elements[0] is not root:
-            model = Model([root or _STAND_IN, *self.elements], self.refs, self.problems)
-            self.cache["local_model"] = model
+        model = Model([root or _STAND_IN, *self.elements], (), self.problems)
+        model._refs = None  # made when asked for (see Model.refs)
+        model.local = self
         return model
+
+    @property
+    def refs(self) -> list[NameRef]:
+        """The section's name tokens, in order.  Made from its elements when asked for,
+        and kept for the few sections asked about last only: a document has more names
+        than elements."""
+        refs = _RECENT_REFS.get(self)
+        if refs is not None:
+            _RECENT_REFS.move_to_end(self)
+            return refs
+        refs = self._make_refs()
+        if "symbols" not in self.cache:  # small, kept: see symbols()
+            self.cache["symbols"] = tuple(
+                dict.fromkeys(r.symbol for r in refs if r.symbol is not None)
+            )
+        _RECENT_REFS[self] = refs
+        if len(_RECENT_REFS) > 64:
+            _RECENT_REFS.popitem(last=False)
+        return refs
+
+    def _make_refs(self) -> list[NameRef]:
+        refs: list[NameRef] = []
+        root = self.root
+        if root is not None:
+            refs.extend(_name_refs(root, 0, None))
+        els = self.elements
+        for i, el in enumerate(els, 1):
+            p = el.parent
+            refs.extend(_name_refs(el, i, els[p - 1] if p > 0 else None))
+            if (
+                el.end_name_start >= 0
+                and el.zone == Zone.NODE
+                and el.name not in EXPLICIT_TAGS
+                and el.name != "SubTree"
+            ):  # the end tag of a compact node names its type too
+                refs.append(
+                    NameRef(
+                        el.end_name_start,
+                        el.end_name_end,
+                        el.name,
+                        None,
+                        Role.NODE_TYPE_END,
+                        _symbol(("model", el.name)),
+                        i,
+                    )
+                )
+        refs.sort(key=_start)
+        return refs
 
     def ref_at(self, offset: int) -> NameRef | None:
         """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
-        starts: list[int] | None = self.cache.get("ref_starts")
-        if starts is None:
-            starts = self.cache["ref_starts"] = [r.start for r in self.refs]
-        i = bisect_right(starts, offset) - 1
-        if i >= 0 and self.refs[i].start <= offset <= self.refs[i].end:
-            return self.refs[i]
+        refs = self.refs
+        i = bisect_right([r.start for r in refs], offset) - 1
+        if i >= 0 and refs[i].start <= offset <= refs[i].end:
+            return refs[i]
         return None
 
-    def by_symbol(self) -> dict[Symbol, list[NameRef]]:
-        index: dict[Symbol, list[NameRef]] | None = self.cache.get("by_symbol")
-        if index is None:
-            index = {}
-            for r in self.refs:
-                if r.symbol is not None:
-                    index.setdefault(r.symbol, []).append(r)
-            self.cache["by_symbol"] = index
-        return index
+    def symbols(self) -> tuple[Symbol, ...]:
+        """The symbols the section's names refer to (found when its names are first made,
+        as for its diagnostics)."""
+        found: tuple[Symbol, ...] | None = self.cache.get("symbols")
+        if found is None:
+            refs = self.refs
+            found = self.cache.get("symbols")
+            if found is None:
+                found = self.cache["symbols"] = tuple(
+                    dict.fromkeys(r.symbol for r in refs if r.symbol is not None)
+                )
+        return found
+
+
+_RECENT_REFS: OrderedDict[Section, list[NameRef]] = OrderedDict()
 
 
 class Part:
@@ -274,15 +328,8 @@ class Part:
         )
 
     def top(self) -> Element:
-        """The section's top element in document coordinates (kept on the section while
-        it stays where it is)."""
-        sec = self.section
-        hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
-        if hit is not None and hit[:3] == (self.origin, self.tok_origin, self.elem_base):
-            return hit[3]
-        el = self.element(sec.elements[0])
-        sec.cache["top"] = (self.origin, self.tok_origin, self.elem_base, el)
-        return el
+        """The section's top element in document coordinates."""
+        return _top(self.section, self.origin, self.tok_origin, self.elem_base)
 
     def ref(self, r: NameRef) -> NameRef:
         o = self.origin
@@ -299,6 +346,17 @@ class Part:
 
     def problem(self, p: StructureProblem) -> StructureProblem:
         return StructureProblem(p.start + self.origin, p.end + self.origin, p.code, p.message)
+
+
+def _top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> Element:
+    """A section's top element in document coordinates (kept on the section while it
+    stays where it is)."""
+    hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
+    if hit is not None and hit[0] == origin and hit[1] == tok_origin and hit[2] == elem_base:
+        return hit[3]
+    el = Part(sec, origin, tok_origin, elem_base).element(sec.elements[0])
+    sec.cache["top"] = (origin, tok_origin, elem_base, el)
+    return el
 
 
 class _Lazy(Sequence[Any]):
@@ -338,16 +396,17 @@ class _Lazy(Sequence[Any]):
 
 
 class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
-    """Every symbol's references in document order, made from the sections' own indexes;
-    the references of a symbol are put in document coordinates when asked for."""
+    """Every symbol's references in document order, made from the sections' sets of
+    symbols; the references of a symbol are made (in document coordinates) when asked for,
+    from the sections that have it."""
 
     __slots__ = ("_cache", "_chunks", "_keys")
 
-    def __init__(self, chunks: list[tuple[Part, dict[Symbol, list[NameRef]]]]) -> None:
+    def __init__(self, chunks: list[tuple[Part, tuple[Symbol, ...]]]) -> None:
         self._chunks = chunks
-        keys: dict[Symbol, None] = {}
-        for _, index in chunks:
-            keys.update(dict.fromkeys(index))
+        keys: set[Symbol] = set()
+        for _, symbols in chunks:
+            keys.update(symbols)
         self._keys = keys
         self._cache: dict[Symbol, list[NameRef]] = {}
 
@@ -356,7 +415,13 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
         if refs is None:
             if symbol not in self._keys:
                 raise KeyError(symbol)
-            refs = [part.ref(r) for part, index in self._chunks for r in index.get(symbol, ())]
+            refs = [
+                part.ref(r)
+                for part, symbols in self._chunks
+                if symbol in symbols
+                for r in part.section.refs
+                if r.symbol == symbol
+            ]
             self._cache[symbol] = refs
         return refs
 
@@ -391,6 +456,7 @@ class Model:
         "firsts",
         "head",
         "head_ntokens",
+        "local",
         "origins",
         "root_element",
         "sections",
@@ -398,6 +464,7 @@ class Model:
         "tail",
         "tail_base",
         "tail_start",
+        "top_names",
     )
 
     def __init__(
@@ -412,14 +479,16 @@ class Model:
         self._problems: Sequence[StructureProblem] | None = problems
         self._ref_starts = ref_starts
         self._by_symbol: Mapping[Symbol, list[NameRef]] | None = None
-        self._cache: dict[Zone, list[Element]] = {}
+        self._cache: dict[Zone | None, list[Element]] = {}
         self.root_element: Element | None = None
+        self.local: Section | None = None  # the section a section's own model is of
         self.head: Section | None = None  # None for a model that is not made of sections
         self.head_ntokens = 0
         self.sections: list[Section] = []
         self.origins: list[int] = []
         self.firsts: list[int] = []
         self.bases: list[int] = []
+        self.top_names: list[str] = []  # the name of each section's top element
         self.sections_end = 0
         self.tail: Section | None = None
         self.tail_base = 0
@@ -435,13 +504,14 @@ class Model:
 
     @property
     def refs(self) -> Sequence[NameRef]:
+        if self._refs is None and self.local is not None:
+            self._refs = self.local.refs
         if self._refs is None:
             parts = self.parts()
-            lengths = [len(p.section.refs) for p in parts]
-            bases = [0, *accumulate(lengths)]
-            self._refs = _Lazy(
-                bases[-1], bases[:-1], lambda c, j: parts[c].ref(parts[c].section.refs[j])
-            )
+            with bulk():
+                local = [p.section.refs for p in parts]
+            bases = [0, *accumulate(map(len, local))]
+            self._refs = _Lazy(bases[-1], bases[:-1], lambda c, j: parts[c].ref(local[c][j]))
         return self._refs
 
     @property
@@ -482,7 +552,9 @@ class Model:
         """Every symbol's references in document order (built once, on first use)."""
         if self._by_symbol is None:
             if self.head is not None:
-                self._by_symbol = _SymbolIndex([(p, p.section.by_symbol()) for p in self.parts()])
+                with bulk():
+                    chunks = [(p, p.section.symbols()) for p in self.parts()]
+                    self._by_symbol = _SymbolIndex(chunks)
             else:
                 index: dict[Symbol, list[NameRef]] = {}
                 for r in self.refs:
@@ -500,17 +572,39 @@ class Model:
         root = self.root
         if root is None:
             return []
-        if zone is not None and self.head is not None:
+        if self.head is not None:
             found: list[Element] | None = self._cache.get(zone)
             if found is None:
                 found = self._cache[zone] = [
-                    self.part(k).top()
-                    for k, sec in enumerate(self.sections)
-                    if sec.elements[0].zone == zone
+                    _top(sec, o, f, b)
+                    for sec, o, f, b in zip(
+                        self.sections, self.origins, self.firsts, self.bases, strict=True
+                    )
+                    if zone is None or sec.elements[0].zone == zone
                 ]
             return found
         els = self.elements
         return [els[i] for i in root.children if zone is None or els[i].zone == zone]
+
+    def root_child_names(self) -> Sequence[str]:
+        """The names of the root's children."""
+        if self.head is not None:
+            return self.top_names
+        return [e.name for e in self.root_children()]
+
+    def root_children_named(self, names: Collection[str]) -> list[Element]:
+        """The root's children (in document coordinates) with one of ``names``; only
+        those are made."""
+        if self.head is not None:
+            tops = self.top_names
+            if not any(name in tops for name in names):  # a search in C
+                return []
+            return [
+                _top(self.sections[k], self.origins[k], self.firsts[k], self.bases[k])
+                for k, name in enumerate(tops)
+                if name in names
+            ]
+        return [c for c in self.root_children() if c.name in names]
 
     # -- sections ---------------------------------------------------------------------------
 
@@ -542,16 +636,30 @@ class Model:
         root = self.root_element
         if root is None:
             return []
-        parts = self.parts()
-        bases = [p.elem_base for p in parts]
-        n = bases[-1] + len(parts[-1].section.elements)
-        last = len(parts) - 1 if self.tail is not None else len(parts)
+        # Chunk 0 is the head (from element 1 on), then the sections, then the tail.
+        bases = [1, *self.bases]
+        nsec = len(self.sections)
+        if self.tail is not None:
+            bases.append(self.tail_base)
+            n = self.tail_base + len(self.tail.elements)
+        else:
+            assert self.head is not None
+            n = 1 + len(self.head.elements)
+        head, tail, tail_base = self.head, self.tail, self.tail_base
+        sections, origins, firsts, elem_bases = self.sections, self.origins, self.firsts, self.bases
 
+        # (Not a method: the view must not refer back to the model, a cycle that only the
+        # cyclic collector could free.)
         def make(c: int, j: int) -> Element:
-            part = parts[c]
-            if j == 0 and 0 < c < last:
-                return part.top()
-            return part.element(part.section.elements[j])
+            if c == 0:
+                assert head is not None
+                return head.elements[j]  # already in document coordinates
+            if c > nsec:
+                assert tail is not None
+                return Part(tail, 0, 0, tail_base).element(tail.elements[j])
+            k = c - 1
+            part = Part(sections[k], origins[k], firsts[k], elem_bases[k])
+            return part.top() if j == 0 else part.element(sections[k].elements[j])
 
         lazy = _Lazy(n, bases, make)
         if n:
@@ -576,34 +684,9 @@ _NAME_START = (
 _NAME_CHAR = _NAME_START + r"\-.0-9\u00b7\u0300-\u036f\u203f-\u2040"
 
 
-class _LazyPattern:
-    """A regular expression compiled on first use (these character classes take tens of
-    milliseconds to compile, which the server's start should not pay)."""
-
-    __slots__ = ("_compiled", "_source")
-
-    def __init__(self, source: str) -> None:
-        self._source = source
-        self._compiled: re.Pattern[str] | None = None
-
-    @property
-    def pattern(self) -> re.Pattern[str]:
-        if self._compiled is None:
-            self._compiled = re.compile(self._source)
-        return self._compiled
-
-    def match(self, text: str) -> re.Match[str] | None:
-        return self.pattern.match(text)
-
-    def fullmatch(self, text: str) -> re.Match[str] | None:
-        return self.pattern.fullmatch(text)
-
-    def finditer(self, text: str) -> Iterator[re.Match[str]]:
-        return self.pattern.finditer(text)
-
-
-XML_NAME_RE = _LazyPattern(f"[{_NAME_START}][{_NAME_CHAR}]*")
-_NOT_NAME_CHAR = _LazyPattern(f"[^{_NAME_CHAR}]")
+# Compiled on first use: these character classes take tens of milliseconds to compile.
+XML_NAME_RE = LazyPattern(f"[{_NAME_START}][{_NAME_CHAR}]*")
+_NOT_NAME_CHAR = LazyPattern(f"[^{_NAME_CHAR}]")
 # The same for ASCII names (the common case), cheap to compile.
 _ASCII_NAME_RE = re.compile(r"[:A-Z_a-z][-.0-9:A-Z_a-z]*")
 _ASCII_NOT_NAME_CHAR = re.compile(r"[^-.0-9:A-Z_a-z]")
@@ -684,20 +767,52 @@ def _owner(el: Element) -> Symbol:
     return ("model", el.value("ID") or "")
 
 
+# A named tuple from all its fields, without the (slower) Python-level constructor.
+_new = tuple.__new__
+
+# Symbols repeat (every use of a node type or port): they are shared (bounded).
+_SYMBOLS: dict[Symbol, Symbol] = {}
+
+
+def _symbol(symbol: Symbol) -> Symbol:
+    shared = _SYMBOLS.get(symbol)
+    if shared is None:
+        if len(_SYMBOLS) >= 65536:
+            _SYMBOLS.clear()
+        shared = _SYMBOLS[symbol] = symbol
+    return shared
+
+
+# The port symbols of each owner, by port name (bounded).
+_PORTS: dict[Symbol, dict[str, Symbol]] = {}
+
+
+def _port_symbols(owner: Symbol) -> dict[str, Symbol]:
+    ports = _PORTS.get(owner)
+    if ports is None:
+        if len(_PORTS) >= 4096:
+            _PORTS.clear()
+        ports = _PORTS[owner] = {}
+    return ports
+
+
 def _value_ref(
     el: Element, idx: int, a: Attr, kind: NameKind | None, role: Role, symbol: Symbol | None
 ) -> NameRef | None:
     if a.value is None:
         return None
-    return NameRef(
-        el.token_start + a.value_start,
-        el.token_start + a.value_end,
-        a.value,
-        kind,
-        role,
-        symbol,
-        idx,
-        a.quote,
+    return _new(
+        NameRef,
+        (
+            el.token_start + a.value_start,
+            el.token_start + a.value_end,
+            a.value,
+            kind,
+            role,
+            _symbol(symbol) if symbol is not None else None,
+            idx,
+            a.quote,
+        ),
     )
 
 
@@ -727,31 +842,42 @@ def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
                 out.append(_value_ref(el, idx, a, NameKind.MODEL, role, (sym, a.value or "")))
         else:
             out.append(
-                NameRef(
-                    ts + 1,
-                    ts + 1 + len(name),
-                    name,
-                    NameKind.MODEL,
-                    Role.NODE_TYPE,
-                    ("model", name),
-                    idx,
+                _new(
+                    NameRef,
+                    (
+                        ts + 1,
+                        ts + 1 + len(name),
+                        name,
+                        NameKind.MODEL,
+                        Role.NODE_TYPE,
+                        _symbol(("model", name)),
+                        idx,
+                        "",
+                    ),
                 )
             )
-        owner = _owner(el)
+        ports = _port_symbols(_owner(el))
         for a in el.attrs:
             an = a.name
             if an == "name":
                 out.append(_value_ref(el, idx, a, NameKind.INSTANCE, Role.INSTANCE, None))
             elif an not in RESERVED_PORT_NAMES:
+                psym = ports.get(an)
+                if psym is None:
+                    psym = ports[an] = _symbol(("port", *_owner(el), an))
                 out.append(
-                    NameRef(
-                        ts + a.name_start,
-                        ts + a.name_end,
-                        an,
-                        NameKind.PORT,
-                        Role.PORT_USE,
-                        ("port", *owner, an),
-                        idx,
+                    _new(
+                        NameRef,
+                        (
+                            ts + a.name_start,
+                            ts + a.name_end,
+                            an,
+                            NameKind.PORT,
+                            Role.PORT_USE,
+                            psym,
+                            idx,
+                            "",
+                        ),
                     )
                 )
     elif zone == Zone.MODEL_ENTRY:
@@ -805,7 +931,6 @@ class _Builder:
         "lexical",
         "origin",
         "problems",
-        "refs",
         "stack",
         "text",
         "tok_origin",
@@ -826,23 +951,16 @@ class _Builder:
         self.els = els
         self.stack = stack
         self.has_root = has_root
-        self.refs: list[NameRef] = []
         self.problems: list[StructureProblem] = []
         self.lexical: list[StructureProblem] = []
 
-    def run(self, tokens: list[Token], starts: list[int], i: int, mode: int) -> tuple[int, int]:
+    def run(self, tokens: list[Token], starts: Sequence[int], i: int, mode: int) -> tuple[int, int]:
         """Process tokens from ``i``; returns where it stopped and how (``OPEN``: at a
         start tag with only the root open, or, for a section, at the root's end tag;
         ``CLOSED``: a section closed the root; ``EOF``)."""
         n = len(tokens)
         text, origin = self.text, self.origin
-        els, stack, refs, problems, lexical = (
-            self.els,
-            self.stack,
-            self.refs,
-            self.problems,
-            self.lexical,
-        )
+        els, stack, problems, lexical = self.els, self.stack, self.problems, self.lexical
         first = i
         start_kind, end_kind, text_kind = Kind.START, Kind.END, Kind.TEXT
         node_zone = Zone.NODE
@@ -906,14 +1024,13 @@ class _Builder:
                 els.append(el)
                 if parent is not None:
                     parent.children.append(idx)
-                refs.extend(_name_refs(el, idx, parent))
                 _check_xml_names(tstart, tok, zone == node_zone, problems)
                 if tok.self_closing:
                     el.end = tstart + tok.length
                 else:
                     stack.append(idx)
             elif kind == end_kind:
-                _close(tstart, tok, els, stack, refs, problems)
+                _close(tstart, tok, els, stack, problems)
                 if mode == _SECTION and not stack:
                     return i + 1, CLOSED
             i += 1
@@ -925,8 +1042,7 @@ class _Builder:
         while len(stack) > (1 if keep_root else 0):
             _report_unclosed(self.els[stack.pop()], self.problems, closed_by=None)
 
-    def section(self, ntokens: int, length: int, end: int) -> Section:
-        self.refs.sort(key=_start)
+    def section(self, ntokens: int, length: int, end: int, head: bool = False) -> Section:
         root_end = None
         if end == CLOSED:
             root = self.els[0]
@@ -935,11 +1051,11 @@ class _Builder:
             ntokens,
             length,
             self.els[1:],
-            self.refs,
             self.problems,
             self.lexical,
             end,
             root_end,
+            self.els[0] if head and self.els else None,
         )
 
 
@@ -948,7 +1064,7 @@ def _start(r: NameRef) -> int:
 
 
 def _section(
-    tokens: list[Token], starts: list[int], text: str, i: int, root_name: str
+    tokens: list[Token], starts: Sequence[int], text: str, i: int, root_name: str
 ) -> tuple[Section, int, int]:
     """The section that starts at token ``i`` (a start tag with only the root open)."""
     origin = starts[i]
@@ -968,7 +1084,9 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     replaced since (see :func:`bt_lsp.scanner.rescan`), the sections that the edit cannot
     have changed are reused.
     """
-    tokens, starts = scan.tokens, scan.starts
+    tokens = scan.tokens
+    # A full build reads every start: as a list; an update reads a few.
+    starts: Sequence[int] = scan.starts if change is not None else scan.starts.tolist()
     n = len(tokens)
     hb = _Builder(text, 0, 0, [], [], False)
     i, state = hb.run(tokens, starts, 0, _HEAD)
@@ -981,6 +1099,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     origins: list[int] = []
     firsts: list[int] = []
     bases: list[int] = []
+    names: list[str] = []
     if state == OPEN and root is not None:
         base = 1
         shift = 0
@@ -1000,6 +1119,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
                 origins = old.origins[:k]
                 firsts = old.firsts[:k]
                 bases = old.bases[:k]
+                names = old.top_names[:k]
                 i = ends[k - 1]
                 state = sections[-1].end
                 base = bases[-1] + len(sections[-1].elements)
@@ -1016,6 +1136,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
                     origins.extend(map(dchar.__add__, old.origins[m:]))
                     firsts.extend(map(shift.__add__, old.firsts[m:]))
                     bases.extend(map(dbase.__add__, old.bases[m:]))
+                    names.extend(old.top_names[m:])
                     i = old.sections_end + shift
                     state = old.sections[-1].end
                     base = bases[-1] + len(sections[-1].elements)
@@ -1025,9 +1146,11 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
             origins.append(starts[i])
             firsts.append(i)
             bases.append(base)
+            names.append(sec.elements[0].name)
             base += len(sec.elements)
             i = j
         model.sections, model.origins, model.firsts, model.bases = sections, origins, firsts, bases
+        model.top_names = names
         model.sections_end = i
         root.children = list(bases)
         if state == CLOSED:
@@ -1047,7 +1170,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
         model.tail_base = base
     else:
         hb.finish(keep_root=False)
-    model.head = hb.section(i if sections else n, 0, EOF)
+    model.head = hb.section(i if sections else n, 0, EOF, head=True)
     return model
 
 
@@ -1056,7 +1179,6 @@ def _close(
     tok: Token,
     elements: list[Element],
     stack: list[int],
-    refs: list[NameRef],
     problems: list[StructureProblem],
 ) -> None:
     """Match an end tag to an open element, tolerating a few missing end tags."""
@@ -1082,11 +1204,7 @@ def _close(
     idx = stack.pop()
     el = elements[idx]
     el.end = tstart + tok.length
-    el.end_name_start, el.end_name_end = name_s, name_e
-    if el.zone == Zone.NODE and el.name not in EXPLICIT_TAGS and el.name != "SubTree":
-        refs.append(
-            NameRef(name_s, name_e, tok.name, None, Role.NODE_TYPE_END, ("model", tok.name), idx)
-        )
+    el.end_name_start, el.end_name_end = name_s, name_e  # its ref: see Section.refs
 
 
 def _report_unclosed(el: Element, problems: list[StructureProblem], closed_by: str | None) -> None:

@@ -46,6 +46,7 @@ import re
 from collections.abc import Collection
 from typing import Final
 
+from bt_lsp.lazyre import LazyPattern
 from bt_lsp.names import (
     RESERVED_MODEL_NAMES,
     RESERVED_PORT_NAMES,
@@ -63,12 +64,13 @@ _NAME_START_CHARS: Final = (
 )
 _NAME_CHARS: Final = _NAME_START_CHARS + r"\-.0-9\xB7\u0300-\u036F\u203F-\u2040"
 
-_XML_NAME_RE: Final = re.compile(f"[{_NAME_START_CHARS}][{_NAME_CHARS}]*")
-_NAME_START_RE: Final = re.compile(f"[{_NAME_START_CHARS}]")
+# Compiled on first use (each takes milliseconds to compile).
+_XML_NAME_RE: Final = LazyPattern(f"[{_NAME_START_CHARS}][{_NAME_CHARS}]*")
+_NAME_START_RE: Final = LazyPattern(f"[{_NAME_START_CHARS}]")
 # Characters kept in a model or port name: XML name characters except ':' and '.'.
-_BAD_RUN_RE: Final = re.compile(f"(?:[^{_NAME_CHARS}]|[:.])+")
+_BAD_RUN_RE: Final = LazyPattern(f"(?:[^{_NAME_CHARS}]|[:.])+")
 # Word separators for the alternatives: bad runs, '_' and '-'.
-_WORD_SEP_RE: Final = re.compile(f"(?:[^{_NAME_CHARS}]|[:._-])+")
+_WORD_SEP_RE: Final = LazyPattern(f"(?:[^{_NAME_CHARS}]|[:._-])+")
 # Characters removed from an instance name.
 _INSTANCE_BAD_RE: Final = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f\ud800-\udfff\ufffe\uffff]+")
 _ASCII_LETTERS: Final = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz")

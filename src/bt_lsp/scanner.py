@@ -9,7 +9,8 @@ soon as a new token starts where an old one (shifted by the edit) started after 
 edit, and reuse the rest.  A property test checks incremental == full scan.
 
 Offsets inside a token are relative to the token's start, so reused tokens are shared
-unchanged; only the list of absolute starts is shifted.
+unchanged; the absolute starts are kept in blocks (:class:`bt_lsp.text.Offsets`), so an
+edit moves the blocks after it, not each start.
 
 The scanner never raises, never recurses, always advances and is linear: every loop
 either consumes text or stops.  It expands nothing: entity references other than XML's
@@ -19,9 +20,11 @@ five and character references are left as written, DOCTYPEs are skipped whole.
 from __future__ import annotations
 
 import re
-from bisect import bisect_right
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import NamedTuple
+
+from bt_lsp.text import Offsets
 
 
 class Kind(IntEnum):
@@ -40,8 +43,7 @@ UNESCAPED = "xml-unescaped-char"
 DOCTYPE_CODE = "xml-doctype"
 
 
-@dataclass(frozen=True, slots=True)
-class Problem:
+class Problem(NamedTuple):
     """A lexical problem; offsets relative to the token start."""
 
     start: int
@@ -50,8 +52,7 @@ class Problem:
     message: str
 
 
-@dataclass(frozen=True, slots=True)
-class Attr:
+class Attr(NamedTuple):
     """An attribute; offsets relative to the token start.
 
     ``value_start``/``value_end`` delimit the raw value between the quotes (entity
@@ -68,8 +69,11 @@ class Attr:
     quote: str
 
 
-@dataclass(frozen=True, slots=True)
-class Token:
+class Token(NamedTuple):
+    """A token; offsets relative to its start.  Tokens, attributes and problems are named
+    tuples: immutable, small and quick to make (a document has tens of thousands).  Equal
+    tokens may be one object (whitespace runs and end tags are shared)."""
+
     kind: Kind
     length: int
     reach: int  # how far (from the token start) the scan looked; >= length
@@ -94,6 +98,7 @@ _FAST_TAG_RE = re.compile(
     r"((?:[ \t\r\n]+[^ \t\r\n/>=<\"']+[ \t\r\n]*=[ \t\r\n]*(?:\"[^\"<]*\"|'[^'<]*'))*)"
     r"[ \t\r\n]*(/?)>"
 )
+_FAST_END_RE = re.compile(r"</([^ \t\r\n/>=<\"']+)[ \t\r\n]*>")
 _FAST_ATTR_RE = re.compile(
     r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
 )
@@ -196,11 +201,42 @@ def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
     return "".join(out)
 
 
+# Makes a named tuple from all its fields without the Python-level constructor (three times
+# quicker, for the hot paths).
+_new = tuple.__new__
+
+# Shared tokens: text runs by length, end tags by their text (bounded).
+_TEXT_TOKENS: dict[int, Token] = {}
+_END_TOKENS: dict[str, Token] = {}
+# Tag and attribute names, shared (bounded).
+_NAMES: dict[str, str] = {}
+_SHARED_MAX = 8192
+
+
+def _text_token(length: int) -> Token:
+    """A text run followed by '<' (its scan looked at that '<' too)."""
+    tok = _TEXT_TOKENS.get(length)
+    if tok is None:
+        if len(_TEXT_TOKENS) >= _SHARED_MAX:
+            _TEXT_TOKENS.clear()
+        tok = _TEXT_TOKENS[length] = Token(Kind.TEXT, length, length + 1)
+    return tok
+
+
+def _name(name: str) -> str:
+    shared = _NAMES.get(name)
+    if shared is None:
+        if len(_NAMES) >= _SHARED_MAX:
+            _NAMES.clear()
+        shared = _NAMES[name] = name
+    return shared
+
+
 def _scan_text(text: str, pos: int, n: int) -> Token:
     end = text.find("<", pos)
     if end == -1:
         return Token(Kind.TEXT, n - pos, n - pos)
-    return Token(Kind.TEXT, end - pos, end - pos + 1)
+    return _text_token(end - pos)
 
 
 def _scan_delimited(
@@ -275,6 +311,17 @@ def _scan_doctype(text: str, pos: int, n: int) -> Token:
 
 
 def _scan_end_tag(text: str, pos: int, n: int) -> Token:
+    m = _FAST_END_RE.match(text, pos)
+    if m is not None:  # the common case: shared
+        key = m.group(0)
+        tok = _END_TOKENS.get(key)
+        if tok is None:
+            if len(_END_TOKENS) >= _SHARED_MAX:
+                _END_TOKENS.clear()
+            name = _name(m.group(1))
+            length = len(key)
+            tok = _END_TOKENS[key] = Token(Kind.END, length, length + 1, name, 2, 2 + len(name))
+        return tok
     problems: list[Problem] = []
     m = _NAME_RE.match(text, pos + 2)
     if m is None:
@@ -318,45 +365,59 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
     m = _FAST_TAG_RE.match(text, pos)
     if m is None:
         return None
-    name = m.group(1)
+    name = _name(m.group(1))
+    a_start, a_end = m.span(2)
+    length = m.end() - pos
+    self_closing = m.group(3) == "/"
+    if a_start == a_end:
+        return Token(Kind.START, length, length + 1, name, 1, 1 + len(name), (), self_closing)
     attrs: list[Attr] = []
     problems: list[Problem] = []
     seen: set[str] = set()
-    a_start = m.start(2)
-    for am in _FAST_ATTR_RE.finditer(text, a_start, m.end(2)):
-        vi = 2 if am.group(2) is not None else 3
-        raw = am.group(vi)
-        vs = am.start(vi) - pos
-        aname = am.group(1)
+    for am in _FAST_ATTR_RE.finditer(text, a_start, a_end):
+        aname, raw, raw2 = am.groups()
+        ns, ne = am.span(1)
+        if raw is None:
+            raw = raw2
+            vs, ve = am.span(3)
+            quote = "'"
+        else:
+            vs, ve = am.span(2)
+            quote = '"'
+        vs -= pos
         if aname in seen:
             problems.append(
-                Problem(
-                    am.start(1) - pos, am.end(1) - pos, XML_SYNTAX, f"Duplicate attribute '{aname}'"
-                )
+                Problem(ns - pos, ne - pos, XML_SYNTAX, f"Duplicate attribute '{aname}'")
             )
         seen.add(aname)
         attrs.append(
-            Attr(
-                aname,
-                am.start(1) - pos,
-                am.end(1) - pos,
-                decode_value(raw, vs, problems),
-                vs,
-                vs + len(raw),
-                '"' if vi == 2 else "'",
+            _new(
+                Attr,
+                (
+                    _name(aname),
+                    ns - pos,
+                    ne - pos,
+                    raw if "&" not in raw else decode_value(raw, vs, problems),
+                    vs,
+                    ve - pos,
+                    quote,
+                ),
             )
         )
-    length = m.end() - pos
-    return Token(
-        Kind.START,
-        length,
-        length + 1,
-        name=name,
-        name_start=1,
-        name_end=1 + len(name),
-        attrs=tuple(attrs),
-        self_closing=m.group(3) == "/",
-        problems=tuple(problems),
+    return _new(
+        Token,
+        (
+            Kind.START,
+            length,
+            length + 1,
+            name,
+            1,
+            1 + len(name),
+            tuple(attrs),
+            self_closing,
+            True,
+            tuple(problems) if problems else (),
+        ),
     )
 
 
@@ -539,16 +600,20 @@ def scan_token(text: str, pos: int) -> Token:
     )
 
 
+# The token starts of a scan: offsets kept in blocks (see bt_lsp.text.Offsets).
+Starts = Offsets
+
+
 @dataclass(slots=True)
 class Scan:
     """The tokens of a text and their absolute start offsets."""
 
     tokens: list[Token]
-    starts: list[int]
+    starts: Starts
 
     def index_at(self, offset: int) -> int:
         """Index of the token containing ``offset`` (the last token for offsets past it)."""
-        return max(0, bisect_right(self.starts, offset) - 1)
+        return max(0, self.starts.index_at(offset))
 
 
 def scan(text: str) -> Scan:
@@ -560,7 +625,7 @@ def scan(text: str) -> Scan:
         tokens.append(tok)
         starts.append(pos)
         pos += tok.length
-    return Scan(tokens, starts)
+    return Scan(tokens, Starts.of(starts))
 
 
 @dataclass(frozen=True, slots=True)
@@ -612,15 +677,14 @@ def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> 
                 while k < nold and starts[k] < old_pos:
                     k += 1
                 if k < nold and starts[k] == old_pos:
-                    tail_starts = list(map(delta.__add__, starts[k:])) if delta else starts[k:]
-                    result = Scan(
-                        tokens[:first] + new_tokens + tokens[k:],
-                        starts[:first] + new_starts + tail_starts,
-                    )
+                    new_list = tokens[:first]
+                    new_list.extend(new_tokens)
+                    new_list.extend(tokens[k:])
+                    result = Scan(new_list, starts.replaced(first, k, new_starts, delta))
                     return result, Rescan(first, k, first + len(new_tokens))
         tok = scan_token(new_text, pos)
         new_tokens.append(tok)
         new_starts.append(pos)
         pos += tok.length
-    result = Scan(tokens[:first] + new_tokens, starts[:first] + new_starts)
+    result = Scan(tokens[:first] + new_tokens, starts.replaced(first, nold, new_starts, delta))
     return result, Rescan(first, nold, first + len(new_tokens))

@@ -15,12 +15,14 @@ This module is pure: it does not import any LSP library.
 
 from __future__ import annotations
 
+from array import array
 from bisect import bisect_left, bisect_right
+from collections.abc import Iterator, Sequence
 from itertools import accumulate, count
 from operator import add
-from typing import Final, Literal
+from typing import Final, Literal, overload
 
-__all__ = ["Encoding", "LineIndex", "normalize_encoding"]
+__all__ = ["Encoding", "LineIndex", "Offsets", "normalize_encoding"]
 
 Encoding = Literal["utf-8", "utf-16", "utf-32"]
 
@@ -79,6 +81,119 @@ def _unit_width(char: str, encoding: Encoding) -> int:
     return 1
 
 
+class Offsets(Sequence[int]):
+    """A sorted list of offsets (the starts of a scan's tokens, of a text's lines), in
+    blocks: each block holds a run of offsets relative to its first one, as an array of
+    machine integers.  After an edit only the blocks around it are made again
+    (:meth:`replaced`); the others are shared with the old list, only their base offsets
+    and first indexes move.  So an edit does not touch every offset after it, and an
+    offset takes 8 bytes, not an ``int`` object."""
+
+    __slots__ = ("_bases", "_blocks", "_firsts", "_n")
+
+    BLOCK = 512
+
+    def __init__(self, bases: list[int], firsts: list[int], blocks: list[array[int]]) -> None:
+        self._bases = bases  # the offset of each block's first token
+        self._firsts = firsts  # the index of each block's first token
+        self._blocks = blocks
+        self._n = firsts[-1] + len(blocks[-1]) if blocks else 0
+
+    @classmethod
+    def of(cls, starts: Sequence[int]) -> Offsets:
+        bases: list[int] = []
+        firsts: list[int] = []
+        blocks: list[array[int]] = []
+        size = cls.BLOCK
+        for i in range(0, len(starts), size):
+            base = starts[i]
+            bases.append(base)
+            firsts.append(i)
+            blocks.append(array("q", map((-base).__add__, starts[i : i + size])))
+        return cls(bases, firsts, blocks)
+
+    def __len__(self) -> int:
+        return self._n
+
+    @overload
+    def __getitem__(self, i: int) -> int: ...
+    @overload
+    def __getitem__(self, i: slice) -> list[int]: ...
+    def __getitem__(self, i: int | slice) -> int | list[int]:
+        if isinstance(i, slice):
+            return self.tolist()[i]
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError(i)
+        b = bisect_right(self._firsts, i) - 1
+        return self._bases[b] + self._blocks[b][i - self._firsts[b]]
+
+    def __iter__(self) -> Iterator[int]:
+        for base, block in zip(self._bases, self._blocks, strict=True):
+            yield from map(base.__add__, block)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Offsets | list | tuple):
+            return self.tolist() == list(other)
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"Offsets({self.tolist()!r})"
+
+    def tolist(self) -> list[int]:
+        out: list[int] = []
+        for base, block in zip(self._bases, self._blocks, strict=True):
+            out.extend(map(base.__add__, block))
+        return out
+
+    def bisect_right(self, offset: int) -> int:
+        """The number of offsets at or before ``offset`` (as :func:`bisect.bisect_right`)."""
+        b = bisect_right(self._bases, offset) - 1
+        if b < 0:
+            return 0
+        return self._firsts[b] + bisect_right(self._blocks[b], offset - self._bases[b])
+
+    def bisect_left(self, offset: int) -> int:
+        """The number of offsets before ``offset`` (as :func:`bisect.bisect_left`)."""
+        b = bisect_left(self._bases, offset) - 1
+        if b < 0:
+            return 0
+        return self._firsts[b] + bisect_left(self._blocks[b], offset - self._bases[b])
+
+    def index_at(self, offset: int) -> int:
+        """Index of the last offset at or before ``offset`` (-1 if none)."""
+        return self.bisect_right(offset) - 1
+
+    def replaced(self, first: int, stop: int, new: list[int], delta: int) -> Offsets:
+        """These starts with ``[first, stop)`` replaced by ``new`` (absolute offsets) and
+        every start from ``stop`` on moved by ``delta``."""
+        bases, firsts, blocks, n = self._bases, self._firsts, self._blocks, self._n
+        if not blocks:
+            return Offsets.of(new)
+        bf = bisect_right(firsts, first) - 1 if first < n else len(blocks) - 1
+        bk = bisect_right(firsts, stop) - 1 if stop < n else len(blocks) - 1
+        middle: list[int] = list(map(bases[bf].__add__, blocks[bf][: first - firsts[bf]]))
+        middle.extend(new)
+        if stop < n:
+            middle.extend(map((bases[bk] + delta).__add__, blocks[bk][stop - firsts[bk] :]))
+        mid = Offsets.of(middle)
+        dtok = len(new) - (stop - first)
+        start_index = firsts[bf]
+        out_firsts = firsts[:bf]
+        out_firsts.extend(map(start_index.__add__, mid._firsts))
+        out_firsts.extend(map(dtok.__add__, firsts[bk + 1 :]))
+        out_bases = bases[:bf]
+        out_bases.extend(mid._bases)
+        out_bases.extend(map(delta.__add__, bases[bk + 1 :]))
+        out_blocks = blocks[:bf]
+        out_blocks.extend(mid._blocks)
+        out_blocks.extend(blocks[bk + 1 :])
+        return Offsets(out_bases, out_firsts, out_blocks)
+
+
 class LineIndex:
     """Line starts of a text, and conversions between offsets and LSP positions.
 
@@ -89,15 +204,16 @@ class LineIndex:
     __slots__ = ("_starts", "_text")
 
     _text: str
-    _starts: list[int]
+    _starts: Offsets  # an edit moves blocks of them, not each of them
 
     def __init__(self, text: str) -> None:
         self._text = text
-        self._starts = [0]
-        self._starts.extend(_line_starts(text))
+        starts = [0]
+        starts.extend(_line_starts(text))
+        self._starts = Offsets.of(starts)
 
     @classmethod
-    def _from_parts(cls, text: str, starts: list[int]) -> LineIndex:
+    def _from_parts(cls, text: str, starts: Offsets) -> LineIndex:
         index = cls.__new__(cls)
         index._text = text
         index._starts = starts
@@ -160,7 +276,7 @@ class LineIndex:
     def line_of(self, offset: int) -> int:
         """The line holding ``offset`` (clamped to ``[0, len(text)]``)."""
         offset = min(max(offset, 0), len(self._text))
-        return bisect_right(self._starts, offset) - 1
+        return self._starts.bisect_right(offset) - 1
 
     # -- conversions -------------------------------------------------------------------
 
@@ -173,7 +289,7 @@ class LineIndex:
         """
         text = self._text
         offset = min(max(offset, 0), len(text))
-        line = bisect_right(self._starts, offset) - 1
+        line = self._starts.bisect_right(offset) - 1
         start = self._starts[line]
         if offset > start and text[offset - 1] == "\r" and text[offset : offset + 1] == "\n":
             offset -= 1  # between "\r" and "\n": the end of the line
@@ -275,17 +391,12 @@ class LineIndex:
         # A line start p depends only on the characters at p - 1 and p. Those are unchanged
         # for old starts p < start and p > end, so only [start, new_end] is rescanned, from
         # one character before it to one character after it.
-        keep_before = bisect_left(starts, start)
-        keep_after = bisect_right(starts, end)
+        keep_before = starts.bisect_left(start)
+        keep_after = starts.bisect_right(end)
         lo = max(start - 1, 0)
         hi = min(new_end + 1, len(new_full_text))
         rescanned = [lo + rel for rel in _line_starts(new_full_text[lo:hi]) if lo + rel <= new_end]
-
-        result = starts[:keep_before] if keep_before else [0]
-        result.extend(rescanned)
-        delta = new_end - end
-        if delta:
-            result.extend(map(delta.__add__, starts[keep_after:]))
-        else:
-            result.extend(starts[keep_after:])
+        # Line 0 always starts at 0; the starts in [keep_before, keep_after) are replaced,
+        # the later ones move.
+        result = starts.replaced(max(keep_before, 1), keep_after, rescanned, new_end - end)
         return LineIndex._from_parts(new_full_text, result)

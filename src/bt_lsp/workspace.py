@@ -16,11 +16,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bt_lsp import analysis
+from bt_lsp.bulk import in_bulk
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic, limited, make
-from bt_lsp.document import Document, looks_like_bt
+from bt_lsp.document import Document
 from bt_lsp.fileio import FileError, read_text
-from bt_lsp.model import Model, Zone
+from bt_lsp.model import Model
 from bt_lsp.settings import Settings
 
 # Folders that never hold a project's own trees (build outputs, VCS, dependencies).
@@ -64,7 +65,7 @@ class Include:
 
 def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
     out: list[Include] = []
-    for el in doc.model.root_children(Zone.INCLUDE):
+    for el in doc.model.root_children_named(("include",)):  # the INCLUDE zone
         a = el.attr("path")
         if a is None or a.value is None or not a.value.strip():
             continue  # include-missing-path is a semantic rule of the document itself
@@ -92,6 +93,8 @@ class Workspace:
         self._open: dict[Path, Document] = {}
         self._disk: dict[Path, tuple[tuple[int, int], Document | None, str | None]] = {}
         self._files: list[Path] | None = None
+        self._includes: dict[Path, tuple[Model, Settings, list[Include]]] = {}
+        self._paths: tuple[tuple[int, tuple[Path, ...]], list[Path]] | None = None
         self.generation = 0  # bumps whenever a file other than an edited open one changes
 
     # -- documents --------------------------------------------------------------------------
@@ -129,6 +132,9 @@ class Workspace:
         except OSError as e:
             self._disk[path] = ((0, 0), None, e.strerror or str(e))
             return None, e.strerror or str(e)
+        except ValueError as e:  # a path the OS cannot look up ("embedded null byte")
+            self._disk[path] = ((0, 0), None, str(e))
+            return None, str(e)
         if not path.is_file():
             self._disk[path] = ((0, 0), None, "not a file")
             return None, "not a file"
@@ -185,10 +191,12 @@ class Workspace:
         return out
 
     def bt_documents(self) -> Iterator[tuple[Path, Document]]:
-        paths = set(self.files()) | set(self._open)
-        for p in sorted(paths):
+        key = (self.generation, tuple(self._open))
+        if self._paths is None or self._paths[0] != key:
+            self._paths = (key, sorted(set(self.files()) | set(self._open)))
+        for p in self._paths[1]:
             doc = self.document(p)
-            if doc is not None and (looks_like_bt(doc.text) or p.suffix == ".btproj"):
+            if doc is not None and (doc.is_bt or p.suffix == ".btproj"):
                 yield p, doc
 
     # -- includes -----------------------------------------------------------------------------
@@ -197,7 +205,15 @@ class Workspace:
         doc = doc if doc is not None else self.document(path)
         if doc is None:
             return []
-        return includes_of(path, doc, self.settings)
+        # Kept per path while the document's model and the settings are the same (every
+        # document's includes are looked at for every other one).
+        model = doc.model
+        hit = self._includes.get(path)
+        if hit is not None and hit[0] is model and hit[1] is self.settings:
+            return hit[2]
+        found = includes_of(path, doc, self.settings)
+        self._includes[path] = (model, self.settings, found)
+        return found
 
     def include_closure(self, path: Path, doc: Document | None = None) -> list[Path]:
         """Files reachable through includes from ``path`` (not ``path`` itself), in
@@ -314,7 +330,7 @@ class Workspace:
             included_by=included_by,
         )
 
-
+    @in_bulk
     def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
         """Every diagnostic of ``doc`` in this workspace."""
         out = analysis.analyze(doc, self.context_for(path, doc))

@@ -10,8 +10,12 @@ import time
 from typing import Any
 
 SERVER = [sys.executable, "-m", "bt_lsp", "serve"]
-INIT = {"jsonrpc": "2.0", "id": 1, "method": "initialize",
-        "params": {"capabilities": {}, "processId": None, "rootUri": None}}
+INIT = {
+    "jsonrpc": "2.0",
+    "id": 1,
+    "method": "initialize",
+    "params": {"capabilities": {}, "processId": None, "rootUri": None},
+}
 
 
 def frame(obj: dict[str, Any]) -> bytes:
@@ -33,19 +37,29 @@ def responses(stdout: bytes) -> dict[int, dict[str, Any]]:
 
 def run(messages: list[dict[str, Any]]) -> tuple[int, dict[int, dict[str, Any]], float]:
     start = time.monotonic()
-    proc = subprocess.run(SERVER, input=b"".join(frame(m) for m in messages),
-                          capture_output=True, timeout=60)
+    proc = subprocess.run(
+        SERVER, input=b"".join(frame(m) for m in messages), capture_output=True, timeout=60
+    )
     return proc.returncode, responses(proc.stdout), time.monotonic() - start
 
 
 def test_shutdown_then_exit_and_requests_after_shutdown() -> None:
-    rc, res, _ = run([
-        INIT,
-        {"jsonrpc": "2.0", "id": 2, "method": "shutdown"},
-        {"jsonrpc": "2.0", "id": 3, "method": "textDocument/hover", "params": {
-            "textDocument": {"uri": "file:///x.xml"}, "position": {"line": 0, "character": 0}}},
-        {"jsonrpc": "2.0", "method": "exit"},
-    ])
+    rc, res, _ = run(
+        [
+            INIT,
+            {"jsonrpc": "2.0", "id": 2, "method": "shutdown"},
+            {
+                "jsonrpc": "2.0",
+                "id": 3,
+                "method": "textDocument/hover",
+                "params": {
+                    "textDocument": {"uri": "file:///x.xml"},
+                    "position": {"line": 0, "character": 0},
+                },
+            },
+            {"jsonrpc": "2.0", "method": "exit"},
+        ]
+    )
     assert rc == 0
     assert res[2]["result"] is None
     assert res[3]["error"]["code"] == -32600

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import TYPE_CHECKING, Any, Final, Literal
 
 from bt_lsp.builtins import BUILTINS, Category, PortModel
@@ -168,22 +169,42 @@ def quoted(text: str, limit: int = 60) -> str:
     return f"'{shown}'"
 
 
+@lru_cache(maxsize=65536)  # the same names are compared again in every document
 def edit_distance(a: str, b: str, limit: int) -> int:
-    """Levenshtein distance of ``a`` and ``b``; any value above ``limit`` is ``limit + 1``."""
-    if abs(len(a) - len(b)) > limit:
+    """Levenshtein distance of ``a`` and ``b``; any value above ``limit`` is ``limit + 1``.
+
+    Only the cells within ``limit`` of the diagonal are computed (the others are above the
+    limit anyway), so a check against hundreds of names stays cheap."""
+    la, lb = len(a), len(b)
+    if abs(la - lb) > limit:
         return limit + 1
-    prev = list(range(len(b) + 1))
-    for i, ca in enumerate(a, 1):
-        cur = [i]
-        best = i
-        for j, cb in enumerate(b, 1):
-            v = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (ca != cb))
-            cur.append(v)
-            best = min(best, v)
+    if a == b:
+        return 0
+    big = limit + 1
+    prev = [j if j <= limit else big for j in range(lb + 1)]
+    for i in range(1, la + 1):
+        ca = a[i - 1]
+        lo = i - limit if i > limit else 1
+        hi = i + limit if i + limit < lb else lb
+        cur = [big] * (lb + 1)
+        best = cur[0] = i if i <= limit else big
+        for j in range(lo, hi + 1):
+            v = prev[j - 1] + (ca != b[j - 1])
+            x = prev[j] + 1
+            if x < v:
+                v = x
+            x = cur[j - 1] + 1
+            if x < v:
+                v = x
+            if v > big:
+                v = big
+            cur[j] = v
+            if v < best:
+                best = v
         if best > limit:
-            return limit + 1
+            return big
         prev = cur
-    return min(prev[-1], limit + 1)
+    return prev[lb] if prev[lb] < big else big
 
 
 @dataclass(slots=True)

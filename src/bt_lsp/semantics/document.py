@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from bt_lsp.model import EXPLICIT_TAGS, Element, Zone
+from bt_lsp.model import EXPLICIT_TAGS, Element
 from bt_lsp.semantics.base import State, quoted
 
 MAX_DEPTH: Final = 256
@@ -38,12 +38,9 @@ _ID_TAGS: Final = EXPLICIT_TAGS | {"SubTree"}
 
 
 def check_root(st: State) -> None:
-    elements = st.model.elements
-    if not elements:
+    root = st.model.root  # the first element, when there is one
+    if root is None:
         st.add(0, 0, "root-element", "The document has no <root> element")
-        return
-    root = elements[0]
-    if root.zone != Zone.ROOT:  # pragma: no cover - the first element is always the root
         return
     if root.name != "root":
         st.add(
@@ -63,8 +60,10 @@ def check_root(st: State) -> None:
                 '<root> has no BTCPP_format attribute; add BTCPP_format="4" if the file is '
                 "written for BehaviorTree.CPP 4 (BehaviorTree.CPP warns about it)",
             )
-    children = [elements[i] for i in root.children]
-    models_sections = [c for c in children if c.name == "TreeNodesModel"]
+    # Only the children that a rule looks at closely are made (a large document has
+    # thousands of trees).
+    model = st.model
+    models_sections = model.root_children_named(("TreeNodesModel",))
     for extra in models_sections[1:]:
         st.add(
             extra.name_start,
@@ -72,13 +71,11 @@ def check_root(st: State) -> None:
             "duplicate-model-section",
             "Only a single <TreeNodesModel> is supported; merge this section into the first",
         )
-    trees = 0
-    for c in children:
-        if c.name == "BehaviorTree":
-            trees += 1
-        elif c.name == "include":
-            _check_include(st, c)
-        elif models_sections and c.name in _ID_TAGS and c.attr("ID") is None:
+    trees = model.root_child_names().count("BehaviorTree")
+    for c in model.root_children_named(("include",)):
+        _check_include(st, c)
+    for c in model.root_children_named(_ID_TAGS) if models_sections else ():
+        if c.attr("ID") is None:
             st.add(
                 c.name_start,
                 c.name_end,

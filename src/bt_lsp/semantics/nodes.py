@@ -190,9 +190,12 @@ def _closest(st: State, type_id: str) -> str | None:
     """A known node type that ``type_id`` is probably a typo of (edit distance 1-2)."""
     if len(type_id) < 5:
         return None
-    limit = 1 if len(type_id) < 8 else 2
+    n = len(type_id)
+    limit = 1 if n < 8 else 2
     best: tuple[int, str] | None = None
     for cand in (*BUILTINS, *st.ctx.models):
+        if abs(len(cand) - n) > limit:
+            continue
         d = edit_distance(type_id, cand, limit)
         if d <= limit and (best is None or d < best[0]):
             best = (d, cand)

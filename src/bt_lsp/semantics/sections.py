@@ -24,7 +24,7 @@ import weakref
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Final, TypeVar
 
-from bt_lsp.context import Context, ModelDecl, TreeDecl
+from bt_lsp.context import Context, DocumentFacts, ModelDecl, TreeDecl
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.model import Element, Section
 from bt_lsp.semantics.base import State
@@ -95,16 +95,21 @@ class _Entry:
     line: int | None  # the line the section starts on, when a message names a line
     deps: dict[Dep, object]  # the signature of each context entry looked up
     out: list[Diagnostic]
-    generation: int = 0  # the last check of its document that found it valid
 
 
 @dataclasses.dataclass(slots=True)
 class _History:
-    """The last check of a document: its number and the signature of every context entry
-    looked up by its sections, so that the next check compares each entry once."""
+    """The last check of a document: the settings, the signature of every context entry
+    looked up by its sections (so that the next check compares each entry once), what
+    the context was combined from besides the document itself, and its sections (all of
+    them valid then), with those that have diagnostics and those that name lines."""
 
-    generation: int = 0
+    settings: tuple[object, ...] = ()
     sigs: dict[Dep, object] = dataclasses.field(default_factory=dict)
+    sources: tuple[object, ...] = ()
+    valid: set[Section] | None = None
+    noisy: set[Section] = dataclasses.field(default_factory=set)
+    lines: set[Section] = dataclasses.field(default_factory=set)
 
 
 _HISTORY: weakref.WeakKeyDictionary[Document, _History] = weakref.WeakKeyDictionary()
@@ -113,7 +118,9 @@ _HISTORY: weakref.WeakKeyDictionary[Document, _History] = weakref.WeakKeyDiction
 def check_sections(st: State, check: Callable[[State, Sequence[Element]], None]) -> None:
     """Add the section pass's diagnostics of every section of ``st.model`` to ``st.out``:
     ``check`` runs over the elements of the sections whose remembered results are out of
-    date."""
+    date.  When the context's entries did not change, only the sections that are new
+    since the last check of the document are looked at (and those whose messages name a
+    line), so that an edit costs what it changes."""
     model, ctx = st.model, st.ctx
     root = model.root
     settings = (
@@ -136,38 +143,124 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
     hist = _HISTORY.get(st.doc)
     if hist is None:
         hist = _HISTORY[st.doc] = _History()
-    previous = hist.generation
-    generation = previous + 1
+    sections, origins = model.sections, model.origins
+    now = set(sections)
+    same = hist.valid is not None and hist.settings == settings
     # The context entries that changed since the last check: a section that was valid
     # then is valid now unless it looked one of them up.
-    changed = {d for d, sig in hist.sigs.items() if current(d) != sig}
+    touched = _touched(hist.valid, now, hist.sources, ctx) if same else None
+    if touched is None:
+        changed = {d for d, sig in hist.sigs.items() if current(d) != sig}
+    else:
+        changed = set()
+        sigs = hist.sigs
+        candidates: list[Dep] = [(f, key) for key in touched for f in _FIELDS]
+        if touched:
+            candidates.extend((f, None) for f in _FIELDS)
+        for d in candidates:
+            if d in sigs and current(d) != sigs[d]:
+                changed.add(d)
     lines = st.doc.lines
-    out = st.out
-    for sec, origin in zip(model.sections, model.origins, strict=True):
-        entry: _Entry | None = sec.cache.get(_KEY)
-        valid = (
-            entry is not None
-            and entry.settings == settings
-            and (entry.line is None or entry.line == lines.line_of(origin))
-        )
-        if valid:
-            assert entry is not None
-            if entry.generation == previous:
-                valid = changed.isdisjoint(entry.deps)
+    index: dict[Section, int] | None = None
+    todo: list[Section] = []
+    if same and not changed:
+        assert hist.valid is not None
+        valid = hist.valid & now
+        todo.extend(now - valid)
+        noisy = hist.noisy & valid
+        line_dependent = hist.lines & valid
+        if line_dependent:
+            index = dict(zip(sections, range(len(sections)), strict=True))
+            for sec in list(line_dependent):
+                entry: _Entry = sec.cache[_KEY]
+                if entry.line != lines.line_of(origins[index[sec]]):
+                    valid.discard(sec)
+                    noisy.discard(sec)
+                    line_dependent.discard(sec)
+                    todo.append(sec)
+    else:
+        trusted = hist.valid if same and hist.valid is not None else set()
+        valid, noisy, line_dependent = set(), set(), set()
+        for sec, origin in zip(sections, origins, strict=True):
+            found: _Entry | None = sec.cache.get(_KEY)
+            if found is not None and sec in trusted:
+                ok = (
+                    found.line is None or found.line == lines.line_of(origin)
+                ) and changed.isdisjoint(found.deps)
             else:
-                valid = all(current(d) == sig for d, sig in entry.deps.items())
-        if not valid:
-            entry = _run(st, sec, origin, root, settings, check, current, lines)
-            sec.cache[_KEY] = entry
-        assert entry is not None
-        entry.generation = generation
-        if entry.out:
+                ok = _still_valid(found, settings, lines, origin, current)
+            if ok:
+                assert found is not None
+                valid.add(sec)
+                if found.out:
+                    noisy.add(sec)
+                if found.line is not None:
+                    line_dependent.add(sec)
+            else:
+                todo.append(sec)
+    if todo:
+        if index is None:
+            index = dict(zip(sections, range(len(sections)), strict=True))
+        for sec in todo:
+            origin = origins[index[sec]]
+            found = sec.cache.get(_KEY)
+            if not _still_valid(found, settings, lines, origin, current):
+                found = _run(st, sec, origin, root, settings, check, current, lines)
+                sec.cache[_KEY] = found
+            assert found is not None
+            valid.add(sec)
+            if found.out:
+                noisy.add(sec)
+            if found.line is not None:
+                line_dependent.add(sec)
+    if noisy:
+        if index is None:
+            index = dict(zip(sections, range(len(sections)), strict=True))
+        out = st.out
+        for sec in noisy:
+            origin = origins[index[sec]]
             out.extend(
                 Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
-                for d in entry.out
+                for d in sec.cache[_KEY].out
             )
-    hist.generation = generation
-    hist.sigs = memo  # every entry looked up by a section now valid, and a few more
+    hist.settings = settings
+    hist.sigs.update(memo)
+    hist.sources = ctx.sources
+    hist.valid, hist.noisy, hist.lines = valid, noisy, line_dependent
+
+
+def _still_valid(
+    entry: _Entry | None,
+    settings: tuple[object, ...],
+    lines: LineIndex,
+    origin: int,
+    current: Callable[[Dep], object],
+) -> bool:
+    """Whether remembered results hold, every context entry they read compared."""
+    return (
+        entry is not None
+        and entry.settings == settings
+        and (entry.line is None or entry.line == lines.line_of(origin))
+        and all(current(d) == sig for d, sig in entry.deps.items())
+    )
+
+
+def _touched(
+    before: set[Section] | None, now: set[Section], sources: tuple[object, ...], ctx: Context
+) -> set[str] | None:
+    """The names declared by the sections that came or went since the last check, when
+    nothing else can have changed the context (``None`` when something else may have)."""
+    if before is None or not ctx.sources or ctx.sources != sources:
+        return None
+    touched: set[str] = set()
+    for sec in now.symmetric_difference(before):
+        facts: DocumentFacts | None = sec.cache.get("facts")
+        if facts is None:
+            return None
+        touched.update(t.id for t in facts.trees)
+        touched.update(m.id for m in facts.models)
+        touched.update(m.id for m in facts.subtree_models)
+    return touched
 
 
 def _run(

@@ -43,7 +43,10 @@ class BtServer(LanguageServer):
         )
         self.docs: dict[str, OpenDocument] = {}
         self.settings = Settings()
+        self.settings_in_use = self.settings  # what diagnostics were last computed with
         self.init_options: object = None  # the client's initializationOptions
+        self._settings_stamps = 0  # counts settings sources, in the order they arrive
+        self._settings_in_force = 0  # the stamp of the settings in force
         self.pull_diagnostics = False
         self.configuration_support = False
         self.refresh_support = False
@@ -75,7 +78,7 @@ class BtServer(LanguageServer):
         if not od.is_bt:
             result: list[Diagnostic] = []
         else:
-            size = len(od.doc.text.encode("utf-8", "surrogatepass"))
+            size = od.doc.utf8_size
             if size > self.settings.max_document_bytes:
                 result = list(od.doc.diagnostics)
                 result.append(
@@ -158,6 +161,9 @@ class BtServer(LanguageServer):
                 self.schedule(uri)
 
     def settings_changed(self) -> None:
+        if self.settings == self.settings_in_use:
+            return  # e.g. a didChangeConfiguration about other extensions' settings
+        self.settings_in_use = self.settings
         self.project.set_settings(self.settings)
         self.generation += 1
         if self.pull_diagnostics:
@@ -185,7 +191,10 @@ class BtServer(LanguageServer):
         are answered with a JSON-RPC error by pygls itself.  Deliberate error answers (a
         refused rename, an unknown method, malformed params) are not internal errors."""
         if isinstance(error, JsonRpcException) and not isinstance(error, JsonRpcInternalError):
-            refusal = isinstance(error, JsonRpcMethodNotFound) or error.code == types.LSPErrorCodes.RequestFailed
+            refusal = (
+                isinstance(error, JsonRpcMethodNotFound)
+                or error.code == types.LSPErrorCodes.RequestFailed
+            )
             self.log_message(
                 f"bt-lsp: {type(error).__name__}: {error}",
                 types.MessageType.Log if refusal else types.MessageType.Warning,
@@ -198,10 +207,17 @@ class BtServer(LanguageServer):
 
     # -- settings ---------------------------------------------------------------------------
 
-    def apply_settings(self, raw: object) -> None:
+    def apply_settings(self, raw: object, issued: int | None = None) -> None:
         """Settings from the client's ``btLsp`` section over its initializationOptions: a
         key the section leaves out keeps its initializationOptions value, and a missing
-        section (``null``) means the initializationOptions alone."""
+        section (``null``) means the initializationOptions alone.
+
+        ``issued`` orders the sources: the answer to a workspace/configuration request is
+        dropped if settings that arrived after the request was sent are already in force."""
+        issued = self._next_settings_stamp() if issued is None else issued
+        if issued < self._settings_in_force:
+            return
+        self._settings_in_force = issued
         problems: list[str] = []
         if raw is not None and not isinstance(raw, Mapping):
             problems.append("btLsp settings must be an object")
@@ -210,9 +226,14 @@ class BtServer(LanguageServer):
         for p in problems:
             self.log_message(f"bt-lsp settings: {p}", types.MessageType.Warning)
 
+    def _next_settings_stamp(self) -> int:
+        self._settings_stamps += 1
+        return self._settings_stamps
+
     async def fetch_settings(self) -> None:
         if not self.configuration_support:
             return
+        issued = self._next_settings_stamp()
         try:
             result = await self.workspace_configuration_async(
                 types.ConfigurationParams(items=[types.ConfigurationItem(section=SECTION)])
@@ -220,7 +241,7 @@ class BtServer(LanguageServer):
         except Exception:
             self.log_error("reading workspace/configuration")
             return
-        self.apply_settings(result[0] if result else None)
+        self.apply_settings(result[0] if result else None, issued)
 
 
 def _section(raw: object) -> Mapping[str, Any]:
@@ -252,6 +273,7 @@ def create_server() -> BtServer:
         if params.initialization_options is not None:
             ls.apply_settings(params.initialization_options)
             ls.init_options = params.initialization_options
+        ls.settings_in_use = ls.settings
         roots = [f.uri for f in params.workspace_folders or []]
         if not roots and params.root_uri:
             roots = [params.root_uri]

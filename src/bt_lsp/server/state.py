@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document, looks_like_bt
+from bt_lsp.document import Document
 
 
 @dataclass(slots=True)
@@ -22,4 +22,4 @@ class OpenDocument:
     cached: list[Diagnostic] = field(default_factory=list)
 
     def refresh_kind(self) -> None:
-        self.is_bt = looks_like_bt(self.doc.text)
+        self.is_bt = self.doc.is_bt

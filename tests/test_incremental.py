@@ -1,0 +1,197 @@
+"""What an edit reuses gives what a fresh analysis gives.
+
+An edit re-scans the tokens around it, rebuilds the model's sections around them, and
+re-checks only the sections whose inputs changed (see ``bt_lsp.model`` and
+``bt_lsp.semantics.sections``).  These tests edit documents at random places, with text
+that changes the structure, names and declarations, and compare every step with a fresh
+document: tokens, the model (elements, name tokens, problems, lookups), the document's own
+diagnostics, the semantic ones alone and in a workspace of two documents that include and
+declare for each other.
+"""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from bt_lsp import scanner
+from bt_lsp.analysis import analyze
+from bt_lsp.document import Document
+from bt_lsp.model import Model
+from bt_lsp.scanner import rescan, scan
+from bt_lsp.semantics.base import edit_distance
+from bt_lsp.text import LineIndex, Offsets
+from bt_lsp.workspace import Workspace
+
+MAIN = """<?xml version="1.0"?>
+<!-- a comment -->
+<root BTCPP_format="4" main_tree_to_execute="Main">
+  <include path="models.xml"/>
+  <BehaviorTree ID="Main">
+    <Sequence name="main sequence">
+      <MoveTo goal="{goal}" speed="1.5"/>
+      <SubTree ID="Helper" target="{goal}" name="helper"/>
+      <Action ID="Grab" object="cup"/>
+      <Check.It/>
+      <RetryUntilSuccessful num_attempts="3"><Fallback><Open door="d"/><Wait/></Fallback>
+      </RetryUntilSuccessful>
+      <Script code="x := 1"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Helper">
+    <ReactiveSequence><MoveTo goal="{target}"/><SubTree ID="Main"/></ReactiveSequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Main Tree"><AlwaysSuccess name="a&#7;b"/></BehaviorTree>
+  <TreeNodesModel>
+    <Action ID="Grab"><input_port name="object" type="std::string"/></Action>
+    <Condition ID="Check.It"/>
+    <SubTree ID="Helper"><input_port name="target"/></SubTree>
+  </TreeNodesModel>
+</root>
+"""
+
+MODELS = """<root BTCPP_format="4">
+  <BehaviorTree ID="Other"><AlwaysSuccess/></BehaviorTree>
+  <TreeNodesModel>
+    <Action ID="MoveTo"><input_port name="goal" type="int"/>
+      <input_port name="speed" type="double"/></Action>
+    <Action ID="Open"><input_port name="door"/></Action>
+  </TreeNodesModel>
+</root>
+"""
+
+PIECES = [
+    "x", "", " ", "\n", "<", ">", '"', "/>", "</", "=", "&amp;", "😋",
+    "<A/>", "<B>", "</B>", "</Sequence>", "</BehaviorTree>", "</root>", "<root>",
+    "<BehaviorTree ID='Q'><Wait/></BehaviorTree>", "<SubTree ID='Q'/>", "<!--", "-->",
+    "Main", "Helper", "MoveTo", "Grab", "ID", "name", "int", "double", "Open",
+    ' BTCPP_format="4"', "<TreeNodesModel><Action ID='Wait'/></TreeNodesModel>",
+]  # fmt: skip
+
+
+def _edit(rng: random.Random, doc: Document) -> None:
+    text = doc.text
+    start = rng.randint(0, len(text))
+    end = min(len(text), start + rng.choice((0, 0, 1, 3, 12)))
+    doc.edit(start, end, rng.choice(PIECES))
+
+
+def _model_view(model: Model) -> Any:
+    elements = [
+        (e.name, e.zone, e.token_start, e.token_index, e.parent, e.depth, e.attrs,
+         e.self_closing, e.closed, e.end, e.end_name_start, e.end_name_end, e.children)
+        for e in model.elements
+    ]  # fmt: skip
+    refs = list(model.refs)
+    problems = sorted(model.problems)
+    return elements, refs, problems, dict(model.by_symbol)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_model_after_edits_equals_a_fresh_one(seed: int) -> None:
+    rng = random.Random(seed)
+    doc = Document(MAIN)
+    for _ in range(25):
+        _ = doc.model
+        for _ in range(rng.randint(1, 3)):  # several edits may come before a model
+            _edit(rng, doc)
+        fresh = Document(doc.text)
+        assert doc.scan.tokens == fresh.scan.tokens
+        assert doc.scan.starts == fresh.scan.starts
+        assert _model_view(doc.model) == _model_view(fresh.model)
+        for offset in range(0, len(doc.text) + 1, 7):
+            assert doc.model.ref_at(offset) == fresh.model.ref_at(offset)
+        assert doc.diagnostics == fresh.diagnostics
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_semantic_diagnostics_after_edits_equal_fresh_ones(seed: int) -> None:
+    rng = random.Random(100 + seed)
+    doc = Document(MAIN)
+    analyze(doc)
+    for _ in range(25):
+        _edit(rng, doc)
+        assert analyze(doc) == analyze(Document(doc.text))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_workspace_diagnostics_after_edits_equal_fresh_ones(seed: int, tmp_path: Path) -> None:
+    rng = random.Random(200 + seed)
+    main, models = tmp_path / "main.xml", tmp_path / "models.xml"
+    main.write_text(MAIN, encoding="utf-8")
+    models.write_text(MODELS, encoding="utf-8")
+    ws = Workspace([tmp_path])
+    docs = {main: Document(MAIN, str(main)), models: Document(MODELS, str(models))}
+    for path, doc in docs.items():
+        ws.open(path, doc)
+        ws.diagnostics(path, doc)
+    for _ in range(15):
+        _edit(rng, docs[rng.choice((main, models))])
+        fresh_ws = Workspace([tmp_path])
+        fresh = {p: Document(d.text, str(p)) for p, d in docs.items()}
+        for p, d in fresh.items():
+            fresh_ws.open(p, d)
+        for path, doc in docs.items():
+            assert ws.diagnostics(path, doc) == fresh_ws.diagnostics(path, fresh[path])
+
+
+@pytest.mark.parametrize("block", [1, 2, 3, 7])
+def test_token_starts_in_small_blocks(block: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(scanner.Starts, "BLOCK", block)
+    rng = random.Random(block)
+    text = MAIN
+    old = scan(text)
+    for _ in range(60):
+        start = rng.randint(0, len(text))
+        end = min(len(text), start + rng.randint(0, 20))
+        insert = rng.choice(PIECES)
+        new_text = text[:start] + insert + text[end:]
+        old, _ = rescan(old, new_text, start, end, len(insert))
+        text = new_text
+        full = scan(text)
+        assert old.tokens == full.tokens
+        assert old.starts.tolist() == full.starts.tolist() == list(old.starts)
+        assert len(old.starts) == len(full.starts)
+        for offset in range(0, len(text) + 1, 5):
+            assert old.index_at(offset) == full.index_at(offset)
+
+
+@pytest.mark.parametrize("block", [1, 2, 5])
+def test_line_starts_in_small_blocks(block: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(Offsets, "BLOCK", block)
+    rng = random.Random(block)
+    text = "a\nb\r\nc\rd\n\n" * 4
+    lines = LineIndex(text)
+    for _ in range(300):
+        start = rng.randint(0, len(text))
+        end = min(len(text), start + rng.randint(0, 6))
+        insert = rng.choice(["", "\n", "\r", "\r\n", "x", "\n\n", "ab\rc"])
+        new_text = text[:start] + insert + text[end:]
+        lines = lines.edited(start, end, insert, new_text)
+        text = new_text
+        fresh = LineIndex(text)
+        assert lines == fresh and lines.line_starts == fresh.line_starts
+        for offset in range(0, len(text) + 1, 3):
+            assert lines.position(offset, "utf-16") == fresh.position(offset, "utf-16")
+
+
+def _levenshtein(a: str, b: str) -> int:
+    prev = list(range(len(b) + 1))
+    for i, ca in enumerate(a, 1):
+        cur = [i]
+        for j, cb in enumerate(b, 1):
+            cur.append(min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (ca != cb)))
+        prev = cur
+    return prev[-1]
+
+
+def test_edit_distance_is_levenshtein_up_to_the_limit() -> None:
+    rng = random.Random(5)
+    for _ in range(3000):
+        a = "".join(rng.choice("abc") for _ in range(rng.randint(0, 8)))
+        b = "".join(rng.choice("abc") for _ in range(rng.randint(0, 8)))
+        limit = rng.randint(0, 3)
+        assert edit_distance(a, b, limit) == min(_levenshtein(a, b), limit + 1)
