@@ -19,7 +19,7 @@ from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic
 from bt_lsp.edits import TextEdit
 from bt_lsp.fixes import Fix, fix_all, fixes_for
-from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit
+from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.workspace import normalize
 
@@ -57,19 +57,7 @@ def _workspace_edit(
         open_doc = ls.get(uri)
         version = open_doc.version if open_doc is not None else None
         per_uri.append((uri, version, [to_text_edit(doc.lines, e, enc) for e in file_edits]))
-    if ls.versioned_edits:
-        return types.WorkspaceEdit(
-            document_changes=[
-                types.TextDocumentEdit(
-                    text_document=types.OptionalVersionedTextDocumentIdentifier(
-                        uri=uri, version=version
-                    ),
-                    edits=list(lsp_edits),
-                )
-                for uri, version, lsp_edits in per_uri
-            ]
-        )
-    return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
+    return workspace_edit(per_uri, ls.versioned_edits)
 
 
 def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:

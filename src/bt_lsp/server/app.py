@@ -165,13 +165,7 @@ class BtServer(LanguageServer):
             return  # e.g. a didChangeConfiguration about other extensions' settings
         self.settings_in_use = self.settings
         self.project.set_settings(self.settings)
-        self.generation += 1
-        if self.pull_diagnostics:
-            if self.refresh_support:
-                self.workspace_diagnostic_refresh(None)
-        else:
-            for uri in list(self.docs):
-                self.publish(uri)
+        self.refresh_all()
 
     # -- logging ----------------------------------------------------------------------------
 

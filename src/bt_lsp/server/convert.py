@@ -37,3 +37,24 @@ def to_diagnostic(lines: LineIndex, d: Diagnostic, enc: Encoding) -> types.Diagn
 
 def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit:
     return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)
+
+
+def workspace_edit(
+    per_uri: list[tuple[str, int | None, list[types.TextEdit]]], versioned: bool
+) -> types.WorkspaceEdit:
+    """Edits to several documents as one WorkspaceEdit: versioned ``documentChanges`` when
+    the client supports them (it then refuses edits to a document that has moved on),
+    else plain ``changes``."""
+    if versioned:
+        return types.WorkspaceEdit(
+            document_changes=[
+                types.TextDocumentEdit(
+                    text_document=types.OptionalVersionedTextDocumentIdentifier(
+                        uri=uri, version=version
+                    ),
+                    edits=list(lsp_edits),
+                )
+                for uri, version, lsp_edits in per_uri
+            ]
+        )
+    return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})

@@ -18,7 +18,7 @@ from pygls.uris import from_fs_path
 from bt_lsp import __version__, navigation
 from bt_lsp.edits import TextEdit
 from bt_lsp.navigation import BUILTIN_CATALOG, DocSymbol, Place, RenameRefused, SymbolKind
-from bt_lsp.server.convert import to_range, to_text_edit
+from bt_lsp.server.convert import to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,
     context_of,
@@ -138,19 +138,7 @@ def rename_edit(
         per_uri.append(
             (src.uri, src.version, [to_text_edit(src.doc.lines, e, enc) for e in file_edits])
         )
-    if ls.versioned_edits:
-        return types.WorkspaceEdit(
-            document_changes=[
-                types.TextDocumentEdit(
-                    text_document=types.OptionalVersionedTextDocumentIdentifier(
-                        uri=uri, version=version
-                    ),
-                    edits=list(lsp_edits),
-                )
-                for uri, version, lsp_edits in per_uri
-            ]
-        )
-    return types.WorkspaceEdit(changes={uri: e for uri, _, e in per_uri})
+    return workspace_edit(per_uri, ls.versioned_edits)
 
 
 def _document_symbol(lines: LineIndex, s: DocSymbol, enc: Encoding) -> types.DocumentSymbol:
