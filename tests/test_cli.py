@@ -296,12 +296,14 @@ def test_directory_named_like_a_file_is_searched(
     assert capsys.readouterr().out.startswith("x.xml/crlf.xml:2:21: ")
 
 
-def test_permission_denied_exits_2(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_permission_denied_exits_2(
+    work: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from tests.test_fileio import deny_access
+
     path = _put(work / "locked.xml", CLEAN)
     path.chmod(0)
-    if os.name != "posix" or os.access(path, os.R_OK):
-        path.chmod(0o644)
-        pytest.skip("file permissions do not apply to this user")
+    deny_access(path.resolve(), monkeypatch)
     try:
         assert main(["check", "locked.xml"]) == 2
     finally:

@@ -7,11 +7,13 @@ import codecs
 import os
 import stat
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from bt_lsp import fileio
 from bt_lsp.fileio import (
     DEFAULT_MAX_BYTES,
     Decoded,
@@ -116,18 +118,37 @@ def test_directory(tmp_path: Path) -> None:
         read_text(str(path))
 
 
-def _skip_unless_permissions_apply(path: Path) -> None:
-    """Skip when file modes do not restrict this process (root, or not POSIX)."""
-    if os.name != "posix" or os.access(path, os.R_OK | os.W_OK):
-        path.chmod(0o755 if path.is_dir() else 0o644)
-        pytest.skip("file permissions do not apply to this user")
+def deny_access(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Make ``path`` (a file, or a folder's entries) refuse access.  File modes do that for
+    ordinary users; root ignores them, so there the operating system's refusal is raised at
+    fileio's own calls instead, the same ``PermissionError`` a denied ``open`` gives."""
+    if os.name == "posix" and not os.access(path, os.R_OK | os.W_OK):
+        return
+    real_open, real_mkstemp = open, fileio.tempfile.mkstemp
+    denied = os.path.abspath(path)
+
+    def refuse(target: Any) -> None:
+        where = os.path.abspath(os.fspath(target))
+        if where == denied or where.startswith(denied + os.sep):
+            raise PermissionError(13, "Permission denied", os.fspath(target))
+
+    def guarded_open(file: Any, *args: Any, **kwargs: Any) -> Any:
+        refuse(file)
+        return real_open(file, *args, **kwargs)
+
+    def guarded_mkstemp(*args: Any, dir: Any = None, **kwargs: Any) -> Any:
+        refuse(os.path.join(dir or os.getcwd(), "x"))
+        return real_mkstemp(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(fileio, "open", guarded_open, raising=False)
+    monkeypatch.setattr(fileio.tempfile, "mkstemp", guarded_mkstemp)
 
 
-def test_permission_denied(tmp_path: Path) -> None:
+def test_permission_denied(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "locked.xml"
     path.write_text("<root/>")
     path.chmod(0)
-    _skip_unless_permissions_apply(path)
+    deny_access(path, monkeypatch)
     try:
         with pytest.raises(FileError, match=r"cannot read .*locked\.xml: Permission denied"):
             read_text(str(path))
@@ -205,11 +226,11 @@ def test_write_to_missing_file(tmp_path: Path) -> None:
         write_text_atomic(str(tmp_path / "gone.xml"), "<a/>", "utf-8", False)
 
 
-def test_write_in_read_only_directory(tmp_path: Path) -> None:
+def test_write_in_read_only_directory(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     path = tmp_path / "a.xml"
     path.write_bytes(b"<a/>")
     tmp_path.chmod(0o555)
-    _skip_unless_permissions_apply(tmp_path)
+    deny_access(tmp_path, monkeypatch)
     try:
         with pytest.raises(FileError, match=r"cannot write .*Permission denied"):
             write_text_atomic(str(path), "<b/>", "utf-8", False)
