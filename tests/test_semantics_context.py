@@ -46,7 +46,7 @@ def test_facts_of_a_document() -> None:
     move = facts.models[0]
     assert move.category == "Action" and MAIN[move.start : move.end] == "MoveBase"
     assert move.ports == (
-        PortModel("goal", "input", "Pose", None, ""),
+        PortModel("goal", "input", "Pose", None, "Where to go"),
         PortModel("result", "output", "", None, ""),
         PortModel("state", "inout", "", "idle", ""),
     )
@@ -127,3 +127,26 @@ def test_combine() -> None:
 def test_tree_decl_defaults() -> None:
     t = TreeDecl("X", None, 0, 1)
     assert t.calls == () and t.call_spans == ()
+
+
+def test_port_description_written_as_text() -> None:
+    """BehaviorTree.CPP and Groot2 write a port's description as the element's text."""
+    doc = Document(
+        '<root BTCPP_format="4"><TreeNodesModel><Action ID="Move">\n'
+        '<input_port name="goal" type="Pose">Where &amp; how\n   far <![CDATA[<x>]]>'
+        "<!-- not this --></input_port>\n"
+        '<input_port name="speed" description="attr wins">text</input_port>\n'
+        '<output_port name="done"/><inout_port name="empty">  </inout_port>\n'
+        "</Action></TreeNodesModel></root>"
+    )
+    ports = {p.name: p.description for p in facts_of(doc).models[0].ports}
+    assert ports == {
+        "goal": "Where & how far <x>",
+        "speed": "attr wins",
+        "done": "",
+        "empty": "",
+    }
+    # The description follows edits of the text (the section is rebuilt).
+    at = doc.text.index("Where")
+    doc.edit(at, at + 5, "When")
+    assert facts_of(doc).models[0].ports[0].description == "When & how far <x>"

@@ -384,7 +384,7 @@ def extract(model: Model, path: str | None) -> DocumentFacts:
                         _DIRECTIONS[el.name],
                         el.value("type") or "",
                         el.value("default"),
-                        el.value("description") or "",
+                        el.value("description") or el.content or "",
                     )
                 )
     if tree is not None:

@@ -36,7 +36,7 @@ from typing import Any, NamedTuple, overload
 from bt_lsp.bulk import bulk
 from bt_lsp.lazyre import LazyPattern
 from bt_lsp.names import RESERVED_PORT_NAMES, NameKind
-from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Rescan, Scan, Token
+from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Rescan, Scan, Token, decode_value
 
 Symbol = tuple[str, ...]
 
@@ -110,6 +110,9 @@ class Element:
     end_name_start: int = -1  # absolute span of the end tag's name, if any
     end_name_end: int = -1
     children: list[int] = field(default_factory=list)
+    # The text inside a port declaration (BehaviorTree.CPP writes a port's description
+    # there); ``None`` for every other element.
+    content: str | None = None
 
     @property
     def name_start(self) -> int:
@@ -325,6 +328,7 @@ class Part:
             el.end_name_start + o if el.end_name_start >= 0 else -1,
             el.end_name_end + o if el.end_name_end >= 0 else -1,
             [g(c) for c in el.children],
+            el.content,
         )
 
     def top(self) -> Element:
@@ -1030,7 +1034,10 @@ class _Builder:
                 else:
                     stack.append(idx)
             elif kind == end_kind:
-                _close(tstart, tok, els, stack, problems)
+                closed = _close(tstart, tok, els, stack, problems)
+                if closed >= 0 and els[closed].zone == Zone.PORT_DECL:
+                    el = els[closed]
+                    el.content = _content(tokens, starts, text, el.token_index + self.tok_origin, i)
                 if mode == _SECTION and not stack:
                     return i + 1, CLOSED
             i += 1
@@ -1180,8 +1187,9 @@ def _close(
     elements: list[Element],
     stack: list[int],
     problems: list[StructureProblem],
-) -> None:
-    """Match an end tag to an open element, tolerating a few missing end tags."""
+) -> int:
+    """Match an end tag to an open element, tolerating a few missing end tags; the index
+    of the element it closed, -1 if none."""
     name_s, name_e = tstart + tok.name_start, tstart + tok.name_end
     match = -1
     for depth in range(len(stack) - 1, max(-1, len(stack) - 65), -1):
@@ -1198,13 +1206,28 @@ def _close(
                 f"Unexpected end tag '</{tok.name}>'{expected}",
             )
         )
-        return
+        return -1
     while len(stack) > match + 1:
         _report_unclosed(elements[stack.pop()], problems, closed_by=tok.name)
     idx = stack.pop()
     el = elements[idx]
     el.end = tstart + tok.length
     el.end_name_start, el.end_name_end = name_s, name_e  # its ref: see Section.refs
+    return idx
+
+
+def _content(tokens: list[Token], starts: Sequence[int], text: str, first: int, stop: int) -> str:
+    """The text of tokens ``first + 1 .. stop - 1`` (an element's content): its text runs
+    with references decoded and its CDATA sections, whitespace runs made single spaces."""
+    parts: list[str] = []
+    for k in range(first + 1, stop):
+        tok = tokens[k]
+        s = starts[k]
+        if tok.kind == Kind.TEXT:
+            parts.append(decode_value(text[s : s + tok.length], 0, None))
+        elif tok.kind == Kind.CDATA and tok.closed:
+            parts.append(text[s + 9 : s + tok.length - 3])
+    return " ".join("".join(parts).split())
 
 
 def _report_unclosed(el: Element, problems: list[StructureProblem], closed_by: str | None) -> None:

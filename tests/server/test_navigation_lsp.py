@@ -42,7 +42,8 @@ B_XML = """\
   <TreeNodesModel>
     <Action ID="MoveBase">
       <input_port name="goal" type="Pose" description="Where to go"/>
-      <input_port name="speed" type="double" default="0.5" description="How fast"/>
+      <input_port name="speed" type="double" default="0.5">How
+        &amp; fast</input_port>
     </Action>
     <SubTree ID="Dock"><input_port name="pose"/></SubTree>
   </TreeNodesModel>
@@ -668,5 +669,5 @@ async def test_hover_shows_the_ports_of_a_model_declared_in_another_file(lsp: Na
     md = got.contents.value
     assert "Action declared in the TreeNodesModel of" in md and "b.xml" in md
     assert "| `goal` | input | `Pose` | required | Where to go |" in md
-    assert "| `speed` | input | `double` | `0.5` | How fast |" in md
+    assert "| `speed` | input | `double` | `0.5` | How & fast |" in md
     assert got.range == rng(lsp, A_XML, span(A_XML, "MoveBase"))
