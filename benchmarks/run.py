@@ -321,6 +321,53 @@ def lxml_parse_seconds(data: bytes) -> float:
     return t1 - t0
 
 
+# The least any Python analysis must do: visit every tag and read every attribute's name,
+# value and offset once (C regular expressions, one tuple per attribute, an element stack),
+# with no name rule, model or semantic check.  It bounds what a pure-Python first analysis
+# can reach against lxml's C parser.
+_FLOOR_TOKEN = re.compile(
+    r"<([^ \t\r\n/>=<\"']+)((?:[ \t\r\n]+[^ \t\r\n/>=<\"']+[ \t\r\n]*=[ \t\r\n]*"
+    r"(?:\"[^\"<]*\"|'[^'<]*'))*)[ \t\r\n]*(/?)>|</([^ \t\r\n/>=<\"']+)[ \t\r\n]*>|[^<]+"
+    r"|<!--.*?-->|<[?!][^>]*>",
+    re.S,
+)
+_FLOOR_ATTR = re.compile(
+    r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
+)
+
+
+def floor_pass(text: str) -> tuple[int, int]:
+    """The minimal pass over ``text`` (see above); returns the elements and attributes
+    it read."""
+    stack: list[tuple[str, int, list[tuple[str, str, int]]]] = []
+    elements = attributes = 0
+    for m in _FLOOR_TOKEN.finditer(text):
+        name, attrs, empty, end = m.group(1, 2, 3, 4)
+        if name:
+            found = [
+                (a.group(1), a.group(2) or a.group(3) or "", a.start(1))
+                for a in _FLOOR_ATTR.finditer(attrs)
+            ]
+            elements += 1
+            attributes += len(found)
+            if not empty:
+                stack.append((name, m.start(), found))
+        elif end and stack:
+            stack.pop()
+    return elements, attributes
+
+
+def python_floor_seconds(text: str) -> float:
+    """The time of :func:`floor_pass` over ``text``."""
+    gc.collect()
+    gc.disable()
+    t0 = time.perf_counter()
+    floor_pass(text)
+    t1 = time.perf_counter()
+    gc.enable()
+    return t1 - t0
+
+
 def corpus_files(corpus: Path) -> list[Path]:
     return sorted(p for p in corpus.rglob("*.xml") if p.is_file())
 
@@ -383,6 +430,7 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
         for size in args.sizes:
             doc = make_doc(size, folder, args.edits, args.seed)
             lx: list[float] = []
+            floor: list[float] = []
             sessions: list[Session] = []
             for r in range(args.repeat):
                 # Interleave everything, so that a busy moment of the machine hits all.
@@ -392,13 +440,14 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
                 sessions.append(s)
                 startups.append(s.startup)
                 lx.append(lxml_parse_seconds(doc.text.encode()))
+                floor.append(python_floor_seconds(doc.text))
                 print(
                     f"  {doc.size} bytes, run {r + 1}/{args.repeat}: open {ms(s.open)} ms, "
                     f"edit {ms(statistics.median(s.edits))} ms, lxml "
                     f"{ms(statistics.median(lx))} ms",
                     file=sys.stderr,
                 )
-            results["sizes"][str(size)] = _size_result(doc, lx, sessions)
+            results["sizes"][str(size)] = _size_result(doc, lx, floor, sessions)
         results["startup"] = {"bt-lsp": summary(startups), "bare pygls": summary(bare)}
         results["startup"]["samples"] = {"bt-lsp": startups, "bare pygls": bare}
         if args.corpus and not args.no_check:
@@ -419,12 +468,15 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
     return results
 
 
-def _size_result(doc: Doc, lx: list[float], sessions: list[Session]) -> dict[str, Any]:
+def _size_result(
+    doc: Doc, lx: list[float], floor: list[float], sessions: list[Session]
+) -> dict[str, Any]:
     def cat(get: Callable[[Session], list[float]]) -> list[float]:
         return [x for s in sessions for x in get(s)]
 
     samples = {
         "lxml": lx,
+        "python floor": floor,
         "open": [s.open for s in sessions],
         "edit": cat(lambda s: s.edits),
         "quick fix": cat(lambda s: s.quick_fix),
@@ -474,6 +526,7 @@ def table(results: dict[str, Any]) -> str:
         + " |"
     )
     for key, label, ratio in (
+        ("python floor", "Python reads every tag and attribute once, no rules (ms, × lxml)", True),
         ("open", "open → first diagnostics (ms, × lxml)", True),
         ("edit", "1-character edit → its diagnostics (ms, × lxml)", True),
         ("quick fix", "quick fix: codeAction + resolve (ms)", False),

@@ -44,6 +44,14 @@ def test_generated_xml_parses_and_has_exactly_the_planted_bad_names(size: int) -
     assert [d for d in diags if not d.is_name_rule] == []
 
 
+def test_python_floor_reads_every_element_and_attribute() -> None:
+    g = bench_generate.generate(40_000, seed=3)
+    root = etree.fromstring(g.text.encode())
+    elements = [e for e in root.iter() if isinstance(e.tag, str)]
+    assert bench_run.floor_pass(g.text) == (len(elements), sum(len(e.attrib) for e in elements))
+    assert bench_run.python_floor_seconds(g.text) > 0
+
+
 def test_generator_command_line(tmp_path: Path) -> None:
     out = tmp_path / "g.xml"
     assert bench_generate.main(["12K", str(out), "--seed", "2"]) == 0
@@ -99,6 +107,7 @@ def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert bench_run.main([*args, "--no-check", "--json", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "| open → first diagnostics" in printed and "Start to `initialize`" in printed
+    assert "| Python reads every tag" in printed
     results = json.loads(out.read_text(encoding="utf-8"))
     (size,) = results["sizes"].values()
     samples = size["samples"]
