@@ -345,16 +345,18 @@ def extract(model: Model, path: str | None) -> DocumentFacts:
     subtree_models: list[ModelDecl] = []
     tree: _OpenTree | None = None
     entry: _OpenEntry | None = None
+    # Members bound once: reading one from its enum class is slow in Python 3.11.
+    node, tree_zone, entry_zone, port_zone = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
     for el in model.elements:
         zone = el.zone
-        if zone == Zone.NODE:
+        if zone == node:
             if tree is not None and el.name == "SubTree":
                 a = el.attr("ID")
                 if a is not None and a.value:
                     tree.calls.append(a.value)
                     tree.spans.append(el.span_of_value(a))
             continue
-        if el.depth <= 1 or zone == Zone.MODEL_ENTRY:
+        if el.depth <= 1 or zone == entry_zone:
             if tree is not None:
                 trees.append(tree.close(path))
                 tree = None
@@ -362,11 +364,11 @@ def extract(model: Model, path: str | None) -> DocumentFacts:
                 decl = entry.close(path)
                 (subtree_models if decl.category == "SubTree" else models).append(decl)
                 entry = None
-        if zone == Zone.TREE:
+        if zone == tree_zone:
             tid, s, e = _id_span(el)
             if tid:
                 tree = _OpenTree(tid, s, e)
-        elif zone == Zone.MODEL_ENTRY:
+        elif zone == entry_zone:
             if el.name in _ENTRY_CATEGORIES:
                 mid, s, e = _id_span(el)
                 if mid is not None:
@@ -375,7 +377,7 @@ def extract(model: Model, path: str | None) -> DocumentFacts:
                     for a in el.attrs:
                         if a.name not in _ENTRY_NON_PORT_ATTRS and a.value is not None:
                             entry.ports.append(PortModel(a.name, "input", "", a.value, ""))
-        elif zone == Zone.PORT_DECL and entry is not None:
+        elif zone == port_zone and entry is not None:
             pname = el.value("name")
             if pname is not None:
                 entry.ports.append(

@@ -65,17 +65,24 @@ def name_diagnostics(model: Model) -> list[Diagnostic]:
 
 def _ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
     out: list[Diagnostic] = []
-    for ref in refs:
-        if ref.kind is None:
+    port_decl, instance = Role.PORT_DECL, NameKind.INSTANCE
+    # Unpacked rather than read by field: this runs for every name of a document.
+    for start, end, text, kind, role, _symbol, _element, _quote in refs:
+        if kind is None:
             continue
-        for v in _violations(ref.text, ref.kind, ref.role == Role.PORT_DECL):
+        found = (
+            check_name(text, kind, declaration=False)
+            if kind is instance
+            else _cached_violations(text, kind, role is port_decl)
+        )
+        for v in found:
             out.append(
                 make(
-                    ref.start,
-                    ref.end,
+                    start,
+                    end,
                     v.code,
                     v.message,
-                    {"name": ref.text, "kind": str(ref.kind), "role": str(ref.role)},
+                    {"name": text, "kind": str(kind), "role": str(role)},
                 )
             )
     return out
