@@ -55,19 +55,21 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
     the scope of the nodes that follow).  They run section by section: see
     :mod:`bt_lsp.semantics.sections` for what they may read."""
     scope = TreeScope(None)
+    # Members bound once: reading one from its enum class is slow in Python 3.11.
+    node, tree, entry, port_decl = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
     for el in elements:
         zone = el.zone
-        if zone == Zone.NODE:
+        if zone == node:
             document.check_depth(st, el, scope.depth_flagged)
             res = nodes.check_node(st, el)
             is_subtree = el.name == "SubTree"
             if is_subtree:
                 trees.check_call(st, el, scope)
             ports.check_attributes(st, el, res, scope, is_subtree)
-        elif zone == Zone.TREE:
+        elif zone == tree:
             scope = TreeScope(el)
             trees.begin_tree(st, el)
-        elif zone == Zone.MODEL_ENTRY:
+        elif zone == entry:
             models.check_entry(st, el)
-        elif zone == Zone.PORT_DECL:
+        elif zone == port_decl:
             models.check_port_decl(st, el)
