@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.script import ScriptError, _Checker, check_script
+from bt_lsp.script import ScriptError, _Checker, check_script, identifiers
 
 # Every distinct script found in the real corpus (shared/corpus/real): Script/ScriptCondition
 # `code`, Precondition `if` and the eight pre/post-condition attributes, XML-decoded.
@@ -672,3 +672,21 @@ def test_every_corpus_script_is_listed_and_parses() -> None:
     assert set(found) == set(REAL_SCRIPTS) | set(REAL_LEGACY_SCRIPTS)
     for code in found:
         assert check_script(code, legacy=True) is None, code
+
+
+@pytest.mark.parametrize(
+    ("code", "names", "stop"),
+    [
+        ("a := b + 1; c = true || false", ["a", "b", "c"], None),
+        ("x := 'key' .. key", ["x", "key"], None),
+        ('"key" == k', ["k"], None),  # a double-quoted string (4.0-4.9) stays a string
+        ("clé = 1", ["clé"], None),  # a non-ASCII letter does not split an identifier
+        ("@root_key > 3 ? e1 : 0x1F", ["@root_key", "e1"], None),
+        ("a + %b", ["a"], 4),  # the tokens after a lexical error are unknown
+        ("x := 'open", ["x"], 5),
+    ],
+)
+def test_identifiers(code: str, names: list[str], stop: int | None) -> None:
+    spans, end = identifiers(code)
+    assert [code[s:e] for s, e in spans] == names
+    assert end == (len(code) if stop is None else stop)

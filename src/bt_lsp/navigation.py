@@ -14,12 +14,26 @@ A :class:`Place` names a span in some document: ``path=None`` is the document as
 
 from __future__ import annotations
 
+import os
 import re
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from functools import cache
 
+from bt_lsp.blackboard import (
+    KeyForm,
+    KeyRef,
+    TreeKeys,
+    blackboard_keys,
+    enclosing_tree,
+    key_at,
+    mentions,
+    port_value_key,
+    subtree_range,
+    tree_keys,
+    unread_mentions,
+)
 from bt_lsp.builtins import BUILTINS, PortModel
 from bt_lsp.context import Context
 from bt_lsp.document import Document
@@ -35,7 +49,7 @@ from bt_lsp.model import (
     Symbol,
     Zone,
 )
-from bt_lsp.names import RESERVED_PORT_NAMES, NameKind, check_name, is_allowed_port_name
+from bt_lsp.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.scanner import Kind
 from bt_lsp.workspace import Include
 
@@ -45,6 +59,7 @@ __all__ = [
     "DocSymbol",
     "Fold",
     "Highlight",
+    "KeyForm",
     "KeyRef",
     "Place",
     "RenamePlan",
@@ -102,81 +117,6 @@ def _element_at_tag(model: Model, offset: int) -> tuple[int, bool] | None:
             return i, False
         if el.end_name_start >= 0 and el.end_name_start <= offset <= el.end_name_end:
             return i, True
-    return None
-
-
-def enclosing_tree(model: Model, index: int) -> int:
-    """Index of the ``<BehaviorTree>`` holding element ``index`` (itself included), or -1."""
-    els = model.elements
-    while index >= 0:
-        if els[index].zone == Zone.TREE:
-            return index
-        index = els[index].parent
-    return -1
-
-
-def _subtree(model: Model, index: int) -> range:
-    """Indexes of element ``index`` and its descendants (elements are in document order)."""
-    els = model.elements
-    depth = els[index].depth
-    stop = index + 1
-    while stop < len(els) and els[stop].depth > depth:
-        stop += 1
-    return range(index, stop)
-
-
-@dataclass(frozen=True, slots=True)
-class KeyRef:
-    """A blackboard key written ``{key}`` in a port value; ``start``/``end`` span the key
-    (without braces and surrounding spaces).  ``tree`` is the element index of its tree."""
-
-    key: str
-    start: int
-    end: int
-    element: int
-    tree: int
-
-
-_KEY_RE = re.compile(r"\{([^{}]*)\}")
-
-
-def _keys_of(doc: Document, idx: int, tree: int) -> Iterator[KeyRef]:
-    el = doc.model.elements[idx]
-    if el.zone != Zone.NODE:
-        return
-    text = doc.text
-    for a in el.attrs:
-        if a.value is None or a.name in RESERVED_PORT_NAMES or "{" not in a.value:
-            continue
-        vs, ve = el.span_of_value(a)
-        for m in _KEY_RE.finditer(text, vs, ve):
-            raw = m.group(1)
-            key = raw.strip()
-            if not key or key == "=":
-                continue
-            s = m.start(1) + (len(raw) - len(raw.lstrip()))
-            yield KeyRef(key, s, s + len(key), idx, tree)
-
-
-def blackboard_keys(doc: Document, tree: int) -> list[KeyRef]:
-    """Every ``{key}`` written in the ports of the nodes of one tree (by element index)."""
-    model = doc.model
-    if not 0 <= tree < len(model.elements):
-        return []
-    return [k for i in _subtree(model, tree) for k in _keys_of(doc, i, tree)]
-
-
-def key_at(doc: Document, offset: int) -> KeyRef | None:
-    """The blackboard key under ``offset`` (its end counts)."""
-    model = doc.model
-    for i, el in enumerate(model.elements):
-        if el.token_start > offset:
-            break
-        if el.zone != Zone.NODE:
-            continue
-        for k in _keys_of(doc, i, enclosing_tree(model, i)):
-            if k.start <= offset <= k.end:
-                return k
     return None
 
 
@@ -344,6 +284,198 @@ def definition(
     return []
 
 
+# --- blackboard keys across trees ---------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Tree:
+    """A ``<BehaviorTree>``, by element index, of the document asked about (``path=None``)
+    or of another workspace document."""
+
+    path: str | None
+    doc: Document
+    index: int
+
+    @property
+    def id(self) -> str | None:
+        return self.doc.model.elements[self.index].value("ID")
+
+    def shown(self) -> str:
+        tid = self.id
+        name = f"tree '{shown(tid)}'" if tid is not None else "a tree without ID"
+        return name if self.path is None else f"{name} (in {os.path.basename(self.path)})"
+
+
+@dataclass(frozen=True, slots=True)
+class _Call:
+    """A ``<SubTree ID>`` call: the tree it is in, the tree it calls, whether it sets
+    ``_autoremap``, and the ports it remaps explicitly."""
+
+    caller: _Tree
+    callee: str
+    autoremap: bool
+    remapped: frozenset[str]
+
+
+_TRUE_WORDS = frozenset({"1", "true", "True", "TRUE"})
+
+
+def _call_at(path: str | None, doc: Document, idx: int) -> _Call | None:
+    model = doc.model
+    el = model.elements[idx]
+    callee = el.value("ID")
+    if el.zone != Zone.NODE or el.name != "SubTree" or callee is None:
+        return None
+    tree = enclosing_tree(model, idx)
+    if tree < 0:
+        return None
+    remapped = frozenset(a.name for a in el.attrs if is_allowed_port_name(a.name))
+    return _Call(_Tree(path, doc, tree), callee, el.value("_autoremap") in _TRUE_WORDS, remapped)
+
+
+class _Workspace:
+    """The document and the other workspace documents, as seen by the features on keys."""
+
+    def __init__(self, doc: Document, others: Mapping[str, Document]) -> None:
+        self.doc = doc
+        self.others = others
+        self.docs: list[tuple[str | None, Document]] = [(None, doc), *others.items()]
+        self._keys: dict[_Tree, TreeKeys] = {}
+
+    def keys(self, t: _Tree) -> TreeKeys:
+        found = self._keys.get(t)
+        if found is None:
+            found = self._keys[t] = tree_keys(t.doc, t.index)
+        return found
+
+    def refs(self, sym: Symbol) -> list[tuple[str | None, Document, NameRef]]:
+        return [(path, d, r) for path, d in self.docs for r in d.model.refs_to(sym)]
+
+    def trees(self, tid: str) -> list[_Tree]:
+        """The trees with ID ``tid``."""
+        return [
+            _Tree(path, d, r.element)
+            for path, d, r in self.refs(("tree", tid))
+            if r.role == Role.TREE_DEF
+        ]
+
+    def calls_to(self, tid: str) -> list[_Call]:
+        out: list[_Call] = []
+        for path, d, r in self.refs(("tree", tid)):
+            if r.role == Role.SUBTREE_CALL:
+                c = _call_at(path, d, r.element)
+                if c is not None:
+                    out.append(c)
+        return out
+
+    def calls_from(self, t: _Tree) -> list[_Call]:
+        els = t.doc.model.elements
+        out: list[_Call] = []
+        for i in subtree_range(t.doc.model, t.index):
+            if els[i].name == "SubTree":
+                c = _call_at(t.path, t.doc, i)
+                if c is not None:
+                    out.append(c)
+        return out
+
+    def shared(self, start: _Tree, key: str) -> list[_Tree]:
+        """``start`` and the trees whose blackboards reach its ``key`` by name through
+        ``<SubTree _autoremap="true">`` calls, either way and transitively.  A call that
+        remaps the port of that name explicitly does not share it; private keys
+        (``_key``) and root keys (``@key``) are never autoremapped."""
+        found = [start]
+        if key.startswith(("_", "@")):
+            return found
+        seen = {start}
+        i = 0
+        while i < len(found):
+            t = found[i]
+            i += 1
+            linked: list[_Tree] = []
+            for c in self.calls_from(t):
+                if c.autoremap and key not in c.remapped:
+                    linked.extend(self.trees(c.callee))
+            tid = t.id
+            if tid is not None:
+                linked.extend(
+                    c.caller for c in self.calls_to(tid) if c.autoremap and key not in c.remapped
+                )
+            for o in linked:
+                if o not in seen:
+                    seen.add(o)
+                    found.append(o)
+        return found
+
+    def may_be_root(self, t: _Tree) -> bool:
+        """Whether ``t`` may run as the main tree, whose blackboard is the root one: it is a
+        ``main_tree_to_execute``, or no ``<SubTree>`` calls it."""
+        tid = t.id
+        if tid is None:
+            return True
+        roles = {r.role for _, _, r in self.refs(("tree", tid))}
+        return Role.MAIN_TREE in roles or Role.SUBTREE_CALL not in roles
+
+    def root_users(self, key: str) -> list[_Tree]:
+        """The trees that use ``@key``, the key ``key`` of the root blackboard."""
+        name = "@" + key
+        out: list[_Tree] = []
+        for path, d in self.docs:
+            if name not in d.text:
+                continue
+            for i, el in enumerate(d.model.elements):
+                if el.zone == Zone.TREE:
+                    t = _Tree(path, d, i)
+                    if mentions(self.keys(t), name):
+                        out.append(t)
+        return out
+
+    def has_port(self, t: _Tree, name: str) -> bool:
+        tid = t.id
+        return tid is not None and bool(self.refs(("port", "tree", tid, name)))
+
+
+@dataclass(slots=True)
+class _KeyTargets:
+    """What renaming a key changes: its uses in the trees that own it and, when the key is
+    a port of its tree (declared in a ``<SubTree>`` model or remapped by a ``<SubTree>``
+    call), that port's names."""
+
+    key: str
+    homes: list[_Tree]
+    uses: list[tuple[_Tree, KeyRef]]
+    port: Symbol | None = None
+    port_refs: list[tuple[str | None, Document, NameRef]] = field(default_factory=list)
+
+    def places(self) -> list[tuple[str | None, int, int, bool]]:
+        """``(path, start, end, declaration)`` of every occurrence."""
+        out = [(t.path, u.start, u.end, False) for t, u in self.uses]
+        out.extend((path, r.start, r.end, r.declaration) for path, _, r in self.port_refs)
+        return out
+
+
+def _port_targets(ws: _Workspace, sym: Symbol, home: _Tree | None = None) -> _KeyTargets:
+    """A port of a tree (``("port", "tree", id, name)``): in the tree, the key ``name``."""
+    key = sym[3]
+    homes = ws.trees(sym[2])
+    if home is not None and home not in homes:
+        homes.insert(0, home)
+    uses = [(t, u) for t in homes for u in ws.keys(t).of(key)]
+    return _KeyTargets(key, homes, uses, sym, ws.refs(sym))
+
+
+def _key_targets(ws: _Workspace, home: _Tree, key: str) -> _KeyTargets:
+    tid = home.id
+    if tid is not None and not key.startswith("@"):
+        sym: Symbol = ("port", "tree", tid, key)
+        if ws.refs(sym):
+            return _port_targets(ws, sym, home)
+    return _KeyTargets(key, [home], [(home, u) for u in ws.keys(home).of(key)])
+
+
+def _is_tree_port(sym: Symbol | None) -> bool:
+    return sym is not None and len(sym) == 4 and sym[:2] == ("port", "tree")
+
+
 # --- references and highlights ------------------------------------------------------------
 
 
@@ -355,15 +487,23 @@ def references(
     include_declaration: bool = True,
 ) -> list[Place]:
     """Every occurrence of the name under ``offset`` in this document and the others (end
-    tags left out: they repeat their start tag).  A blackboard key's references are the
-    uses of that key in its tree."""
+    tags left out: they repeat their start tag).
+
+    A blackboard key's references are its uses in its tree (port values and script
+    identifiers) and, when the key is a port of its tree, that port's declarations and the
+    ``<SubTree>`` attributes that remap it: the places a rename of the key changes.  A
+    tree's port likewise includes its uses as a key inside the tree."""
+    ws = _Workspace(doc, others or {})
     ref = doc.model.ref_at(offset)
     if ref is None:
         key = key_at(doc, offset)
-        if key is None:
+        if key is None or key.tree < 0:
             return []
+        targets = _key_targets(ws, _Tree(None, doc, key.tree), key.key)
         return [
-            Place(None, k.start, k.end) for k in blackboard_keys(doc, key.tree) if k.key == key.key
+            Place(path, s, e)
+            for path, s, e, decl in targets.places()
+            if include_declaration or not decl
         ]
     if ref.symbol is None:
         return [Place(None, ref.start, ref.end)]
@@ -371,9 +511,9 @@ def references(
     def keep(r: NameRef) -> bool:
         return r.role != Role.NODE_TYPE_END and (include_declaration or not r.declaration)
 
-    out = [Place(None, r.start, r.end) for r in doc.model.refs_to(ref.symbol) if keep(r)]
-    for path, other in (others or {}).items():
-        out.extend(Place(path, r.start, r.end) for r in other.model.refs_to(ref.symbol) if keep(r))
+    out = [Place(path, r.start, r.end) for path, _, r in ws.refs(ref.symbol) if keep(r)]
+    if _is_tree_port(ref.symbol):
+        out.extend(Place(t.path, u.start, u.end) for t, u in _port_targets(ws, ref.symbol).uses)
     return out
 
 
@@ -390,19 +530,24 @@ class Highlight:
 
 def highlights(doc: Document, offset: int) -> list[Highlight]:
     """The occurrences, in this document, of the name under ``offset``: a tree, node type,
-    port or instance name, a blackboard key in its tree, or an element's start and end
-    tag names."""
+    port or instance name, a blackboard key (as :func:`references` finds it), or an
+    element's start and end tag names."""
     model = doc.model
+    ws = _Workspace(doc, {})
     ref = model.ref_at(offset)
     if ref is not None:
         if ref.symbol is None:
             return [Highlight(ref.start, ref.end)]
-        return sorted(Highlight(r.start, r.end, r.declaration) for r in model.refs_to(ref.symbol))
+        found = {Highlight(r.start, r.end, r.declaration) for r in model.refs_to(ref.symbol)}
+        if _is_tree_port(ref.symbol):
+            found.update(Highlight(u.start, u.end) for _, u in _port_targets(ws, ref.symbol).uses)
+        return sorted(found)
     key = key_at(doc, offset)
     if key is not None:
-        return [
-            Highlight(k.start, k.end) for k in blackboard_keys(doc, key.tree) if k.key == key.key
-        ]
+        if key.tree < 0:
+            return [Highlight(key.start, key.end)]
+        targets = _key_targets(ws, _Tree(None, doc, key.tree), key.key)
+        return sorted({Highlight(s, e, decl) for _, s, e, decl in targets.places()})
     hit = _element_at_tag(model, offset)
     if hit is None:
         return []
@@ -426,12 +571,14 @@ class RenameRefused(Exception):
 
 @dataclass(frozen=True, slots=True)
 class RenameTarget:
-    """What a rename at a position changes: the span of the name and its current text."""
+    """What a rename at a position changes: the span of the name and its current text;
+    ``ref`` is the name token, or ``key`` the blackboard key use."""
 
     start: int
     end: int
     placeholder: str
-    ref: NameRef
+    ref: NameRef | None = None
+    key: KeyRef | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -446,14 +593,32 @@ class RenamePlan:
         return len(self.edits) + sum(len(e) for e in self.other_edits.values())
 
 
+def _refuse_key_use(k: KeyRef) -> None:
+    if k.key.startswith("@"):
+        raise RenameRefused(
+            f"'{shown(k.key)}' is a key of the root blackboard (the '@' prefix), which every "
+            "tree of the running program shares; it cannot be renamed from one tree"
+        )
+    if k.entities:
+        raise RenameRefused(
+            f"The key '{shown(k.key)}' is written with character or entity references in "
+            f"'{k.attr}'; write it out plainly to rename it"
+        )
+
+
 def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
     """The name a rename at ``offset`` would change, ``None`` when there is none there.
 
     Raises :class:`RenameRefused` for names that cannot be renamed from XML (the built-in
-    nodes of BehaviorTree.CPP and their ports)."""
+    nodes of BehaviorTree.CPP and their ports) and for blackboard keys that cannot be
+    renamed (see :func:`rename`)."""
     ref = doc.model.ref_at(offset)
     if ref is None:
-        return None
+        key = key_at(doc, offset)
+        if key is None or key.tree < 0:
+            return None
+        _refuse_key_use(key)
+        return RenameTarget(key.start, key.end, key.key, key=key)
     sym = ref.symbol
     if sym is not None and sym[0] == "model" and sym[1] in BUILTINS:
         raise RenameRefused(
@@ -527,25 +692,215 @@ def _check_new_name(
         )
 
 
+_SCRIPT_IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _check_key_name(new_name: str, in_script: bool) -> None:
+    """Refuse a new name that cannot be a blackboard key where the key is written."""
+
+    def refuse(why: str) -> None:
+        raise RenameRefused(f"Cannot rename to '{shown(new_name)}': {why}")
+
+    if not new_name:
+        refuse("a blackboard key cannot be empty")
+    if "{" in new_name or "}" in new_name:
+        refuse("a blackboard key cannot contain '{' or '}', which delimit it in a port value")
+    if new_name != new_name.strip(" \t\r\n"):
+        refuse("BehaviorTree.CPP trims the white space around a key")
+    if new_name == "=":
+        refuse("'{=}' stands for the key named like its port")
+    if new_name.startswith("@"):
+        refuse(
+            "a key starting with '@' is a key of the root blackboard; a rename cannot move "
+            "a key there"
+        )
+    if any(c < " " or c == "\x7f" for c in new_name):
+        refuse("a blackboard key cannot contain control characters")
+    if in_script and (
+        _SCRIPT_IDENTIFIER_RE.fullmatch(new_name) is None or new_name in ("true", "false")
+    ):
+        refuse(
+            "the key is used in a script, where it must be an identifier: an ASCII letter or "
+            "'_', then ASCII letters, digits or '_' (and not 'true' or 'false')"
+        )
+
+
+def _check_key_safety(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
+    """Refuse a key rename that would not change every use of the key, or that would make
+    it another key, in the blackboards of the running program."""
+    key = targets.key
+    homes = targets.homes
+    for t, u in targets.uses:
+        if u.entities:
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': it is written with character or entity "
+                f"references in '{u.attr}' in {t.shown()}; write it out plainly first"
+            )
+    for t in homes:
+        if unread_mentions(ws.keys(t), key):
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': a script in {t.shown()} has a syntax error "
+                f"before a '{shown(key)}' that may be this key; fix the script first"
+            )
+    if new_name == key:
+        return
+    for t in homes:
+        group = ws.shared(t, key)
+        for o in group:
+            if o not in homes and mentions(ws.keys(o), key):
+                raise RenameRefused(
+                    f"Cannot rename '{shown(key)}': {o.shown()} shares it with {t.shown()} "
+                    'through <SubTree _autoremap="true">, and renaming it in one tree '
+                    "would disconnect them"
+                )
+        root = next((o for o in group if ws.may_be_root(o)), None)
+        users = ws.root_users(key) if root is not None else []
+        if root is not None and users:
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': '@{shown(key)}' in {users[0].shown()} is this "
+                f"key (of the root blackboard) when {root.shown()} runs as the main tree"
+            )
+        group = ws.shared(t, new_name)
+        for o in group:
+            if mentions(ws.keys(o), new_name) or ws.has_port(o, new_name):
+                how = "" if o == t else f", shared with {t.shown()} through _autoremap"
+                raise RenameRefused(
+                    f"Cannot rename to '{shown(new_name)}': {o.shown()} already uses a key "
+                    f"'{shown(new_name)}'{how}; the two keys would become one"
+                )
+        root = next((o for o in group if ws.may_be_root(o)), None)
+        users = ws.root_users(new_name) if root is not None else []
+        if root is not None and users:
+            raise RenameRefused(
+                f"Cannot rename to '{shown(new_name)}': '@{shown(new_name)}' in "
+                f"{users[0].shown()} is that key (of the root blackboard) when {root.shown()} "
+                "runs as the main tree; the two keys would become one"
+            )
+
+
+def _key_edit(u: KeyRef, new_name: str) -> TextEdit:
+    if u.form == KeyForm.SCRIPT:
+        return TextEdit(u.start, u.end, new_name)
+    text = escape_value(new_name, u.quote)
+    return TextEdit(u.start, u.end, "{" + text + "}" if u.form == KeyForm.BARE_SAME else text)
+
+
+def _spelled_out(d: Document, r: NameRef) -> TextEdit | None:
+    """For a port attribute about to be renamed whose value is ``{=}`` or ``=`` (the key
+    named like the port): that key written out, so that it stays the same key."""
+    if r.role != Role.PORT_USE:
+        return None
+    a = d.model.elements[r.element].attr(r.text)
+    k = port_value_key(d, r.element, a) if a is not None else None
+    if k is None or k.form not in (KeyForm.SAME, KeyForm.BARE_SAME):
+        return None
+    return _key_edit(k, k.key)
+
+
+_EditsByPath = dict[str | None, dict[tuple[int, int], TextEdit]]
+
+
+def _add(by_path: _EditsByPath, path: str | None, e: TextEdit) -> None:
+    by_path.setdefault(path, {})[(e.start, e.end)] = e
+
+
+def _plan(by_path: _EditsByPath) -> RenamePlan:
+    own = by_path.pop(None, {})
+    return RenamePlan(
+        tuple(sorted(own.values())),
+        {path: tuple(sorted(e.values())) for path, e in by_path.items() if path is not None and e},
+    )
+
+
+def _port_edits(ws: _Workspace, sym: Symbol, new_name: str) -> _EditsByPath:
+    """Renaming a port: its names, and the ``{=}`` values of renamed attributes spelled out."""
+    by_path: _EditsByPath = {}
+    for path, d, r in ws.refs(sym):
+        fix = _spelled_out(d, r)
+        if fix is not None:
+            _add(by_path, path, fix)
+        for e in rename_edits([r], new_name):
+            _add(by_path, path, e)
+    return by_path
+
+
+def _rename_keys(
+    ws: _Workspace, targets: _KeyTargets, new_name: str, port_checked: bool = False
+) -> RenamePlan:
+    if targets.uses or not targets.port:
+        _check_key_name(new_name, any(u.form == KeyForm.SCRIPT for _, u in targets.uses))
+    if targets.port_refs and not port_checked:
+        _check_new_name(targets.port_refs[0][2], new_name, ws.doc.model, ws.others)
+    _check_key_safety(ws, targets, new_name)
+    by_path = _port_edits(ws, targets.port, new_name) if targets.port is not None else {}
+    for t, u in targets.uses:
+        _add(by_path, t.path, _key_edit(u, new_name))
+    return _plan(by_path)
+
+
 def rename(
     doc: Document, offset: int, new_name: str, others: Mapping[str, Document] | None = None
 ) -> RenamePlan | None:
     """Rename the name under ``offset`` and every reference to it in the workspace.
 
     ``None`` when there is no name there; raises :class:`RenameRefused` when the name cannot
-    be renamed or ``new_name`` breaks a rule (the message gives the rule's reason)."""
+    be renamed or ``new_name`` breaks a rule (the message gives the rule's reason).  A port
+    attribute renamed while its value is ``{=}`` or ``=`` (the key named like the port)
+    gets that key written out, so that the node keeps its key.
+
+    A blackboard key (under the cursor in ``{key}``, at the ``=`` of ``{=}`` or as a script
+    identifier) is renamed in the tree that uses it, because BehaviorTree.CPP gives each
+    tree instance a blackboard of its own: every use in the port values and scripts of
+    that tree's nodes, nothing in other trees (the ``port="{key}"`` of a ``<SubTree>``
+    call belongs to the calling tree).  When the key is also a port of its tree (declared
+    in a ``<SubTree>`` model entry or remapped by ``<SubTree>`` calls: inside a subtree the
+    port's name is its key), the port is renamed with it across the workspace; renaming
+    such a port likewise renames the key inside the tree.
+
+    Refused with the reason, rather than done partly or with a changed meaning:
+
+    * a key starting with ``@``: a key of the root blackboard, which every tree of the
+      running program shares, so no rename inside one tree can follow it;
+    * a key that some tree reaches as ``@key``, in a tree that may run as the main tree
+      (its document's ``main_tree_to_execute``, or called by no ``<SubTree>``): the main
+      tree's blackboard is the root one;
+    * a key shared through ``_autoremap``: a ``<SubTree _autoremap="true">`` call that does
+      not remap a port of that name gives caller and subtree one entry for every key not
+      starting with ``_`` (transitively, either way), so renaming the key where another
+      tree of that chain uses it would disconnect the two;
+    * a new name that would merge two keys: one already used in the tree or in a tree
+      sharing it through ``_autoremap``, a port of the tree, or a key that ``@name``
+      reaches while the tree may be the main one;
+    * a key written with character or entity references (``{go&#97;l}``), and a key that
+      appears after a syntax error in a script of the tree (which cannot be read further);
+    * a new name that is empty, contains ``{`` or ``}`` or control characters, has white
+      space around it, is ``=``, starts with ``@`` or, for a key used in a script, is not an
+      identifier (``[A-Za-z_][A-Za-z0-9_]*``, not ``true`` or ``false``); for a key that
+      is a port too, the port name rules apply as well.
+    """
     others = others or {}
     target = prepare_rename(doc, offset)
     if target is None:
         return None
+    ws = _Workspace(doc, others)
+    if target.key is not None:
+        k = target.key
+        return _rename_keys(ws, _key_targets(ws, _Tree(None, doc, k.tree), k.key), new_name)
     ref = target.ref
+    if ref is None:  # pragma: no cover - a target is a name or a key
+        return None
     model = doc.model
     _check_new_name(ref, new_name, model, others)
-    if ref.symbol is None:
+    sym = ref.symbol
+    if sym is None:
         return RenamePlan(tuple(rename_edits([ref], new_name)))
+    if _is_tree_port(sym):
+        return _rename_keys(ws, _port_targets(ws, sym), new_name, port_checked=True)
+    if sym[0] == "port":
+        return _plan(_port_edits(ws, sym, new_name))
     return RenamePlan(
-        tuple(rename_edits(model.refs_to(ref.symbol), new_name)),
-        other_file_edits(ref.symbol, new_name, {p: d.model for p, d in others.items()}),
+        tuple(rename_edits(model.refs_to(sym), new_name)),
+        other_file_edits(sym, new_name, {p: d.model for p, d in others.items()}),
     )
 
 

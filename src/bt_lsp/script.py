@@ -42,7 +42,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Final
 
-__all__ = ["ScriptError", "check_script"]
+__all__ = ["ScriptError", "check_script", "identifiers"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,6 +113,7 @@ _ONE_CHAR_OPS: Final = {
 
 _MAX_SHOWN: Final = 24
 _WORD_OPERATORS: Final = {"and": "&&", "or": "||"}
+_LITERAL_WORDS: Final = frozenset({"true", "false"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,6 +135,35 @@ def check_script(code: str, *, legacy: bool = False) -> ScriptError | None:
         return _Checker(code, legacy).run()
     except Exception as exc:  # pragma: no cover - defensive: a checker must never crash
         return ScriptError(0, len(code), f"Internal error while checking the script: {exc}")
+
+
+def identifiers(code: str) -> tuple[list[tuple[int, int]], int]:
+    """The identifier tokens of ``code`` as code-point spans, and how far ``code`` could be
+    tokenized: ``len(code)``, or the offset of the lexical error where BehaviorTree.CPP
+    stops reading it (what follows is unknown).
+
+    Identifiers are what the grammar reads as names: blackboard keys, ``@root`` keys and
+    enum names (registered in C++, so no syntax tells them from keys).  The literals
+    ``true`` and ``false`` are left out, and nothing inside a string is ever an identifier.
+    ``code`` is tokenized as the 4.0-4.9 parser reads it, a superset of 4.10: a
+    double-quoted string stays one string and a non-ASCII letter stays inside its
+    identifier, so neither is split into identifiers that are not there.
+    """
+    checker = _Checker(code, True)
+    found: list[tuple[int, int]] = []
+    for token in checker.tokens():
+        kind = token.kind
+        if kind == _EOF:
+            return found, len(code)
+        if kind == _ERROR:
+            return found, token.start
+        if (
+            kind == _ATOM
+            and checker.is_ident_start(code[token.start])
+            and code[token.start : token.end] not in _LITERAL_WORDS
+        ):
+            found.append((token.start, token.end))
+    return found, len(code)  # pragma: no cover - tokens() always ends with _EOF
 
 
 class _Checker:

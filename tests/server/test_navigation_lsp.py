@@ -377,6 +377,113 @@ async def test_prepare_rename_outside_a_name_is_null(lsp: NavClient) -> None:
     assert got is None
 
 
+# --- blackboard keys ----------------------------------------------------------------------
+
+# Tree "Keys" uses the key "target" in a precondition, a script and two port values, after
+# characters outside the BMP on the same lines; tree "Other" has a "target" of its own, and
+# so has "Main" in a.xml.
+K_XML = """\
+<root BTCPP_format="4">
+  <BehaviorTree ID="Keys">
+    <Sequence name="🚀 départ" _skipIf="target == '🚀 target' &amp;&amp; ok">
+      <Script name="𝔖𝔠𝔯𝔦𝔭𝔱 🚀" code="target := 'target' .. target"/>
+      <MoveBase name="🚀🚀" goal="{target}" speed="1"/>
+      <SubTree ID="Dock" pose="{ target }"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Other">
+    <MoveBase goal="{target}"/>
+  </BehaviorTree>
+</root>
+"""
+
+# Where "target" is the key of tree "Keys": (needle, offset of the key in the needle).
+K_USES = [
+    ('_skipIf="target', 9),
+    ('code="target', 6),
+    ("'target' .. target", 12),
+    ('goal="{target}"', 7),
+    ("{ target }", 2),
+]
+
+
+def key_spans() -> list[tuple[int, int]]:
+    out = []
+    for needle, into in K_USES:
+        start = K_XML.index(needle) + into
+        assert K_XML[start : start + 6] == "target"
+        out.append((start, start + 6))
+    return out
+
+
+def sorted_ranges(ranges: Sequence[types.Range]) -> list[types.Range]:
+    return sorted(ranges, key=lambda r: (r.start.line, r.start.character))
+
+
+async def test_rename_a_blackboard_key_in_its_tree(lsp: NavClient) -> None:
+    uri = open_doc(lsp, "keys.xml", K_XML)
+    try:
+        where = doc_pos(lsp, K_XML, 'goal="{target}"', into=9)
+        prepared = await lsp.text_document_prepare_rename_async(
+            types.PrepareRenameParams(text_document=ident(uri), position=where)
+        )
+        edit = await lsp.text_document_rename_async(
+            types.RenameParams(text_document=ident(uri), position=where, new_name="goal_pose")
+        )
+    finally:
+        close_doc(lsp, uri)
+    assert isinstance(prepared, types.PrepareRenamePlaceholder)
+    assert prepared.placeholder == "target"
+    assert prepared.range == rng(lsp, K_XML, key_spans()[3])
+    assert edit is not None
+    expected = [types.TextEdit(range=rng(lsp, K_XML, s), new_text="goal_pose") for s in key_spans()]
+    if edit.document_changes:
+        (change,) = edit.document_changes
+        assert isinstance(change, types.TextDocumentEdit)
+        assert change.text_document.uri == uri and change.text_document.version == 1
+        got = [e for e in change.edits if isinstance(e, types.TextEdit)]
+        assert len(got) == len(change.edits)
+    else:
+        assert edit.changes is not None and set(edit.changes) == {uri}
+        got = list(edit.changes[uri])
+    assert sorted(got, key=lambda e: (e.range.start.line, e.range.start.character)) == expected
+    new = apply(lsp, K_XML, got)
+    assert new.count("goal_pose") == 5
+    assert "'🚀 target'" in new and "'target'" in new
+    assert '<MoveBase goal="{target}"/>' in new  # tree "Other"
+
+
+async def test_references_and_highlights_of_a_key_from_a_script(lsp: NavClient) -> None:
+    uri = open_doc(lsp, "keys.xml", K_XML)
+    try:
+        where = doc_pos(lsp, K_XML, 'code="target', into=8)
+        refs = await lsp.text_document_references_async(
+            types.ReferenceParams(
+                text_document=ident(uri),
+                position=where,
+                context=types.ReferenceContext(include_declaration=True),
+            )
+        )
+        marks = await lsp.text_document_document_highlight_async(
+            types.DocumentHighlightParams(text_document=ident(uri), position=where)
+        )
+        with pytest.raises(JsonRpcException) as info:
+            await lsp.text_document_rename_async(
+                types.RenameParams(text_document=ident(uri), position=where, new_name="goal pose")
+            )
+    finally:
+        close_doc(lsp, uri)
+    expected = [rng(lsp, K_XML, s) for s in key_spans()]
+    assert refs is not None and {loc.uri for loc in refs} == {uri}
+    assert sorted_ranges([loc.range for loc in refs]) == expected
+    assert marks is not None
+    assert sorted_ranges([h.range for h in marks]) == expected
+    assert all(h.kind == types.DocumentHighlightKind.Read for h in marks)
+    assert info.value.code == types.LSPErrorCodes.RequestFailed.value
+    assert info.value.message.startswith("Cannot rename to 'goal pose'")
+    assert "used in a script" in info.value.message
+
+
 # --- definition, references, highlights ---------------------------------------------------
 
 
