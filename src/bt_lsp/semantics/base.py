@@ -93,6 +93,10 @@ class State:
     v4: bool = False  # <root> declares BTCPP_format
     _types: dict[str, Resolved | None] = field(default_factory=dict)
     _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
+    # Models resolved from declarations, shared by the runs over the sections of one check:
+    # by ID, with the declaration they were made from (still looked up in each run, so that
+    # the run records what it read).
+    made: dict[str, tuple[object, Resolved]] = field(default_factory=dict)
     # A run over one section of the document (see sections.py) has the section's model and
     # text, in coordinates that start at document offset ``origin``.
     origin: int = 0
@@ -129,7 +133,10 @@ class State:
             return self._types[type_id]
         decl = self.ctx.models.get(type_id)
         res: Resolved | None = None
-        if decl is not None:
+        made = self.made.get(type_id)
+        if made is not None and made[0] is decl:
+            res = made[1]
+        elif decl is not None:
             lo, hi = decl.child_range
             required = tuple(
                 p.name for p in decl.ports if p.default is None and p.direction != "output"
@@ -137,6 +144,7 @@ class State:
             res = Resolved(
                 decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
             )
+            self.made[type_id] = (decl, res)
         self._types[type_id] = res
         return res
 
@@ -146,11 +154,15 @@ class State:
             return self._subtrees[tree_id]
         decl = self.ctx.subtree_models.get(tree_id)
         res = None
-        if decl is not None:
+        made = self.made.get("\0" + tree_id)  # a key no node type has
+        if made is not None and made[0] is decl:
+            res = made[1]
+        elif decl is not None:
             # BehaviorTree.CPP treats an empty default of a SubTree model port as none.
             required = tuple(p.name for p in decl.ports if not p.default)
             ports = {p.name: p for p in decl.ports}
             res = Resolved(decl.id, "subtree", "SubTree", ports, 0, 0, required)
+            self.made["\0" + tree_id] = (decl, res)
         self._subtrees[tree_id] = res
         return res
 

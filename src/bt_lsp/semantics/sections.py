@@ -201,11 +201,12 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
     if todo:
         if index is None:
             index = dict(zip(sections, range(len(sections)), strict=True))
+        recording = _RecordingContext(ctx)
         for sec in todo:
             origin = origins[index[sec]]
             found = sec.cache.get(_KEY)
             if not _still_valid(found, settings, lines, origin, current):
-                found = _run(st, sec, origin, root, settings, check, current, lines)
+                found = _run(st, sec, origin, root, settings, check, current, lines, recording)
                 sec.cache[_KEY] = found
             assert found is not None
             valid.add(sec)
@@ -263,6 +264,23 @@ def _touched(
     return touched
 
 
+class _RecordingContext:
+    """The context as the runs over sections see it: the same, except that its mappings
+    note in ``deps`` what a run looks up (cleared before each run)."""
+
+    __slots__ = ("ctx", "deps")
+
+    def __init__(self, ctx: Context) -> None:
+        self.deps: set[Dep] = set()
+        self.ctx = dataclasses.replace(
+            ctx,
+            models=_Recording(ctx.models, "models", self.deps),
+            subtree_models=_Recording(ctx.subtree_models, "subtree_models", self.deps),
+            trees=_Recording(ctx.trees, "trees", self.deps),
+            workspace_trees=_Recording(ctx.workspace_trees, "workspace_trees", self.deps),
+        )
+
+
 def _run(
     st: State,
     sec: Section,
@@ -272,24 +290,19 @@ def _run(
     check: Callable[[State, Sequence[Element]], None],
     current: Callable[[Dep], object],
     lines: LineIndex,
+    recording: _RecordingContext,
 ) -> _Entry:
-    deps: set[Dep] = set()
-    ctx = st.ctx
-    recording = dataclasses.replace(
-        ctx,
-        models=_Recording(ctx.models, "models", deps),
-        subtree_models=_Recording(ctx.subtree_models, "subtree_models", deps),
-        trees=_Recording(ctx.trees, "trees", deps),
-        workspace_trees=_Recording(ctx.workspace_trees, "workspace_trees", deps),
-    )
+    deps = recording.deps
+    deps.clear()
     local = sec.local_model(root)
     run = State(
         st.doc,
-        recording,
+        recording.ctx,
         local,
         st.text[origin : origin + sec.length],
         v4=st.v4,
         origin=origin,
+        made=st.made,
     )
     elements = local.elements
     check(run, elements[1:] if isinstance(elements, list) else list(elements)[1:])
