@@ -21,6 +21,7 @@ from bt_lsp import __version__, fixes
 from bt_lsp.cli import main
 from bt_lsp.codes import CODES
 from bt_lsp.edits import TextEdit
+from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
 
 # 😋 (outside the BMP) sits before the bad port name on line 4: its column counts the emoji
 # as one character (24); SARIF counts it as two UTF-16 code units (25).
@@ -640,6 +641,62 @@ def test_fix_renames_every_reference(work: Path, capsys: pytest.CaptureFixture[s
     assert capsys.readouterr().err == "0 errors, 0 warnings in 1 file\n"
 
 
+def test_fix_renames_tree_ports_with_their_keys(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _put(work / "a.xml", PORTS)
+    assert main(["check", "--fix", "a.xml"]) == 0
+    assert path.read_text(encoding="utf-8") == PORTS_FIXED
+    assert capsys.readouterr().err.splitlines() == [
+        "fixed 5 problems in a.xml",
+        "0 errors, 0 warnings in 1 file",
+    ]
+
+
+def test_fix_says_which_keys_it_left(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _put(work / "a.xml", AUTOREMAP)
+    assert main(["check", "--fix", "a.xml"]) == 0
+    assert path.read_text(encoding="utf-8") == AUTOREMAP.replace(
+        'name="bad.port"', 'name="bad_port"'
+    )
+    assert capsys.readouterr().err.splitlines() == [
+        "fixed 1 problem in a.xml",
+        "bt-lsp: a.xml: renamed 'bad.port' to 'bad_port' and left the key 'bad.port' in "
+        f"tree 'Sub' as it is: {AUTOREMAP_WHY}",
+        "0 errors, 0 warnings in 1 file",
+    ]
+
+
+def test_fix_gives_a_port_one_name_across_a_folder(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The port is declared in one file; its tree and a call are in another.
+    models = _put(
+        work / "d" / "models.xml",
+        '<root BTCPP_format="4">\n  <TreeNodesModel>\n    <SubTree ID="Sub">\n'
+        '      <input_port name="bad.port"/>\n    </SubTree>\n  </TreeNodesModel>\n</root>\n',
+    )
+    trees = _put(
+        work / "d" / "trees.xml",
+        '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+        '  <BehaviorTree ID="Main">\n    <SubTree ID="Sub" bad.port="1"/>\n  </BehaviorTree>\n'
+        '  <BehaviorTree ID="Sub">\n'
+        '    <SetBlackboard output_key="out" value="{bad.port}"/>\n'
+        "  </BehaviorTree>\n</root>\n",
+    )
+    before = (models.read_text(encoding="utf-8"), trees.read_text(encoding="utf-8"))
+    assert main(["check", "--fix", "d"]) == 0
+    # Each file is fixed alone, and the port gets the same name in both, its key included.
+    assert models.read_text(encoding="utf-8") == before[0].replace("bad.port", "bad_port")
+    assert trees.read_text(encoding="utf-8") == before[1].replace("bad.port", "bad_port")
+    # (Once the declaration is renamed, the call misses the required port until it is fixed.)
+    assert capsys.readouterr().err.splitlines() == [
+        "fixed 1 problem in d/models.xml",
+        "fixed 2 problems in d/trees.xml",
+        "0 errors, 0 warnings in 2 files",
+    ]
+
+
 @pytest.mark.parametrize(
     ("encoding", "bom", "newline"),
     [
@@ -684,8 +741,9 @@ def _patch_fix_all(monkeypatch: pytest.MonkeyPatch, bad: TextEdit) -> None:
     """The real fixes, with ``bad`` instead of any edit at the same place."""
     real = fixes.fix_all
 
-    def fake(model: Any, diags: Any) -> list[TextEdit]:
-        return [e for e in real(model, diags) if e.start != bad.start] + [bad]
+    def fake(doc: Any, diags: Any) -> fixes.FixAll:
+        edits = [e for e in real(doc, diags).edits if e.start != bad.start]
+        return fixes.FixAll([*edits, bad])
 
     monkeypatch.setattr(fixes, "fix_all", fake)
 

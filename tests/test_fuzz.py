@@ -29,9 +29,9 @@ def exercise(doc: Document) -> None:
     n = len(doc.text)
     for d in diags:
         assert 0 <= d.start <= d.end <= n
-        for fix in fixes_for(doc.model, d):
+        for fix in fixes_for(doc, d):
             apply_edits(doc.text, fix.edits)
-    apply_edits(doc.text, fix_all(doc.model, diags))
+    apply_edits(doc.text, fix_all(doc, diags).edits)
     for offset in range(0, n + 1, max(1, n // 25)):
         hover_at(doc, offset)
 

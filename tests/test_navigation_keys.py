@@ -150,6 +150,18 @@ def test_no_key_in_strings_literal_texts_or_models() -> None:
     assert found is not None and found.key == "target_2"
 
 
+def test_a_port_with_a_bad_name_gives_a_key_and_ignored_attributes_do_not() -> None:
+    # "goal.x" and "1st" break the port naming rules (the name fixes rename them into
+    # ports); "_note" is an attribute BehaviorTree.CPP ignores, "é" one it cannot read.
+    doc, off, spans = at(
+        '<root><BehaviorTree ID="T"><Nav goal.x="{⟦k‸⟧}" 1st="{⟦k⟧}" again.x="{⟦=⟧}" '
+        '_note="{k}" é="{k}" ok="{⟦k⟧}"/></BehaviorTree></root>'
+    )
+    assert place_spans(references(doc, off)) == [spans[0], spans[1], spans[3]]
+    found = key_at(doc, spans[2][0])
+    assert found is not None and found.key == "again.x" and found.form == KeyForm.SAME
+
+
 # --- rename in one tree -------------------------------------------------------------------
 
 

@@ -14,6 +14,11 @@ tree.  A tree uses a key
   ``true``/``false`` are literals.  Enum names are identifiers too (they are registered
   in C++), so an identifier spelled like a key is taken for that key.
 
+Port values count in attributes whose names break the port naming rules (``goal.x="{g}"``):
+those are errors that the name fixes correct, and the key is the tree's once they do.
+Reserved attributes, the underscore attributes BehaviorTree.CPP ignores (``_x``) and valid
+names it cannot read as ports (starting with a non-ASCII letter) are never ports.
+
 Every use has the span of the key as written in the file: values are decoded (entity
 references replaced) before they are read, and spans are mapped back through the
 references, so ``&amp;&amp;`` before a key does not shift it.  A key whose own characters
@@ -30,7 +35,7 @@ from enum import StrEnum
 from bt_lsp.builtins import BUILTINS, is_blackboard_reference
 from bt_lsp.document import Document
 from bt_lsp.model import Element, Model, Zone
-from bt_lsp.names import is_allowed_port_name
+from bt_lsp.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.scanner import Attr
 from bt_lsp.script import identifiers
 from bt_lsp.semantics.scripts import CONDITION_ATTRS, SCRIPT_PORTS, raw_offsets
@@ -175,6 +180,14 @@ def _script_keys(doc: Document, el: Element, a: Attr, idx: int, tree: int, out: 
         out.unread.append(code[stop:])
 
 
+def _is_port(name: str) -> bool:
+    """Whether a node attribute gives a port: an allowed port name, or a port name that
+    breaks the naming rules (an error to fix, after which its value is the port's)."""
+    if is_allowed_port_name(name):
+        return True
+    return not name.startswith("_") and bool(check_name(name, NameKind.PORT))
+
+
 def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
     el = doc.model.elements[idx]
     if el.zone != Zone.NODE:
@@ -185,7 +198,7 @@ def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
             continue
         if a.name in CONDITION_ATTRS:
             _script_keys(doc, el, a, idx, tree, out)
-        elif not is_allowed_port_name(a.name):
+        elif not _is_port(a.name):
             continue  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
         elif is_blackboard_reference(value):
             k = _port_key(doc, el, a, idx, tree, value)

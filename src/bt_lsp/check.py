@@ -115,6 +115,7 @@ class FileResult:
     error: FileError | None = None
     fixed: int = 0
     not_fixed: str | None = None  # why a file with fixes was left unchanged
+    notes: list[str] = field(default_factory=list)  # what the applied fixes left as it was
     detail: str = ""  # the traceback of an internal error
 
 
@@ -279,6 +280,7 @@ def _well_formed(data: bytes) -> bool:
 class _Fixed:
     doc: Document
     raw: list[Diagnostic]
+    notes: list[str]
 
 
 def _fix(
@@ -290,7 +292,8 @@ def _fix(
 ) -> _Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
     fix)."""
-    edits = fixes.fix_all(doc.model, diags)
+    fix_all = fixes.fix_all(doc, diags)
+    edits = fix_all.edits
     if not edits:
         return None
     if not decoded.lossless:
@@ -328,7 +331,7 @@ def _fix(
         return "the fixes would add name problems elsewhere"
     if _well_formed(decoded.encode(doc.text)) and not _well_formed(new_bytes):
         return "the fixed file would not be well-formed XML"
-    return _Fixed(new_doc, new_raw)
+    return _Fixed(new_doc, new_raw, fix_all.notes)
 
 
 def check_file(path: str, options: Options, workspace: Workspace | None = None) -> FileResult:
@@ -355,6 +358,7 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
                     workspace.file_changed(path)
                 fixed_diags = with_severities(outcome.raw, options.severities)
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
+                result.notes = outcome.notes
                 doc, diags = outcome.doc, fixed_diags
         result.findings = _findings(path, doc, diags)
     except FileError as e:
@@ -642,6 +646,8 @@ def run(
             say(err, f"bt-lsp: not fixing {_visible(path)}: {r.not_fixed}\n")
         if r.fixed:
             say(err, f"fixed {_plural(r.fixed, 'problem')} in {_visible(path)}\n")
+        for note in r.notes:
+            say(err, f"bt-lsp: {_visible(path)}: {_visible(note)}\n")
         if options.format == "text" and r.findings:
             say(out, "".join(line + "\n" for line in format_text(r.findings)))
     progress.clear()

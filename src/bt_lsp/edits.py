@@ -1,12 +1,17 @@
-"""Text edits over code-point offsets, and applying them.
+"""Text edits over code-point offsets, applying them, and fixes (titled edits for a
+diagnostic).
 
 Core layers return edits; only front ends (server, CLI) decide to apply them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from bt_lsp.diagnostics import Diagnostic
 
 
 @dataclass(frozen=True, slots=True, order=True)
@@ -31,3 +36,28 @@ def apply_edits(text: str, edits: Iterable[TextEdit]) -> str:
         pos = edit.end
     parts.append(text[pos:])
     return "".join(parts)
+
+
+def escape_value(text: str, quote: str) -> str:
+    """``text`` written inside an attribute value delimited by ``quote``."""
+    text = text.replace("&", "&amp;").replace("<", "&lt;")
+    if quote == '"':
+        text = text.replace('"', "&quot;")
+    elif quote == "'":
+        text = text.replace("'", "&apos;")
+    return text
+
+
+@dataclass(frozen=True, slots=True)
+class Fix:
+    """A fix: edits to the document, and to other workspace files by path."""
+
+    title: str
+    edits: tuple[TextEdit, ...]
+    preferred: bool
+    diagnostic: Diagnostic
+    other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
+
+    @property
+    def places(self) -> int:
+        return len(self.edits) + sum(len(e) for e in self.other_edits.values())

@@ -1,142 +1,105 @@
-"""Fixes for name diagnostics: sanitized, unique replacements that rename every reference.
+"""Fixes for name diagnostics: sanitized, unique replacements, renamed as a rename would.
+
+A fix renames a bad name exactly as :func:`bt_lsp.navigation.rename` renames it to the same
+new name, through the same :class:`~bt_lsp.navigation.Renamer`: every reference in the
+document and in the other workspace documents, a tree's port together with its uses as a
+blackboard key inside the tree, and the ``{=}`` of a renamed port attribute written out.
+Where the rename refuses:
+
+* a refusal of the new name (it is taken, or would merge two keys): the next candidate
+  name is tried, and numbered ones (``_2``, ``_3`` …) when no candidate will do;
+* a refusal of the tree port's key itself (shared through ``_autoremap``, reached as
+  ``@key``, written with references or after a script's syntax error): the fix renames the
+  port's own names only, and its title says that the key is left as it is.
 
 Pure: these functions return edits; the front ends decide whether to apply them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Collection, Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 
 from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.edits import TextEdit
-from bt_lsp.model import Model, NameRef, Symbol
+from bt_lsp.document import Document
+from bt_lsp.edits import Fix, TextEdit, escape_value
+from bt_lsp.model import NameRef, Symbol
+from bt_lsp.name_edits import (
+    namespace,
+    occurrences,
+    other_file_edits,
+    rename_edits,
+    shown,
+    taken_names,
+)
+from bt_lsp.navigation import RenamePlan, Renamer, RenameRefused, combined
 from bt_lsp.sanitize import candidates, sanitize
+
+__all__ = [
+    "Fix",
+    "FixAll",
+    "Renaming",
+    "escape_value",
+    "fix_all",
+    "fixes_for",
+    "occurrences",
+    "other_file_edits",
+    "preferred_renaming",
+    "rename_edits",
+    "renamings",
+    "shown",
+    "taken_names",
+]
+
+# Numbered names tried when the rename refuses every candidate name.
+_MORE_NAMES = 20
 
 
 @dataclass(frozen=True, slots=True)
-class Fix:
-    """A fix: edits to the document, and to other workspace files by path."""
+class Renaming:
+    """A new name for a bad name, and the edits of renaming it.  ``kept`` names what the
+    rename leaves as it is (``"key 'x' in tree 'T'"``) because the full rename was refused,
+    and ``why`` is that refusal."""
 
-    title: str
-    edits: tuple[TextEdit, ...]
-    preferred: bool
-    diagnostic: Diagnostic
-    other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
+    old: str
+    new: str
+    plan: RenamePlan
+    kept: str | None = None
+    why: str | None = None
 
     @property
-    def places(self) -> int:
-        return len(self.edits) + sum(len(e) for e in self.other_edits.values())
+    def title(self) -> str:
+        places = self.plan.places
+        where = "1 place" if places == 1 else f"{places} places"
+        n = len(self.plan.other_edits)
+        if n:
+            where += f", {n} other file{'s' if n > 1 else ''}"
+        old = shown(self.old)
+        title = (
+            f"Clear '{old}' ({where})"
+            if not self.new
+            else f"Rename '{old}' to '{shown(self.new)}' ({where})"
+        )
+        if self.kept is not None:
+            title += f"; {self.kept} left as it is"
+        return title
+
+    @property
+    def note(self) -> str | None:
+        """What the fix leaves as it is and why, for reports (``None``: nothing)."""
+        if self.kept is None:
+            return None
+        return (
+            f"renamed '{shown(self.old)}' to '{shown(self.new)}' and left the {self.kept} "
+            f"as it is: {self.why}"
+        )
 
 
-def escape_value(text: str, quote: str) -> str:
-    """``text`` written inside an attribute value delimited by ``quote``."""
-    text = text.replace("&", "&amp;").replace("<", "&lt;")
-    if quote == '"':
-        text = text.replace('"', "&quot;")
-    elif quote == "'":
-        text = text.replace("'", "&apos;")
-    return text
-
-
-def _written(ref: NameRef, new_name: str) -> str:
-    return escape_value(new_name, ref.quote) if ref.quote else new_name
-
-
-def occurrences(model: Model, ref: NameRef) -> list[NameRef]:
-    """Every name token that a rename of ``ref`` must change, ``ref`` included."""
-    if ref.symbol is None:
-        return [ref]
-    return model.refs_to(ref.symbol)
-
-
-def rename_edits(refs: Iterable[NameRef], new_name: str) -> list[TextEdit]:
-    return sorted({TextEdit(r.start, r.end, _written(r, new_name)) for r in refs})
-
-
-def _namespace(symbol: Symbol) -> tuple[str, ...]:
-    """Names in one namespace must stay distinct: trees and models share one (a tree ID may
-    not be a node type), a port's namespace is its owner's ports."""
-    return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
-
-
-def _names_in(model: Model, ns: tuple[str, ...]) -> set[str]:
-    return {sym[-1] for sym in model.by_symbol if _namespace(sym) == ns}
-
-
-def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = ()) -> set[str]:
-    """Names a new name for ``symbol`` must avoid: the others in its namespace, in this
-    document and in the other workspace documents."""
-    if symbol is None:
-        return set()
-    ns = _namespace(symbol)
-    taken: set[str] = set()
-    for m in (model, *others):
-        taken |= _names_in(m, ns)
-    if not any(symbol in m.by_symbol for m in others):
-        taken.discard(symbol[-1])
-    return taken
-
-
-def other_file_edits(
-    symbol: Symbol | None, new_name: str, others: Mapping[str, Model]
-) -> dict[str, tuple[TextEdit, ...]]:
-    """The edits renaming ``symbol`` in other workspace documents (by path)."""
-    if symbol is None:
-        return {}
-    out: dict[str, tuple[TextEdit, ...]] = {}
-    for path, m in others.items():
-        refs = m.refs_to(symbol)
-        if refs:
-            out[path] = tuple(rename_edits(refs, new_name))
-    return out
-
-
-def shown(name: str) -> str:
-    """A name with its control characters written visibly (``U+0007``)."""
-    return "".join(c if c.isprintable() or c == " " else f"U+{ord(c):04X}" for c in name)
-
-
-def _title(old: str, new: str, places: int) -> str:
-    where = "1 place" if places == 1 else f"{places} places"
-    if not new:
-        return f"Clear '{shown(old)}' ({where})"
-    return f"Rename '{shown(old)}' to '{shown(new)}' ({where})"
-
-
-def fixes_for(
-    model: Model, diag: Diagnostic, others: Mapping[str, Model] | None = None
-) -> list[Fix]:
-    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.
-    ``others`` are the other workspace documents' models, by path: references there are
-    renamed too."""
-    if not diag.is_name_rule:
-        return []
-    ref = model.ref_at(diag.start)
-    if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
-        return []
-    others = others or {}
-    occ = occurrences(model, ref)
-    names = candidates(ref.text, ref.kind, taken_names(model, ref.symbol, others.values()))
-    fixes: list[Fix] = []
-    for i, new in enumerate(names):
-        if new == ref.text:
-            continue
-        edits = tuple(rename_edits(occ, new))
-        elsewhere = other_file_edits(ref.symbol, new, others)
-        places = len(edits) + sum(len(e) for e in elsewhere.values())
-        title = _title(ref.text, new, places)
-        if elsewhere:
-            n = len(elsewhere)
-            title = title[:-1] + f", {n} other file{'s' if n > 1 else ''})"
-        fixes.append(Fix(title, edits, i == 0, diag, elsewhere))
-    return fixes
-
-
-class _Without(Collection[str]):
+class _Without(AbstractSet[str]):
     """A set minus one name, without copying the set."""
 
-    def __init__(self, names: set[str], left_out: str) -> None:
+    def __init__(self, names: AbstractSet[str], left_out: str) -> None:
         self._names, self._left_out = names, left_out
 
     def __contains__(self, name: object) -> bool:
@@ -149,35 +112,151 @@ class _Without(Collection[str]):
         return len(self._names) - (self._left_out in self._names)
 
 
-def fix_all(model: Model, diags: Iterable[Diagnostic]) -> list[TextEdit]:
+class _With(AbstractSet[str]):
+    """The union of a set and a few more names, without copying the set."""
+
+    def __init__(self, names: AbstractSet[str], more: AbstractSet[str]) -> None:
+        self._names, self._more = names, more
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._more or name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self._names
+        yield from (n for n in self._more if n not in self._names)
+
+    def __len__(self) -> int:
+        return len(self._names) + sum(1 for n in self._more if n not in self._names)
+
+
+def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str]) -> Renaming | None:
+    try:
+        return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken))
+    except RenameRefused as e:
+        sym = ref.symbol
+        if e.new_name or sym is None or sym[:2] != ("port", "tree"):
+            return None
+        why = e.message
+    try:
+        plan = renamer.plan(ref, new, keys=False, taken=taken)
+    except RenameRefused:
+        return None
+    kept = f"key '{shown(sym[3])}' in tree '{shown(sym[2])}'"
+    return Renaming(ref.text, new, plan, kept, why)
+
+
+def renamings(renamer: Renamer, ref: NameRef, taken: AbstractSet[str]) -> Iterator[Renaming]:
+    """The renamings of the bad name ``ref`` (of the renamer's document), best first: one
+    for each candidate name (:func:`bt_lsp.sanitize.candidates`) that the rename accepts,
+    else for the first numbered name it accepts.  ``taken`` are the names of the symbol's
+    namespace that the new name must avoid."""
+    kind = ref.kind
+    if kind is None:
+        return
+    tried: set[str] = set()
+    found = False
+    for new in candidates(ref.text, kind, taken):
+        if new == ref.text or new in tried:
+            continue
+        tried.add(new)
+        r = _renaming(renamer, ref, new, taken)
+        if r is not None:
+            found = True
+            yield r
+    if found:
+        return
+    for _ in range(_MORE_NAMES):
+        new = sanitize(ref.text, kind, _With(taken, tried))
+        if new == ref.text or new in tried:
+            return
+        tried.add(new)
+        r = _renaming(renamer, ref, new, taken)
+        if r is not None:
+            yield r
+            return
+
+
+def _name_ref(doc: Document, diag: Diagnostic) -> NameRef | None:
+    """The name token a name diagnostic is about."""
+    if not diag.is_name_rule:
+        return None
+    ref = doc.model.ref_at(diag.start)
+    if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
+        return None
+    return ref
+
+
+def preferred_renaming(
+    doc: Document, ref: NameRef, others: Mapping[str, Document] | None = None
+) -> Renaming | None:
+    """The renaming of the preferred fix for the bad name ``ref``."""
+    others = others or {}
+    taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
+    return next(renamings(Renamer(doc, others), ref, taken), None)
+
+
+def fixes_for(
+    doc: Document, diag: Diagnostic, others: Mapping[str, Document] | None = None
+) -> list[Fix]:
+    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.
+    ``others`` are the other workspace documents, by path: references there are renamed
+    too."""
+    ref = _name_ref(doc, diag)
+    if ref is None:
+        return []
+    others = others or {}
+    taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
+    return [
+        Fix(r.title, r.plan.edits, i == 0, diag, r.plan.other_edits)
+        for i, r in enumerate(renamings(Renamer(doc, others), ref, taken))
+    ]
+
+
+@dataclass(frozen=True, slots=True)
+class FixAll:
+    """The edits of every preferred name fix of a document, and a note for each fix that
+    left a key as it is (see :attr:`Renaming.note`)."""
+
+    edits: list[TextEdit]
+    notes: list[str] = field(default_factory=list)
+
+
+def fix_all(doc: Document, diags: Iterable[Diagnostic]) -> FixAll:
     """Every preferred name fix at once, consistently: one new name per symbol, all
-    distinct from each other and from the names that stay."""
-    chosen: dict[Symbol | tuple[int, int], str] = {}
-    edits: dict[tuple[int, int], TextEdit] = {}
+    distinct from each other and from the names that stay.  Each symbol is renamed as a
+    rename renames it (its keys included), in the document seen alone: fix-all changes no
+    other file, so it takes no name or key of another file into account either (a file
+    fixed before would otherwise make the next one choose another name for the same
+    symbol, as ``bt-lsp check --fix`` fixes the files of a folder one after the other)."""
+    model = doc.model
+    renamer = Renamer(doc)
+    done: set[Symbol | tuple[int, int]] = set()
+    plans: list[RenamePlan] = []
+    notes: list[str] = []
     taken_by_ns: dict[tuple[str, ...], set[str]] = {}
     for sym in model.by_symbol:
-        taken_by_ns.setdefault(_namespace(sym), set()).add(sym[-1])
+        taken_by_ns.setdefault(namespace(sym), set()).add(sym[-1])
     for diag in diags:
-        if not diag.is_name_rule:
-            continue
-        ref = model.ref_at(diag.start)
-        if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
+        ref = _name_ref(doc, diag)
+        if ref is None:
             continue
         key: Symbol | tuple[int, int] = (
             ref.symbol if ref.symbol is not None else (ref.start, ref.end)
         )
-        if key in chosen:
+        if key in done:
             continue
+        done.add(key)
+        names: set[str] | None = None
+        taken: AbstractSet[str] = frozenset()
         if ref.symbol is not None:
-            ns = _namespace(ref.symbol)
-            taken_by_ns.setdefault(ns, set())
-            taken: Collection[str] = _Without(taken_by_ns[ns], ref.symbol[-1])
-        else:
-            taken = ()
-        new = sanitize(ref.text, ref.kind, taken)
-        chosen[key] = new
-        if ref.symbol is not None:
-            taken_by_ns[_namespace(ref.symbol)].add(new)
-        for e in rename_edits(occurrences(model, ref), new):
-            edits[(e.start, e.end)] = e
-    return sorted(edits.values())
+            names = taken_by_ns.setdefault(namespace(ref.symbol), set())
+            taken = _Without(names, ref.symbol[-1])
+        r = next(renamings(renamer, ref, taken), None)
+        if r is None:
+            continue
+        if names is not None:
+            names.add(r.new)
+        plans.append(RenamePlan(r.plan.edits, written_out=r.plan.written_out))
+        if r.note is not None:
+            notes.append(r.note)
+    return FixAll(list(combined(plans).edits), notes)

@@ -9,10 +9,10 @@ from bt_lsp.builtins import BUILTINS, PortModel
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import name_violations
 from bt_lsp.document import Document
-from bt_lsp.fixes import occurrences, taken_names
+from bt_lsp.fixes import preferred_renaming
 from bt_lsp.model import DECLARING_ROLES, NameRef, Role
+from bt_lsp.name_edits import occurrences
 from bt_lsp.names import RULES
-from bt_lsp.sanitize import sanitize
 
 
 @dataclass(frozen=True, slots=True)
@@ -137,11 +137,15 @@ def hover_at(doc: Document, offset: int, ctx: Context | None = None) -> HoverTex
                     f"| {c.category} "
                     f"| {c.reason} |"
                 )
-        new = sanitize(ref.text, ref.kind, taken_names(model, ref.symbol))
-        places = len(occurrences(model, ref))
-        lines.append("")
-        where = "1 place" if places == 1 else f"{places} places"
-        lines.append(f"Suggested replacement: {_code(new)} (the quick fix renames {where})")
+        fix = preferred_renaming(doc, ref)
+        if fix is not None:
+            places = fix.plan.places
+            where = "1 place" if places == 1 else f"{places} places"
+            lines.append("")
+            lines.append(f"Suggested replacement: {_code(fix.new)} (the quick fix renames {where})")
+            if fix.kept is not None:
+                lines.append("")
+                lines.append(f"The quick fix leaves the {fix.kept} as it is: {fix.why}")
     else:
         lines.append(f"**{_what(ref)}**")
         decl = [r for r in occurrences(model, ref) if r.role in DECLARING_ROLES]

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from functools import cache
+from typing import NoReturn
 
 from bt_lsp.blackboard import (
     KeyForm,
@@ -37,8 +38,7 @@ from bt_lsp.blackboard import (
 from bt_lsp.builtins import BUILTINS, PortModel
 from bt_lsp.context import Context
 from bt_lsp.document import Document
-from bt_lsp.edits import TextEdit
-from bt_lsp.fixes import escape_value, other_file_edits, rename_edits, shown, taken_names
+from bt_lsp.edits import TextEdit, escape_value
 from bt_lsp.model import (
     EXPLICIT_TAGS,
     XML_NAME_RE,
@@ -49,6 +49,7 @@ from bt_lsp.model import (
     Symbol,
     Zone,
 )
+from bt_lsp.name_edits import other_file_edits, rename_edits, shown, taken_names
 from bt_lsp.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.scanner import Kind
 from bt_lsp.workspace import Include
@@ -65,10 +66,12 @@ __all__ = [
     "RenamePlan",
     "RenameRefused",
     "RenameTarget",
+    "Renamer",
     "SymbolKind",
     "WorkspaceSymbol",
     "blackboard_keys",
     "builtin_catalog",
+    "combined",
     "definition",
     "document_symbols",
     "element_end",
@@ -562,11 +565,14 @@ def highlights(doc: Document, offset: int) -> list[Highlight]:
 
 
 class RenameRefused(Exception):
-    """A rename that cannot be done; the message says why."""
+    """A rename that cannot be done; the message says why.  ``new_name`` tells a refusal of
+    the new name (another name may do: it breaks a rule, is taken, or would merge two
+    keys) from a refusal of the rename itself (the name or key cannot be renamed)."""
 
-    def __init__(self, message: str) -> None:
+    def __init__(self, message: str, *, new_name: bool = False) -> None:
         super().__init__(message)
         self.message = message
+        self.new_name = new_name
 
 
 @dataclass(frozen=True, slots=True)
@@ -583,10 +589,16 @@ class RenameTarget:
 
 @dataclass(frozen=True, slots=True)
 class RenamePlan:
-    """Edits to the document, and to the other documents by path."""
+    """Edits to the document, and to the other documents by path.
+
+    ``written_out`` holds ``(path, start, end)`` (``path=None`` for the document) of the
+    edits that only write out the key a port attribute already has (its ``{=}`` or ``=``,
+    see :func:`rename`): when renames are combined, another rename's edit of the same span
+    wins, since it renames that key."""
 
     edits: tuple[TextEdit, ...]
     other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
+    written_out: frozenset[tuple[str | None, int, int]] = frozenset()
 
     @property
     def places(self) -> int:
@@ -643,52 +655,64 @@ def _kind_of(ref: NameRef) -> NameKind:
     return NameKind.MODEL  # main_tree_to_execute, end tags
 
 
+def _refuse_new_name(new_name: str, why: str) -> NoReturn:
+    raise RenameRefused(f"Cannot rename to '{shown(new_name)}': {why}", new_name=True)
+
+
 def _check_new_name(
-    ref: NameRef, new_name: str, model: Model, others: Mapping[str, Document]
+    ref: NameRef,
+    new_name: str,
+    model: Model,
+    others: Mapping[str, Document],
+    taken: Collection[str] | None = None,
 ) -> None:
+    """Refuse a new name that breaks a rule of the name, or that another name of its
+    namespace has (``taken``: those names, when the caller knows them already)."""
     kind = _kind_of(ref)
     sym = ref.symbol
     violations = check_name(new_name, kind, declaration=kind is NameKind.PORT)
     if violations:
-        raise RenameRefused(f"Cannot rename to '{shown(new_name)}': {violations[0].message}")
+        _refuse_new_name(new_name, violations[0].message)
     if kind is NameKind.INSTANCE or sym is None:
         return
     all_refs = [r for m in (model, *(d.model for d in others.values())) for r in m.refs_to(sym)]
     if kind is NameKind.PORT:
         if not is_allowed_port_name(new_name):
-            raise RenameRefused(
-                f"Cannot rename to '{shown(new_name)}': a port name must start with an "
-                "ASCII letter, or BehaviorTree.CPP does not read the attribute as a port"
+            _refuse_new_name(
+                new_name,
+                "a port name must start with an ASCII letter, or BehaviorTree.CPP does not "
+                "read the attribute as a port",
             )
         if any(r.role == Role.PORT_USE for r in all_refs) and not XML_NAME_RE.fullmatch(new_name):
-            raise RenameRefused(
-                f"Cannot rename to '{shown(new_name)}': the port is written as an attribute "
-                "name, and this is not a valid XML name"
+            _refuse_new_name(
+                new_name,
+                "the port is written as an attribute name, and this is not a valid XML name",
             )
     elif not XML_NAME_RE.fullmatch(new_name) and any(
         r.role in (Role.NODE_TYPE, Role.NODE_TYPE_END) for r in all_refs
     ):
-        raise RenameRefused(
-            f"Cannot rename to '{shown(new_name)}': the node type is written as an "
-            "element name, and this is not a valid XML name"
+        _refuse_new_name(
+            new_name,
+            "the node type is written as an element name, and this is not a valid XML name",
         )
     if new_name == sym[-1]:
         return
     if sym[0] != "port" and new_name in BUILTINS:
-        raise RenameRefused(
-            f"Cannot rename to '{shown(new_name)}': it is a built-in node type of "
-            "BehaviorTree.CPP, and trees and node types share one namespace"
+        _refuse_new_name(
+            new_name,
+            "it is a built-in node type of BehaviorTree.CPP, and trees and node types share "
+            "one namespace",
         )
-    if new_name in taken_names(model, sym, (d.model for d in others.values())):
+    if taken is None:
+        taken = taken_names(model, sym, (d.model for d in others.values()))
+    if new_name in taken:
         if sym[0] == "port":
             owner = f"tree '{sym[2]}'" if sym[1] == "tree" else f"node type '{sym[2]}'"
-            raise RenameRefused(
-                f"Cannot rename to '{shown(new_name)}': the {owner} already has a port "
-                "with that name"
-            )
-        raise RenameRefused(
-            f"Cannot rename to '{shown(new_name)}': a tree or node type with that name "
-            "already exists (trees and node types share one namespace)"
+            _refuse_new_name(new_name, f"the {owner} already has a port with that name")
+        _refuse_new_name(
+            new_name,
+            "a tree or node type with that name already exists (trees and node types share "
+            "one namespace)",
         )
 
 
@@ -697,37 +721,38 @@ _SCRIPT_IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 def _check_key_name(new_name: str, in_script: bool) -> None:
     """Refuse a new name that cannot be a blackboard key where the key is written."""
-
-    def refuse(why: str) -> None:
-        raise RenameRefused(f"Cannot rename to '{shown(new_name)}': {why}")
-
     if not new_name:
-        refuse("a blackboard key cannot be empty")
+        _refuse_new_name(new_name, "a blackboard key cannot be empty")
     if "{" in new_name or "}" in new_name:
-        refuse("a blackboard key cannot contain '{' or '}', which delimit it in a port value")
+        _refuse_new_name(
+            new_name,
+            "a blackboard key cannot contain '{' or '}', which delimit it in a port value",
+        )
     if new_name != new_name.strip(" \t\r\n"):
-        refuse("BehaviorTree.CPP trims the white space around a key")
+        _refuse_new_name(new_name, "BehaviorTree.CPP trims the white space around a key")
     if new_name == "=":
-        refuse("'{=}' stands for the key named like its port")
+        _refuse_new_name(new_name, "'{=}' stands for the key named like its port")
     if new_name.startswith("@"):
-        refuse(
+        _refuse_new_name(
+            new_name,
             "a key starting with '@' is a key of the root blackboard; a rename cannot move "
-            "a key there"
+            "a key there",
         )
     if any(c < " " or c == "\x7f" for c in new_name):
-        refuse("a blackboard key cannot contain control characters")
+        _refuse_new_name(new_name, "a blackboard key cannot contain control characters")
     if in_script and (
         _SCRIPT_IDENTIFIER_RE.fullmatch(new_name) is None or new_name in ("true", "false")
     ):
-        refuse(
+        _refuse_new_name(
+            new_name,
             "the key is used in a script, where it must be an identifier: an ASCII letter or "
-            "'_', then ASCII letters, digits or '_' (and not 'true' or 'false')"
+            "'_', then ASCII letters, digits or '_' (and not 'true' or 'false')",
         )
 
 
-def _check_key_safety(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
-    """Refuse a key rename that would not change every use of the key, or that would make
-    it another key, in the blackboards of the running program."""
+def _check_key_movable(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
+    """Refuse a key rename that would not change every use of the key in the blackboards of
+    the running program (whatever the new name)."""
     key = targets.key
     homes = targets.homes
     for t, u in targets.uses:
@@ -760,21 +785,31 @@ def _check_key_safety(ws: _Workspace, targets: _KeyTargets, new_name: str) -> No
                 f"Cannot rename '{shown(key)}': '@{shown(key)}' in {users[0].shown()} is this "
                 f"key (of the root blackboard) when {root.shown()} runs as the main tree"
             )
+
+
+def _check_no_merge(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
+    """Refuse a new name that is already a key of the trees owning the key (or of a tree
+    sharing it): the two keys would become one."""
+    if new_name == targets.key:
+        return
+    for t in targets.homes:
         group = ws.shared(t, new_name)
         for o in group:
             if mentions(ws.keys(o), new_name) or ws.has_port(o, new_name):
                 how = "" if o == t else f", shared with {t.shown()} through _autoremap"
-                raise RenameRefused(
-                    f"Cannot rename to '{shown(new_name)}': {o.shown()} already uses a key "
-                    f"'{shown(new_name)}'{how}; the two keys would become one"
+                _refuse_new_name(
+                    new_name,
+                    f"{o.shown()} already uses a key '{shown(new_name)}'{how}; the two keys "
+                    "would become one",
                 )
         root = next((o for o in group if ws.may_be_root(o)), None)
         users = ws.root_users(new_name) if root is not None else []
         if root is not None and users:
-            raise RenameRefused(
-                f"Cannot rename to '{shown(new_name)}': '@{shown(new_name)}' in "
-                f"{users[0].shown()} is that key (of the root blackboard) when {root.shown()} "
-                "runs as the main tree; the two keys would become one"
+            _refuse_new_name(
+                new_name,
+                f"'@{shown(new_name)}' in {users[0].shown()} is that key (of the root "
+                f"blackboard) when {root.shown()} runs as the main tree; the two keys would "
+                "become one",
             )
 
 
@@ -797,31 +832,62 @@ def _spelled_out(d: Document, r: NameRef) -> TextEdit | None:
     return _key_edit(k, k.key)
 
 
-_EditsByPath = dict[str | None, dict[tuple[int, int], TextEdit]]
+class _Edits:
+    """Edits by path (``None``: the document), one per span.  A written-out key gives way
+    to any other edit of its span."""
+
+    def __init__(self) -> None:
+        self.by_path: dict[str | None, dict[tuple[int, int], TextEdit]] = {}
+        self.written_out: set[tuple[str | None, int, int]] = set()
+
+    def add(self, path: str | None, e: TextEdit, written_out: bool = False) -> None:
+        spans = self.by_path.setdefault(path, {})
+        span = (e.start, e.end)
+        if written_out:
+            if span in spans and (path, e.start, e.end) not in self.written_out:
+                return
+            self.written_out.add((path, e.start, e.end))
+        else:
+            self.written_out.discard((path, e.start, e.end))
+        spans[span] = e
+
+    def plan(self) -> RenamePlan:
+        own = self.by_path.get(None, {})
+        return RenamePlan(
+            tuple(sorted(own.values())),
+            {
+                path: tuple(sorted(e.values()))
+                for path, e in self.by_path.items()
+                if path is not None and e
+            },
+            frozenset(self.written_out),
+        )
 
 
-def _add(by_path: _EditsByPath, path: str | None, e: TextEdit) -> None:
-    by_path.setdefault(path, {})[(e.start, e.end)] = e
+def combined(plans: Iterable[RenamePlan]) -> RenamePlan:
+    """Several renames (of different names) as one: one edit per span, where an edit that
+    only writes out a key gives way to another rename's edit of the same span."""
+    edits = _Edits()
+    for p in plans:
+        out = p.written_out
+        for e in p.edits:
+            edits.add(None, e, (None, e.start, e.end) in out)
+        for path, file_edits in p.other_edits.items():
+            for e in file_edits:
+                edits.add(path, e, (path, e.start, e.end) in out)
+    return edits.plan()
 
 
-def _plan(by_path: _EditsByPath) -> RenamePlan:
-    own = by_path.pop(None, {})
-    return RenamePlan(
-        tuple(sorted(own.values())),
-        {path: tuple(sorted(e.values())) for path, e in by_path.items() if path is not None and e},
-    )
-
-
-def _port_edits(ws: _Workspace, sym: Symbol, new_name: str) -> _EditsByPath:
+def _port_edits(ws: _Workspace, sym: Symbol, new_name: str) -> _Edits:
     """Renaming a port: its names, and the ``{=}`` values of renamed attributes spelled out."""
-    by_path: _EditsByPath = {}
+    edits = _Edits()
     for path, d, r in ws.refs(sym):
         fix = _spelled_out(d, r)
         if fix is not None:
-            _add(by_path, path, fix)
+            edits.add(path, fix, written_out=True)
         for e in rename_edits([r], new_name):
-            _add(by_path, path, e)
-    return by_path
+            edits.add(path, e)
+    return edits
 
 
 def _rename_keys(
@@ -831,11 +897,63 @@ def _rename_keys(
         _check_key_name(new_name, any(u.form == KeyForm.SCRIPT for _, u in targets.uses))
     if targets.port_refs and not port_checked:
         _check_new_name(targets.port_refs[0][2], new_name, ws.doc.model, ws.others)
-    _check_key_safety(ws, targets, new_name)
-    by_path = _port_edits(ws, targets.port, new_name) if targets.port is not None else {}
+    _check_key_movable(ws, targets, new_name)
+    _check_no_merge(ws, targets, new_name)
+    edits = _port_edits(ws, targets.port, new_name) if targets.port is not None else _Edits()
     for t, u in targets.uses:
-        _add(by_path, t.path, _key_edit(u, new_name))
-    return _plan(by_path)
+        edits.add(t.path, _key_edit(u, new_name))
+    return edits.plan()
+
+
+class Renamer:
+    """Renames of the names of one document, by the rules of :func:`rename`, with the other
+    workspace documents (by path).  One renamer serves many renames of the same documents
+    (the name fixes use it so): what it reads of their trees is read once."""
+
+    def __init__(self, doc: Document, others: Mapping[str, Document] | None = None) -> None:
+        self._ws = _Workspace(doc, others or {})
+
+    def plan(
+        self,
+        ref: NameRef,
+        new_name: str,
+        *,
+        keys: bool = True,
+        taken: Collection[str] | None = None,
+    ) -> RenamePlan:
+        """The edits renaming the name token ``ref`` of the document (and every reference to
+        its symbol) to ``new_name``, as :func:`rename` makes them; raises
+        :class:`RenameRefused` like it.
+
+        ``keys=False`` leaves the blackboard keys of a tree's port as they are: only the
+        port's own names change (a ``{=}`` of a renamed attribute is still written out), and
+        only the new name is checked, also against the keys of the tree.  ``taken`` are the
+        names the new one must avoid in its namespace, when the caller knows them already
+        (by default they are collected from the documents)."""
+        ws = self._ws
+        _check_new_name(ref, new_name, ws.doc.model, ws.others, taken)
+        sym = ref.symbol
+        if sym is None:
+            return RenamePlan(tuple(rename_edits([ref], new_name)))
+        if _is_tree_port(sym):
+            targets = _port_targets(ws, sym)
+            if keys:
+                return _rename_keys(ws, targets, new_name, port_checked=True)
+            _check_no_merge(ws, targets, new_name)
+            return _port_edits(ws, sym, new_name).plan()
+        if sym[0] == "port":
+            return _port_edits(ws, sym, new_name).plan()
+        return RenamePlan(
+            tuple(rename_edits(ws.doc.model.refs_to(sym), new_name)),
+            other_file_edits(sym, new_name, {p: d.model for p, d in ws.others.items()}),
+        )
+
+    def key_plan(self, key: KeyRef, new_name: str) -> RenamePlan:
+        """The edits renaming the blackboard key used at ``key`` (a use in the document)
+        in its tree, and the port it is, as :func:`rename` makes them."""
+        ws = self._ws
+        home = _Tree(None, ws.doc, key.tree)
+        return _rename_keys(ws, _key_targets(ws, home, key.key), new_name)
 
 
 def rename(
@@ -877,31 +995,21 @@ def rename(
       space around it, is ``=``, starts with ``@`` or, for a key used in a script, is not an
       identifier (``[A-Za-z_][A-Za-z0-9_]*``, not ``true`` or ``false``); for a key that
       is a port too, the port name rules apply as well.
+
+    A refusal of the new name itself (a rule it breaks, a name already taken in its
+    namespace, two keys it would merge) carries :attr:`RenameRefused.new_name`: another
+    name may do.
     """
-    others = others or {}
     target = prepare_rename(doc, offset)
     if target is None:
         return None
-    ws = _Workspace(doc, others)
+    renamer = Renamer(doc, others)
     if target.key is not None:
-        k = target.key
-        return _rename_keys(ws, _key_targets(ws, _Tree(None, doc, k.tree), k.key), new_name)
+        return renamer.key_plan(target.key, new_name)
     ref = target.ref
     if ref is None:  # pragma: no cover - a target is a name or a key
         return None
-    model = doc.model
-    _check_new_name(ref, new_name, model, others)
-    sym = ref.symbol
-    if sym is None:
-        return RenamePlan(tuple(rename_edits([ref], new_name)))
-    if _is_tree_port(sym):
-        return _rename_keys(ws, _port_targets(ws, sym), new_name, port_checked=True)
-    if sym[0] == "port":
-        return _plan(_port_edits(ws, sym, new_name))
-    return RenamePlan(
-        tuple(rename_edits(model.refs_to(sym), new_name)),
-        other_file_edits(sym, new_name, {p: d.model for p, d in others.items()}),
-    )
+    return renamer.plan(ref, new_name)
 
 
 # --- document symbols ---------------------------------------------------------------------

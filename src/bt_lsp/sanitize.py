@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Collection
+from collections.abc import Set as AbstractSet
 from typing import Final
 
 from bt_lsp.lazyre import LazyPattern
@@ -166,7 +167,7 @@ def _instance_gap(match: re.Match[str]) -> str:
 def _unique(base: str, kind: NameKind, taken: Collection[str]) -> str:
     if base not in taken or (kind is NameKind.INSTANCE and not base):
         return base
-    lookup: Collection[str] = taken if isinstance(taken, (set, frozenset)) else set(taken)
+    lookup: Collection[str] = taken if isinstance(taken, AbstractSet) else set(taken)
     stem = base.rstrip("_") or base
     number = 2
     while f"{stem}_{number}" in lookup:

@@ -338,9 +338,10 @@ class Workspace:
         out.sort(key=lambda d: (d.start, d.end, d.code))
         return limited(out)
 
-    def other_models(self, path: Path) -> dict[str, Model]:
-        """The models of the other BT documents of the workspace, by path (for renames)."""
-        return {str(p): d.model for p, d in self.bt_documents() if p != path}
+    def other_documents(self, path: Path) -> dict[str, Document]:
+        """The other BT documents of the workspace (open ones as edited), by path: what a
+        rename or a name fix of the document at ``path`` reaches and checks."""
+        return {str(p): d for p, d in self.bt_documents() if p != path}
 
     def dependents(self, path: Path) -> list[Path]:
         """Open documents whose include closure contains ``path``."""

@@ -409,3 +409,60 @@ async def test_stale_resolve_is_harmless(client: BtClient) -> None:
     await client.diags(uri, 2)
     resolved = await client.code_action_resolve_async(action)
     assert resolved.edit is None or workspace_edits(resolved.edit, uri) == []
+
+
+# Tree "Greet" has a bad port "who.m": the call in "Main" gives it with "{=}" (Main's key
+# "who.m"), and inside Greet it is the key {who.m}.  😋 (two UTF-16 code units, four UTF-8
+# bytes) sits before the key on its line, so that its columns are in the client's encoding.
+TREE_PORT = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main">\n'
+    '    <SubTree ID="Greet" who.m="{=}"/>\n'
+    "  </BehaviorTree>\n"
+    '  <BehaviorTree ID="Greet">\n'
+    '    <SetBlackboard name="😋" output_key="out" value="{who.m}"/>\n'
+    "  </BehaviorTree>\n"
+    "  <TreeNodesModel>\n"
+    '    <SubTree ID="Greet"><input_port name="who.m"/></SubTree>\n'
+    "  </TreeNodesModel>\n"
+    "</root>\n"
+)
+
+
+async def test_tree_port_fix_renames_its_key_inside_the_tree(client: BtClient) -> None:
+    text = TREE_PORT
+    uri = client.open(text)
+    await client.diags(uri, 1)
+    action = await _preferred(client, uri, text, "who.m", 2)  # on the declaration
+    assert action.title == "Rename 'who.m' to 'who_m' (4 places)"
+    action = await client.with_edit(action)
+
+    def edit(needle: str, into: int, length: int, new: str) -> types.TextEdit:
+        start = text.index(needle) + into
+        return types.TextEdit(range=client.range(text, start, start + length), new_text=new)
+
+    expected = [
+        edit('who.m="{=}"', 0, 5, "who_m"),  # the call's attribute ...
+        edit('who.m="{=}"', 8, 1, "who.m"),  # ... whose "{=}" keeps Main's key, written out
+        edit("{who.m}", 1, 5, "who_m"),  # the key inside Greet
+        edit('name="who.m"', 6, 5, "who_m"),  # the declaration
+    ]
+    found = action.edit
+    assert found is not None
+    ws = client.profile.capabilities().workspace
+    if ws and ws.workspace_edit and ws.workspace_edit.document_changes:
+        assert not found.changes and found.document_changes is not None
+        (dc,) = found.document_changes
+        assert isinstance(dc, types.TextDocumentEdit)
+        assert dc.text_document == types.OptionalVersionedTextDocumentIdentifier(uri=uri, version=1)
+        assert list(dc.edits) == expected
+    else:
+        assert not found.document_changes and found.changes is not None
+        assert {u: list(e) for u, e in found.changes.items()} == {uri: expected}
+    new = await _apply(client, uri, text, action)
+    assert new == (
+        text.replace('who.m="{=}"', 'who_m="{who.m}"')
+        .replace('value="{who.m}"', 'value="{who_m}"')
+        .replace('name="who.m"', 'name="who_m"')
+    )
+    assert names_only(await _send_edits(client, uri, 2, text, action)) == []

@@ -20,8 +20,7 @@ from typing import TYPE_CHECKING
 
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.edits import TextEdit
-from bt_lsp.fixes import Fix, escape_value
+from bt_lsp.edits import Fix, TextEdit, escape_value
 from bt_lsp.model import EXPLICIT_TAGS, Element, Model, Zone
 from bt_lsp.names import is_allowed_port_name
 from bt_lsp.scanner import UNESCAPED

@@ -17,6 +17,7 @@ from pygls.uris import from_fs_path
 from bt_lsp import semantics
 from bt_lsp.context import Context
 from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.document import Document
 from bt_lsp.edits import TextEdit
 from bt_lsp.fixes import Fix, fix_all, fixes_for
 from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit
@@ -60,9 +61,12 @@ def _workspace_edit(
     return workspace_edit(per_uri, ls.versioned_edits)
 
 
+def _others(ls: BtServer, od: OpenDocument) -> dict[str, Document]:
+    return ls.project.other_documents(normalize(od.path)) if od.path is not None else {}
+
+
 def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
-    others = ls.project.other_models(od.path) if od.path is not None else {}
-    fixes = fixes_for(od.doc.model, diag, others)
+    fixes = fixes_for(od.doc, diag, _others(ls, od))
     if not diag.is_name_rule:
         ctx = (
             ls.project.context_for(od.path, od.doc)
@@ -74,7 +78,7 @@ def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
 
 
 def _fix_all_edits(ls: BtServer, od: OpenDocument) -> list[TextEdit]:
-    return fix_all(od.doc.model, ls.diagnostics_of(od))
+    return fix_all(od.doc, ls.diagnostics_of(od)).edits
 
 
 def register(server: BtServer) -> None:
