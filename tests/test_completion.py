@@ -252,6 +252,18 @@ def test_keys_used_in_the_tree_after_a_brace() -> None:
     assert item(found, "target").insert == "target"
 
 
+def test_keys_include_those_of_scripts_and_same_name_ports() -> None:
+    found, _, _ = run(
+        here(
+            "<Script code=\"counter := counter + 1; msg := '{quoted}'\"/>"
+            '<MoveBase goal="{=}"/><MoveBase goal="{⟦‸⟧}"/>'
+        )
+    )
+    assert labels(found) == ["counter", "goal", "msg", "res", "target"]  # not "quoted"
+    assert item(found, "counter").detail == "used in a script of this tree"
+    assert item(found, "goal").detail == "used in this tree"
+
+
 def test_keys_include_the_ports_of_the_tree() -> None:
     text = DOC.format(here="").replace(
         '<Sleep msec="{delay}"/>', '<Sleep msec="{delay}"/><Sleep msec="{‸'

@@ -9,7 +9,8 @@ and returns plain items with the span they replace (code-point offsets).  Contex
 * an attribute name in a start tag: the ports of the node and the reserved attributes;
 * an attribute value: tree IDs in ``<SubTree ID>`` and ``main_tree_to_execute``, node types
   in ``<Action|Condition|Control|Decorator ID>``, ``true``/``false`` and statuses for bool
-  and ``NodeStatus`` ports, and after ``{`` the blackboard keys used in the tree.
+  and ``NodeStatus`` ports, and after ``{`` the blackboard keys used in the tree (in port
+  values and scripts).
 """
 
 from __future__ import annotations
@@ -18,12 +19,13 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from bt_lsp.blackboard import KeyForm, key_uses
 from bt_lsp.builtins import BUILTINS, PortModel
 from bt_lsp.context import Context
 from bt_lsp.document import Document
 from bt_lsp.model import EXPLICIT_TAGS, Element, Model, Zone
 from bt_lsp.names import POSTCONDITIONS, PRECONDITIONS
-from bt_lsp.navigation import blackboard_keys, enclosing_tree, ports_of
+from bt_lsp.navigation import enclosing_tree, ports_of
 from bt_lsp.scanner import Attr, Kind, Token
 
 __all__ = ["Completions", "Item", "ItemKind", "complete", "ports_markdown"]
@@ -559,9 +561,10 @@ def _keys(
     tree = enclosing_tree(model, idx)
     seen: dict[str, str] = {}
     if tree >= 0:
-        for k in blackboard_keys(doc, tree):
+        for k in key_uses(doc, tree):
             if not (k.start <= offset <= k.end):
-                seen.setdefault(k.key, "used in this tree")
+                where = "a script of " if k.form == KeyForm.SCRIPT else ""
+                seen.setdefault(k.key, f"used in {where}this tree")
         tid = _tree_id(model, tree)
         decl = ctx.subtree_models.get(tid) if tid else None
         for p in decl.ports if decl is not None else ():
