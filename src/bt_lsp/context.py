@@ -245,6 +245,8 @@ class Context:
 
 # --- extraction ---------------------------------------------------------------------------
 
+_new = tuple.__new__
+
 # Model -> facts, keyed by document; a cached entry is valid while the document's model is
 # the same object (a document builds a new model after every edit).
 _CACHE: weakref.WeakKeyDictionary[Document, tuple[Model, str | None, DocumentFacts]] = (
@@ -301,7 +303,8 @@ def _moved(
     if not local.models and not local.subtree_models and len(local.trees) == 1:
         t = local.trees[0]  # the usual section: one tree
         spans = tuple([(s + o, e + o) for s, e in t.call_spans]) if t.call_spans else ()
-        return (TreeDecl(t.id, path, t.start + o, t.end + o, t.calls, spans),), (), ()
+        # Made without the named tuple's constructor: every edit moves every later section.
+        return (_new(TreeDecl, (t.id, path, t.start + o, t.end + o, t.calls, spans)),), (), ()
     return (
         tuple(
             TreeDecl(
