@@ -199,17 +199,20 @@ def check_recursion(st: State) -> None:
     ctx = st.ctx
     if not ctx.trees:
         return
-    # The definition BehaviorTree.CPP uses for each ID: the last one loaded.
-    graph: dict[str, TreeDecl] = {tid: decls[-1] for tid, decls in ctx.trees.items()}
-    if not any(d.calls for d in graph.values()):
+    # The definition BehaviorTree.CPP uses for each ID (the last one loaded), for the trees
+    # that call others: a tree that calls none cannot be on a cycle.
+    graph: dict[str, TreeDecl] = {
+        tid: decls[-1] for tid, decls in ctx.trees.items() if decls[-1].calls
+    }
+    if not graph:
         return
     order: list[str] = []
     root = st.model.root
     main = root.value("main_tree_to_execute") if root is not None else None
     if main:
         order.append(main)
-    own = [d.id for decls in ctx.trees.values() for d in decls if ctx.is_own(d)]
-    order.extend(own)
+    trees = ctx.trees
+    order.extend(tid for tid in graph if any(ctx.is_own(d) for d in trees[tid]))
     order.extend(graph)
     state: dict[str, int] = {}  # 1 on the stack, 2 done
     flagged: set[tuple[int, int]] = set()
