@@ -94,9 +94,9 @@ class State:
     _types: dict[str, Resolved | None] = field(default_factory=dict)
     _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
     # Models resolved from declarations, shared by the runs over the sections of one check:
-    # by ID, with the declaration they were made from (still looked up in each run, so that
-    # the run records what it read).
-    made: dict[str, tuple[object, Resolved]] = field(default_factory=dict)
+    # by ("model" | "subtree", ID), with the declaration they were made from (still looked
+    # up in each run, so that the run records what it read).
+    made: dict[tuple[str, str], tuple[object, Resolved]] = field(default_factory=dict)
     # A run over one section of the document (see sections.py) has the section's model and
     # text, in coordinates that start at document offset ``origin``.
     origin: int = 0
@@ -133,7 +133,7 @@ class State:
             return self._types[type_id]
         decl = self.ctx.models.get(type_id)
         res: Resolved | None = None
-        made = self.made.get(type_id)
+        made = self.made.get(("model", type_id))
         if made is not None and made[0] is decl:
             res = made[1]
         elif decl is not None:
@@ -144,7 +144,7 @@ class State:
             res = Resolved(
                 decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
             )
-            self.made[type_id] = (decl, res)
+            self.made["model", type_id] = (decl, res)
         self._types[type_id] = res
         return res
 
@@ -154,7 +154,7 @@ class State:
             return self._subtrees[tree_id]
         decl = self.ctx.subtree_models.get(tree_id)
         res = None
-        made = self.made.get("\0" + tree_id)  # a key no node type has
+        made = self.made.get(("subtree", tree_id))
         if made is not None and made[0] is decl:
             res = made[1]
         elif decl is not None:
@@ -162,7 +162,7 @@ class State:
             required = tuple(p.name for p in decl.ports if not p.default)
             ports = {p.name: p for p in decl.ports}
             res = Resolved(decl.id, "subtree", "SubTree", ports, 0, 0, required)
-            self.made["\0" + tree_id] = (decl, res)
+            self.made["subtree", tree_id] = (decl, res)
         self._subtrees[tree_id] = res
         return res
 

@@ -9,7 +9,7 @@ from lsprotocol import types
 
 from bt_lsp.completion import ItemKind, complete
 from bt_lsp.server.convert import to_range
-from bt_lsp.server.lookup import context_of
+from bt_lsp.server.lookup import context_of, offset_of
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -49,7 +49,7 @@ def register(server: BtServer) -> None:
             return None
         enc = ls.encoding
         lines = od.doc.lines
-        offset = lines.offset(params.position.line, params.position.character, enc)
+        offset = offset_of(ls, od, params.position)
         found = complete(od.doc, offset, context_of(ls, od))
         if found is None:
             return types.CompletionList(is_incomplete=False, items=[])

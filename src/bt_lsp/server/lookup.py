@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from lsprotocol import types
 from pygls.uris import from_fs_path, to_fs_path
 
 from bt_lsp.context import Context
@@ -29,6 +30,11 @@ class Source:
     uri: str
     doc: Document
     version: int | None
+
+
+def offset_of(ls: BtServer, od: OpenDocument, pos: types.Position) -> int:
+    """The code-point offset of a position in the client's encoding."""
+    return od.doc.lines.offset(pos.line, pos.character, ls.encoding)
 
 
 def path_of(od: OpenDocument) -> Path | None:

@@ -23,6 +23,7 @@ from bt_lsp.server.lookup import (
     Source,
     context_of,
     includes_of,
+    offset_of,
     source_at,
     workspace_sources,
 )
@@ -90,10 +91,6 @@ def catalog_file() -> tuple[str, LineIndex] | None:
 
 
 # --- conversions --------------------------------------------------------------------------
-
-
-def _offset(ls: BtServer, od: OpenDocument, pos: types.Position) -> int:
-    return od.doc.lines.offset(pos.line, pos.character, ls.encoding)
 
 
 def _locations(
@@ -164,7 +161,7 @@ def register(server: BtServer) -> None:
         sources = workspace_sources(ls, od)
         places = navigation.definition(
             od.doc,
-            _offset(ls, od, params.position),
+            offset_of(ls, od, params.position),
             {k: s.doc for k, s in sources.items()},
             ctx=context_of(ls, od),
             includes=includes_of(ls, od),
@@ -179,7 +176,7 @@ def register(server: BtServer) -> None:
         sources = workspace_sources(ls, od)
         places = navigation.references(
             od.doc,
-            _offset(ls, od, params.position),
+            offset_of(ls, od, params.position),
             {k: s.doc for k, s in sources.items()},
             include_declaration=params.context.include_declaration,
         )
@@ -203,7 +200,7 @@ def register(server: BtServer) -> None:
                 if h.write
                 else types.DocumentHighlightKind.Read,
             )
-            for h in navigation.highlights(od.doc, _offset(ls, od, params.position))
+            for h in navigation.highlights(od.doc, offset_of(ls, od, params.position))
         ]
 
     @server.feature(types.TEXT_DOCUMENT_PREPARE_RENAME)
@@ -214,7 +211,7 @@ def register(server: BtServer) -> None:
         if od is None or not od.is_bt:
             return None
         try:
-            target = navigation.prepare_rename(od.doc, _offset(ls, od, params.position))
+            target = navigation.prepare_rename(od.doc, offset_of(ls, od, params.position))
         except RenameRefused as e:
             raise RequestFailed(e.message) from None
         if target is None:
@@ -233,7 +230,7 @@ def register(server: BtServer) -> None:
         try:
             plan = navigation.rename(
                 od.doc,
-                _offset(ls, od, params.position),
+                offset_of(ls, od, params.position),
                 params.new_name,
                 {k: s.doc for k, s in sources.items()},
             )
@@ -299,7 +296,7 @@ def register(server: BtServer) -> None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
-        spans = navigation.linked_editing_ranges(od.doc, _offset(ls, od, params.position))
+        spans = navigation.linked_editing_ranges(od.doc, offset_of(ls, od, params.position))
         if spans is None:
             return None
         enc = ls.encoding
