@@ -368,6 +368,40 @@ def python_floor_seconds(text: str) -> float:
     return t1 - t0
 
 
+# The phases of a first analysis, as the server runs them on open (each one's result is
+# kept on the document and used by the next).
+PHASES = ("scan", "model", "own diagnostics", "workspace context", "semantic rules")
+
+
+def phase_seconds(text: str, path: Path) -> dict[str, float]:
+    """One first analysis of ``text`` (as if opened at ``path``, in its folder), in the
+    benchmark process, timed by phase: where the time of an open goes, without the
+    protocol (reading the JSON, converting positions, writing the diagnostics)."""
+    from bt_lsp import semantics
+    from bt_lsp.document import Document
+    from bt_lsp.workspace import Workspace
+
+    ws = Workspace([str(path.parent)])
+    gc.collect()
+    gc.disable()  # as the server does for these phases (bt_lsp.bulk)
+    try:
+        t0 = time.perf_counter()
+        doc = Document(text, str(path))
+        t1 = time.perf_counter()
+        doc.model  # noqa: B018 (built when first asked for)
+        t2 = time.perf_counter()
+        doc.diagnostics  # noqa: B018
+        t3 = time.perf_counter()
+        ws.open(path, doc)
+        ctx = ws.context_for(path, doc)
+        t4 = time.perf_counter()
+        semantics.check(doc, ctx)
+        t5 = time.perf_counter()
+    finally:
+        gc.enable()
+    return dict(zip(PHASES, (t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4), strict=True))
+
+
 def corpus_files(corpus: Path) -> list[Path]:
     return sorted(p for p in corpus.rglob("*.xml") if p.is_file())
 
@@ -431,6 +465,7 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
             doc = make_doc(size, folder, args.edits, args.seed)
             lx: list[float] = []
             floor: list[float] = []
+            phases: list[dict[str, float]] = []
             sessions: list[Session] = []
             for r in range(args.repeat):
                 # Interleave everything, so that a busy moment of the machine hits all.
@@ -441,13 +476,14 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
                 startups.append(s.startup)
                 lx.append(lxml_parse_seconds(doc.text.encode()))
                 floor.append(python_floor_seconds(doc.text))
+                phases.append(phase_seconds(doc.text, doc.path))
                 print(
                     f"  {doc.size} bytes, run {r + 1}/{args.repeat}: open {ms(s.open)} ms, "
                     f"edit {ms(statistics.median(s.edits))} ms, lxml "
                     f"{ms(statistics.median(lx))} ms",
                     file=sys.stderr,
                 )
-            results["sizes"][str(size)] = _size_result(doc, lx, floor, sessions)
+            results["sizes"][str(size)] = _size_result(doc, lx, floor, phases, sessions)
         results["startup"] = {"bt-lsp": summary(startups), "bare pygls": summary(bare)}
         results["startup"]["samples"] = {"bt-lsp": startups, "bare pygls": bare}
         if args.corpus and not args.no_check:
@@ -469,7 +505,11 @@ async def run(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _size_result(
-    doc: Doc, lx: list[float], floor: list[float], sessions: list[Session]
+    doc: Doc,
+    lx: list[float],
+    floor: list[float],
+    phases: list[dict[str, float]],
+    sessions: list[Session],
 ) -> dict[str, Any]:
     def cat(get: Callable[[Session], list[float]]) -> list[float]:
         return [x for s in sessions for x in get(s)]
@@ -482,6 +522,7 @@ def _size_result(
         "quick fix": cat(lambda s: s.quick_fix),
         "fix-all": cat(lambda s: s.fix_all),
         "hover": cat(lambda s: s.hover),
+        **{f"phase: {k}": [p[k] for p in phases] for k in PHASES},
     }
     kib = 1024
     return {
@@ -534,6 +575,13 @@ def table(results: dict[str, Any]) -> str:
         ("hover", "hover (ms)", False),
     ):
         rows.append(f"| {label} | " + " | ".join(cell(s, key, ratio) for s in sizes) + " |")
+    # Where the time of an open goes (in the benchmark process, without the protocol).
+    for key in PHASES:
+        rows.append(
+            f"| open, phase: {key} (ms, × lxml) | "
+            + " | ".join(cell(s, f"phase: {key}", True) for s in sizes)
+            + " |"
+        )
     rows.append(
         "| server CPU per edit (ms) | "
         + " | ".join(f"{ms(s['edit cpu']['median'])}" for s in sizes)

@@ -52,6 +52,15 @@ def test_python_floor_reads_every_element_and_attribute() -> None:
     assert bench_run.python_floor_seconds(g.text) > 0
 
 
+def test_phases_time_a_whole_first_analysis(tmp_path: Path) -> None:
+    g = bench_generate.generate(20_000, seed=3)
+    path = tmp_path / "doc.xml"
+    path.write_text(g.text, encoding="utf-8")
+    phases = bench_run.phase_seconds(g.text, path)
+    assert list(phases) == list(bench_run.PHASES)
+    assert all(t > 0 for t in phases.values())
+
+
 def test_generator_command_line(tmp_path: Path) -> None:
     out = tmp_path / "g.xml"
     assert bench_generate.main(["12K", str(out), "--seed", "2"]) == 0
@@ -108,6 +117,8 @@ def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str
     printed = capsys.readouterr().out
     assert "| open → first diagnostics" in printed and "Start to `initialize`" in printed
     assert "| Python reads every tag" in printed
+    for phase in bench_run.PHASES:
+        assert f"| open, phase: {phase} (ms, × lxml) |" in printed
     results = json.loads(out.read_text(encoding="utf-8"))
     (size,) = results["sizes"].values()
     samples = size["samples"]
