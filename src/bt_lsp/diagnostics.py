@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 from typing import TYPE_CHECKING, Any
 
 from bt_lsp.codes import CODES, Severity
@@ -41,22 +40,28 @@ def make(
     return Diagnostic(start, end, code, message, CODES[code].severity, data)
 
 
-@lru_cache(maxsize=16384)
-def _cached_violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
-    return check_name(text, kind, declaration=declaration)
+# The violations of each name text, per role (a role decides the kind and whether the
+# name is declared): names repeat (every use of a node type or port), and a dict keyed by
+# the text alone is the cheapest lookup for the loop below.  Bounded.
+_VIOLATIONS: dict[Role, dict[str, tuple[Violation, ...]]] = {role: {} for role in Role}
+_MAX_CACHED = 16384
 
 
-def _violations(text: str, kind: NameKind, declaration: bool) -> tuple[Violation, ...]:
-    # Model and port names repeat; instance names rarely do (and their rule is quick).
-    if kind == NameKind.INSTANCE:
-        return check_name(text, kind, declaration=declaration)
-    return _cached_violations(text, kind, declaration)
+def _violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
+    cache = _VIOLATIONS[role]
+    found = cache.get(text)
+    if found is None:
+        found = check_name(text, kind, declaration=role is Role.PORT_DECL)
+        if len(cache) >= _MAX_CACHED:
+            cache.clear()
+        cache[text] = found
+    return found
 
 
 def name_violations(ref: NameRef) -> tuple[Violation, ...]:
     if ref.kind is None:
         return ()
-    return _violations(ref.text, ref.kind, ref.role == Role.PORT_DECL)
+    return _violations(ref.text, ref.kind, ref.role)
 
 
 def name_diagnostics(model: Model) -> list[Diagnostic]:
@@ -65,16 +70,14 @@ def name_diagnostics(model: Model) -> list[Diagnostic]:
 
 def _ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
     out: list[Diagnostic] = []
-    port_decl, instance = Role.PORT_DECL, NameKind.INSTANCE
+    caches = _VIOLATIONS
     # Unpacked rather than read by field: this runs for every name of a document.
     for start, end, text, kind, role, _symbol, _element, _quote in refs:
         if kind is None:
             continue
-        found = (
-            check_name(text, kind, declaration=False)
-            if kind is instance
-            else _cached_violations(text, kind, role is port_decl)
-        )
+        found = caches[role].get(text)
+        if found is None:
+            found = _violations(text, kind, role)
         for v in found:
             out.append(
                 make(

@@ -268,11 +268,11 @@ class Section:
         refs: list[NameRef] = []
         root = self.root
         if root is not None:
-            refs.extend(_name_refs(root, 0, None))
+            _name_refs(root, 0, None, refs)
         els = self.elements
         for i, el in enumerate(els, 1):
             p = el.parent
-            refs.extend(_name_refs(el, i, els[p - 1] if p > 0 else None))
+            _name_refs(el, i, els[p - 1] if p > 0 else None, refs)
             if (
                 el.end_name_start >= 0
                 and el.zone == _ZONE_NODE
@@ -827,39 +827,53 @@ def _port_symbols(owner: Symbol) -> dict[str, Symbol]:
 
 
 def _value_ref(
-    el: Element, idx: int, a: Attr, kind: NameKind | None, role: Role, symbol: Symbol | None
-) -> NameRef | None:
-    if a.value is None:
-        return None
-    return _new(
-        NameRef,
-        (
-            el.token_start + a.value_start,
-            el.token_start + a.value_end,
-            a.value,
-            kind,
-            role,
-            _symbol(symbol) if symbol is not None else None,
-            idx,
-            a.quote,
-        ),
-    )
+    out: list[NameRef],
+    el: Element,
+    idx: int,
+    a: Attr,
+    kind: NameKind | None,
+    role: Role,
+    symbol: Symbol | None,
+) -> None:
+    if a.value is not None:
+        out.append(
+            _new(
+                NameRef,
+                (
+                    el.token_start + a.value_start,
+                    el.token_start + a.value_end,
+                    a.value,
+                    kind,
+                    role,
+                    _symbol(symbol) if symbol is not None else None,
+                    idx,
+                    a.quote,
+                ),
+            )
+        )
 
 
-def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
-    """The name tokens of one element, by where it sits (the contract's positions)."""
+# The symbol of each node type and the symbols of its ports, by type (bounded): every
+# element of a document looks them up.
+_MODEL_SYMBOLS: dict[str, tuple[Symbol, dict[str, Symbol]]] = {}
+
+
+def _model_symbols(name: str) -> tuple[Symbol, dict[str, Symbol]]:
+    found = _MODEL_SYMBOLS.get(name)
+    if found is None:
+        if len(_MODEL_SYMBOLS) >= 4096:
+            _MODEL_SYMBOLS.clear()
+        owner: Symbol = ("model", name)
+        found = _MODEL_SYMBOLS[name] = (_symbol(owner), _port_symbols(owner))
+    return found
+
+
+def _name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef]) -> None:
+    """Append the name tokens of one element to ``out``, by where the element sits (the
+    contract's positions)."""
     zone = el.zone
     ts = el.token_start
-    out: list[NameRef | None] = []
-    if zone == _ZONE_ROOT:
-        a = el.attr("main_tree_to_execute")
-        if a is not None:
-            out.append(_value_ref(el, idx, a, None, _ROLE_MAIN_TREE, ("tree", a.value or "")))
-    elif zone == _ZONE_TREE:
-        a = el.attr("ID")
-        if a is not None:
-            out.append(_value_ref(el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, ("tree", a.value or "")))
-    elif zone == _ZONE_NODE:
+    if zone == _ZONE_NODE:
         name = el.name
         if name in EXPLICIT_TAGS or name == "SubTree":
             a = el.attr("ID")
@@ -867,8 +881,12 @@ def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
                 role, sym = (
                     (_ROLE_SUBTREE_CALL, "tree") if name == "SubTree" else (_ROLE_NODE_ID, "model")
                 )
-                out.append(_value_ref(el, idx, a, _KIND_MODEL, role, (sym, a.value or "")))
+                _value_ref(out, el, idx, a, _KIND_MODEL, role, (sym, a.value or ""))
+            owner = _owner(el)
+            ports = _port_symbols(owner)
         else:
+            model_symbol, ports = _model_symbols(name)
+            owner = model_symbol
             out.append(
                 _new(
                     NameRef,
@@ -878,14 +896,12 @@ def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
                         name,
                         _KIND_MODEL,
                         _ROLE_NODE_TYPE,
-                        _symbol(("model", name)),
+                        model_symbol,
                         idx,
                         "",
                     ),
                 )
             )
-        owner = _owner(el)
-        ports = _port_symbols(owner)
         # Unpacked rather than read by field: this runs for every attribute of every node.
         for an, ns, ne, value, vs, ve, quote in el.attrs:
             if an == "name":
@@ -915,25 +931,31 @@ def _name_refs(el: Element, idx: int, parent: Element | None) -> list[NameRef]:
                         (ts + ns, ts + ne, an, _KIND_PORT, _ROLE_PORT_USE, psym, idx, ""),
                     )
                 )
+    elif zone == _ZONE_ROOT:
+        a = el.attr("main_tree_to_execute")
+        if a is not None:
+            _value_ref(out, el, idx, a, None, _ROLE_MAIN_TREE, ("tree", a.value or ""))
+    elif zone == _ZONE_TREE:
+        a = el.attr("ID")
+        if a is not None:
+            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, ("tree", a.value or ""))
     elif zone == _ZONE_MODEL_ENTRY:
         a = el.attr("ID")
         if a is not None:
             entry: Symbol = ("tree" if el.name == "SubTree" else "model", a.value or "")
-            out.append(_value_ref(el, idx, a, _KIND_MODEL, _ROLE_MODEL_DEF, entry))
+            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_MODEL_DEF, entry)
     elif zone == _ZONE_PORT_DECL and parent is not None:
         a = el.attr("name")
         if a is not None:
-            out.append(
-                _value_ref(
-                    el,
-                    idx,
-                    a,
-                    _KIND_PORT,
-                    _ROLE_PORT_DECL,
-                    ("port", *_owner(parent), a.value or ""),
-                )
+            _value_ref(
+                out,
+                el,
+                idx,
+                a,
+                _KIND_PORT,
+                _ROLE_PORT_DECL,
+                ("port", *_owner(parent), a.value or ""),
             )
-    return [r for r in out if r is not None]
 
 
 def _check_xml_names(
