@@ -211,8 +211,10 @@ def check_recursion(st: State) -> None:
     main = root.value("main_tree_to_execute") if root is not None else None
     if main:
         order.append(main)
-    trees = ctx.trees
-    order.extend(tid for tid in graph if any(ctx.is_own(d) for d in trees[tid]))
+    # Then this document's trees: its declarations come last for each ID (see
+    # Context.trees), so a tree is ours when the one kept is.
+    own = ctx.path
+    order.extend([tid for tid, decl in graph.items() if decl.path == own])
     order.extend(graph)
     state: dict[str, int] = {}  # 1 on the stack, 2 done
     flagged: set[tuple[int, int]] = set()
