@@ -41,10 +41,12 @@ def make(
 
 
 # The violations of each name text, per role (a role decides the kind and whether the
-# name is declared): names repeat (every use of a node type or port), and a dict keyed by
-# the text alone is the cheapest lookup for the loop below.  Bounded.
+# name is declared): model and port names repeat (every use of a node type or port), and
+# a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
+# names rarely repeat and their rule is quick: they are not kept (they would cost memory
+# in proportion to the documents).  Bounded.
 _VIOLATIONS: dict[Role, dict[str, tuple[Violation, ...]]] = {role: {} for role in Role}
-_MAX_CACHED = 16384
+_MAX_CACHED = 4096
 
 
 def _violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
@@ -52,9 +54,10 @@ def _violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
     found = cache.get(text)
     if found is None:
         found = check_name(text, kind, declaration=role is Role.PORT_DECL)
-        if len(cache) >= _MAX_CACHED:
-            cache.clear()
-        cache[text] = found
+        if kind is not NameKind.INSTANCE:
+            if len(cache) >= _MAX_CACHED:
+                cache.clear()
+            cache[text] = found
     return found
 
 
