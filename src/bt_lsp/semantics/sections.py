@@ -163,6 +163,15 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
     lines = st.doc.lines
     index: dict[Section, int] | None = None
     todo: list[Section] = []
+
+    def keep(sec: Section, found: _Entry) -> None:
+        """``sec``'s results are valid: file it under what the next check looks at."""
+        valid.add(sec)
+        if found.out:
+            noisy.add(sec)
+        if found.line is not None:
+            line_dependent.add(sec)
+
     if same and not changed:
         assert hist.valid is not None
         valid = hist.valid & now
@@ -191,11 +200,7 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
                 ok = _still_valid(found, settings, lines, origin, current)
             if ok:
                 assert found is not None
-                valid.add(sec)
-                if found.out:
-                    noisy.add(sec)
-                if found.line is not None:
-                    line_dependent.add(sec)
+                keep(sec, found)
             else:
                 todo.append(sec)
     if todo:
@@ -209,11 +214,7 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
                 found = _run(st, sec, origin, root, settings, check, current, lines, recording)
                 sec.cache[_KEY] = found
             assert found is not None
-            valid.add(sec)
-            if found.out:
-                noisy.add(sec)
-            if found.line is not None:
-                line_dependent.add(sec)
+            keep(sec, found)
     if noisy:
         if index is None:
             index = dict(zip(sections, range(len(sections)), strict=True))
