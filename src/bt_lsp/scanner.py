@@ -215,6 +215,10 @@ _END_TOKENS: dict[str, Token] = {}
 # Tag and attribute names, shared (bounded).
 _NAMES: dict[str, str] = {}
 _SHARED_MAX = 8192
+# Short attribute values, shared (bounded): blackboard keys, types and literals recur all
+# over a document (a megabyte of BT XML has three times as many values as distinct ones).
+_VALUES: dict[str, str] = {}
+_SHARED_VALUE_LENGTH = 16
 
 
 def _text_token(length: int) -> Token:
@@ -233,6 +237,17 @@ def _name(name: str) -> str:
         if len(_NAMES) >= _SHARED_MAX:
             _NAMES.clear()
         shared = _NAMES[name] = name
+    return shared
+
+
+def _value(raw: str) -> str:
+    if len(raw) > _SHARED_VALUE_LENGTH:
+        return raw
+    shared = _VALUES.get(raw)
+    if shared is None:
+        if len(_VALUES) >= _SHARED_MAX:
+            _VALUES.clear()
+        shared = _VALUES[raw] = raw
     return shared
 
 
@@ -403,7 +418,7 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
                     _name(aname),
                     ns - pos,
                     ne - pos,
-                    raw if "&" not in raw else decode_value(raw, vs, problems),
+                    _value(raw) if "&" not in raw else decode_value(raw, vs, problems),
                     vs,
                     ve - pos,
                     quote,
