@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.text import Encoding, LineIndex, normalize_encoding
+from bt_lsp.text import Encoding, LineIndex, normalize_encoding, positions_of
 
 ENCODINGS: tuple[Encoding, ...] = get_args(Encoding)
 CODECS = {"utf-8": ("utf-8", 1), "utf-16": ("utf-16-le", 2), "utf-32": ("utf-32-le", 4)}
@@ -412,3 +412,24 @@ def test_large_text_builds_fast() -> None:
     elapsed = time.perf_counter() - t0
     assert idx.line_count == text.count("\n") + 1
     assert elapsed < 1.0  # generous bound for slow CI; typically a few milliseconds
+
+
+@given(texts, encodings, st.lists(st.integers(-3, 50), max_size=6))
+def test_positions_of_a_few_offsets_match_the_index(
+    text: str, enc: Encoding, offsets: list[int]
+) -> None:
+    found = positions_of(text, offsets, enc)
+    idx = LineIndex(text)
+    assert found == {o: idx.position(o, enc) for o in offsets}
+
+
+def test_positions_of_count_lines_without_an_index() -> None:
+    text = "a\n😋b\n\ncé\n"
+    assert positions_of(text, [12, 0, 5, 2, 3], "utf-16") == {
+        0: (0, 0),
+        2: (1, 0),
+        3: (1, 2),
+        5: (2, 0),
+        12: (4, 0),
+    }
+    assert positions_of(text, [8], "utf-8") == {8: (3, 3)}

@@ -17,12 +17,12 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_left, bisect_right
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from itertools import accumulate, count
 from operator import add
 from typing import Final, Literal, overload
 
-__all__ = ["Encoding", "LineIndex", "Offsets", "normalize_encoding"]
+__all__ = ["Encoding", "LineIndex", "Offsets", "normalize_encoding", "positions_of"]
 
 Encoding = Literal["utf-8", "utf-16", "utf-32"]
 
@@ -65,6 +65,37 @@ def _line_starts(text: str) -> list[int]:
     pieces.pop()
     # Line k + 1 starts after k + 1 pieces and k + 1 "\n"s.
     return list(map(add, accumulate(map(len, pieces)), count(1)))
+
+
+def _column(text: str, start: int, offset: int, encoding: Encoding) -> int:
+    """The character of ``offset`` on the line that starts at ``start``."""
+    if encoding == "utf-32":
+        return offset - start
+    segment = text[start:offset]
+    if segment.isascii():
+        return offset - start
+    codec, unit = _CODECS[encoding]
+    return len(segment.encode(codec, "surrogatepass")) // unit
+
+
+def positions_of(
+    text: str, offsets: Iterable[int], encoding: Encoding
+) -> dict[int, tuple[int, int]]:
+    """``LineIndex(text).position(offset, encoding)`` of each of ``offsets``, without
+    making the index: for a few offsets of a long text, C-level counts of the line ends
+    from one offset to the next cost less."""
+    if "\r" in text:  # line ends of every kind: the index knows them
+        lines = LineIndex(text)
+        return {o: lines.position(o, encoding) for o in offsets}
+    out: dict[int, tuple[int, int]] = {}
+    line = previous = 0
+    n = len(text)
+    for o in sorted(set(offsets)):
+        at = min(max(o, 0), n)
+        line += text.count("\n", previous, at)
+        previous = at
+        out[o] = (line, _column(text, text.rfind("\n", 0, at) + 1, at, encoding))
+    return out
 
 
 def _unit_width(char: str, encoding: Encoding) -> int:
@@ -293,13 +324,7 @@ class LineIndex:
         start = self._starts[line]
         if offset > start and text[offset - 1] == "\r" and text[offset : offset + 1] == "\n":
             offset -= 1  # between "\r" and "\n": the end of the line
-        if encoding == "utf-32":
-            return line, offset - start
-        segment = text[start:offset]
-        if segment.isascii():
-            return line, offset - start
-        codec, unit = _CODECS[encoding]
-        return line, len(segment.encode(codec, "surrogatepass")) // unit
+        return line, _column(text, start, offset, encoding)
 
     def offset(self, line: int, character: int, encoding: Encoding) -> int:
         """The offset of a position; the inverse of :meth:`position`.
