@@ -49,7 +49,8 @@ _VIOLATIONS: dict[Role, dict[str, tuple[Violation, ...]]] = {role: {} for role i
 _MAX_CACHED = 4096
 
 
-def _violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
+def violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
+    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role)."""
     cache = _VIOLATIONS[role]
     found = cache.get(text)
     if found is None:
@@ -64,14 +65,15 @@ def _violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
 def name_violations(ref: NameRef) -> tuple[Violation, ...]:
     if ref.kind is None:
         return ()
-    return _violations(ref.text, ref.kind, ref.role)
+    return violations(ref.text, ref.kind, ref.role)
 
 
 def name_diagnostics(model: Model) -> list[Diagnostic]:
-    return _ref_diagnostics(model.refs)
+    return ref_diagnostics(model.refs)
 
 
-def _ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
+def ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
+    """The name-rule diagnostics of ``refs``."""
     out: list[Diagnostic] = []
     caches = _VIOLATIONS
     # Unpacked rather than read by field: this runs for every name of a document.
@@ -80,7 +82,7 @@ def _ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
             continue
         found = caches[role].get(text)
         if found is None:
-            found = _violations(text, kind, role)
+            found = violations(text, kind, role)
         for v in found:
             out.append(
                 make(
@@ -113,7 +115,7 @@ def _own(section: Section) -> list[Diagnostic]:
     if out is None:
         out = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
         out.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
-        out.extend(_ref_diagnostics(section.refs))
+        out.extend(ref_diagnostics(section.refs))
         section.cache["diagnostics"] = out
     return out
 

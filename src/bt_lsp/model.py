@@ -36,7 +36,16 @@ from typing import Any, NamedTuple, overload
 from bt_lsp.bulk import bulk
 from bt_lsp.lazyre import LazyPattern
 from bt_lsp.names import RESERVED_PORT_NAMES, NameKind
-from bt_lsp.scanner import XML_SYNTAX, Attr, Kind, Rescan, Scan, Token, decode_value
+from bt_lsp.scanner import (
+    XML_SYNTAX,
+    Attr,
+    Kind,
+    Rescan,
+    Scan,
+    Token,
+    decode_value,
+    scan_token,
+)
 
 Symbol = tuple[str, ...]
 
@@ -770,7 +779,11 @@ def _xml_name_problem(name: str, checked: bool, port: bool) -> tuple[int, str] |
 def _zone_of(name: str, parent: Element | None, has_root: bool) -> Zone:
     if parent is None:
         return _ZONE_OUTSIDE if has_root else _ZONE_ROOT
-    pz = parent.zone
+    return zone_in(name, parent.zone)
+
+
+def zone_in(name: str, pz: Zone) -> Zone:
+    """The zone of an element named ``name`` whose parent's zone is ``pz``."""
     if pz == _ZONE_ROOT:
         if name == "BehaviorTree":
             return _ZONE_TREE
@@ -956,6 +969,21 @@ def _name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef]
                 _ROLE_PORT_DECL,
                 ("port", *_owner(parent), a.value or ""),
             )
+
+
+def start_tag_refs(text: str, at: int, zone: Zone, parent: Element | None) -> list[NameRef]:
+    """The name tokens of the start tag at offset ``at``, exactly as a model of ``text``
+    makes them, for a caller that knows the element's zone and parent without a model
+    (:mod:`bt_lsp.early_names`).  Element indexes in the result are 0."""
+    out: list[NameRef] = []
+    _name_refs(start_tag_element(text, at, zone), 0, parent, out)
+    return out
+
+
+def start_tag_element(text: str, at: int, zone: Zone) -> Element:
+    """The element whose start tag is at offset ``at``, alone (no parent or children)."""
+    tok = scan_token(text, at)
+    return Element(tok.name, zone, at, 0, -1, 0, tok.attrs, tok.self_closing, tok.closed)
 
 
 def _check_xml_names(

@@ -29,6 +29,7 @@ __all__ = [
     "Violation",
     "check_name",
     "is_allowed_port_name",
+    "may_hold_bad_instance_name",
 ]
 
 
@@ -132,6 +133,8 @@ del _code
 _FORBIDDEN_RE: Final = re.compile(r"[\x00-\x1f\x7f \"&'./:<>?\\|*]")
 # Control characters forbidden in an instance name (tab, LF and CR are allowed).
 _INSTANCE_RE: Final = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+# The same characters, each searched for in a whole text (quicker than the pattern).
+_INSTANCE_FORBIDDEN: Final = "".join(map(chr, (*range(9), 11, 12, *range(14, 32), 127)))
 # Characters escaped when a name is quoted in a one-line message.
 _UNPRINTABLE_RE: Final = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
 _ASCII_DIGITS: Final = frozenset("0123456789")
@@ -291,6 +294,12 @@ def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple
             ),
         )
     raise ValueError(f"unknown name kind {kind!r}")  # pragma: no cover
+
+
+def may_hold_bad_instance_name(text: str) -> bool:
+    """Whether an instance name within ``text`` could break its rule: false when no
+    character the rule forbids occurs in ``text``, written or as a character reference."""
+    return "&#" in text or any(c in text for c in _INSTANCE_FORBIDDEN)
 
 
 def is_allowed_port_name(name: str) -> bool:

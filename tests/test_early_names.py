@@ -1,0 +1,239 @@
+"""The early name pass (bt_lsp.early_names): what it reports is exactly what the full
+analysis reports for the name rules, or it gives up."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from bt_lsp.analysis import analyze
+from bt_lsp.diagnostics import Diagnostic
+from bt_lsp.document import Document
+from bt_lsp.early_names import early_name_diagnostics
+from tests.test_scanner import xmlish
+
+EXAMPLES = int(os.environ.get("BT_LSP_FUZZ_EXAMPLES", "150"))
+CORPUS = sorted((Path(__file__).parent / "data" / "corpus").rglob("*.xml"))
+
+
+def full_names(text: str) -> list[Diagnostic]:
+    """The name-rule diagnostics of the full analysis, in its order."""
+    return [d for d in analyze(Document(text)) if d.is_name_rule]
+
+
+def early(text: str) -> list[Diagnostic]:
+    found = early_name_diagnostics(text)
+    assert found is not None, "the pass gave up on a document it follows"
+    return found
+
+
+# -- examples ---------------------------------------------------------------------------
+
+EVERY_ROLE = (
+    '<?xml version="1.0" encoding="UTF-8"?>\r\n'
+    '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\r\n'
+    '  <BehaviorTree ID="Main Tree">\r\n'
+    '    <Sequence name="tab\there &#127;del">\r\n'
+    '      <Do.It a.b="1" x-y="{v}" _skipIf="x" name="ok"/>\r\n'
+    '      <Action ID="Act:ion" in="1"/>\r\n'
+    '      <SubTree ID="root" _autoremap="true"/>\r\n'
+    "      <!-- <Not.A.Node x.y='1'/> -->\r\n"
+    "      <![CDATA[ <Nor.This/> ]]>\r\n"
+    "      <?pi <Nor.That/> ?>\r\n"
+    '      <Fine name="😀 \x7f" p="&lt;a&gt;"/>\r\n'
+    "    </Sequence>\r\n"
+    "  </BehaviorTree>\r\n"
+    "  <TreeNodesModel>\r\n"
+    '    <Action ID="Bad Model">\r\n'
+    '      <input_port name="ID"/>\r\n'
+    '      <output_port name="9lives">text</output_port>\r\n'
+    '      <inout_port name="fine_port"/>\r\n'
+    "    </Action>\r\n"
+    '    <SubTree ID="Sub.Tree"><input_port name="a b"/></SubTree>\r\n'
+    "  </TreeNodesModel>\r\n"
+    "</root>\r\n"
+)
+
+
+def test_every_role_is_reported_as_the_full_analysis_reports_it() -> None:
+    found = early(EVERY_ROLE)
+    assert found == full_names(EVERY_ROLE)
+    assert {EVERY_ROLE[d.start : d.end] for d in found} == {
+        "Main Tree",
+        "tab\there &#127;del",
+        "Do.It",
+        "a.b",
+        "Act:ion",
+        "root",
+        "😀 \x7f",
+        "Bad Model",
+        "ID",
+        "9lives",
+        "Sub.Tree",
+        "a b",
+    }
+    # Nothing inside the comment, the CDATA section or the processing instruction.
+    assert not any("Not.A" in d.message or "Nor." in d.message for d in found)
+
+
+def test_a_clean_document_has_none() -> None:
+    text = '<root BTCPP_format="4"><BehaviorTree ID="Main"><AlwaysSuccess/></BehaviorTree></root>'
+    assert early(text) == [] == full_names(text)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        pytest.param('<root><BehaviorTree ID="a b">', id="unfinished"),
+        pytest.param('<root><BehaviorTree ID="a b"/></root><x/>', id="two roots"),
+        pytest.param('<root><A x="1" x="2"/></root>', id="duplicate attribute"),
+        pytest.param('<root><A x="&nbsp;"/></root>', id="undefined entity"),
+        pytest.param('<!DOCTYPE root [<!ENTITY e "a b">]><root><A ID="&e;"/></root>', id="doctype"),
+        pytest.param('<root xmlns:b="urn:b"><b:A.x/></root>', id="namespace"),
+        pytest.param('<root><BehaviorTree ID="M"><b:A.x/></BehaviorTree></root>', id="prefix"),
+        pytest.param('<root><A name="\ud800"/></root>', id="lone surrogate"),
+        pytest.param('<root><A name="\x01"/></root>', id="not an XML character"),
+        pytest.param("", id="empty"),
+    ],
+)
+def test_gives_up_on_what_it_does_not_follow(text: str) -> None:
+    assert early_name_diagnostics(text) is None
+
+
+def test_gives_up_rather_than_report_a_part_of_too_many() -> None:
+    body = '<Bad.Name a="1"/>' * 2500
+    text = f'<root><BehaviorTree ID="M">{body}</BehaviorTree></root>'
+    assert early_name_diagnostics(text) is None
+
+
+def test_reads_no_file_and_no_entity() -> None:
+    text = (
+        '<!DOCTYPE root SYSTEM "/etc/passwd"><root><BehaviorTree ID="a b"/></root>\n'
+        '<root><x y="&ext;"/></root>'
+    )
+    assert early_name_diagnostics(text) is None
+
+
+# -- the corpus and generated documents --------------------------------------------------
+
+
+def test_corpus_files_match_the_full_analysis() -> None:
+    followed = 0
+    for path in CORPUS:
+        text = path.read_text(encoding="utf-8", errors="replace")
+        found = early_name_diagnostics(text)
+        if found is not None:
+            followed += 1
+            assert found == full_names(text), path
+    assert followed >= len(CORPUS) * 0.9
+
+
+# Names that are valid XML names (so the document stays well-formed) but may break the
+# BT rules, and attribute values of any kind.
+_XML_NAME = st.from_regex(r"[A-Za-z_][A-Za-z0-9_.\-é😀]{0,5}", fullmatch=True).filter(
+    lambda s: "xml" not in s.lower()
+)
+_VALUE = st.text(alphabet="aZ_9. \t\n\r&<>\"'/\\*?|:\x7f😀é", max_size=6)
+_TAGS = st.sampled_from(["Sequence", "Fallback", "Action", "Condition", "SubTree", "Inverter"])
+_KEYS = st.sampled_from(["name", "ID", "_skipIf", "_autoremap", "port", "__shared_blackboard"])
+
+
+def _escape(value: str, draw: st.DrawFn) -> str:
+    out = []
+    for ch in value:
+        if ch in "&<\"'":
+            out.append({"&": "&amp;", "<": "&lt;", '"': "&quot;", "'": "&apos;"}[ch])
+        elif ch in "\t\n\r\x7f" and draw(st.booleans()):
+            out.append(f"&#{ord(ch)};")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+@st.composite
+def _attrs(draw: st.DrawFn) -> str:
+    keys = draw(st.lists(_KEYS | _XML_NAME, max_size=3, unique=True))
+    return "".join(f' {k}="{_escape(draw(_VALUE), draw)}"' for k in keys)
+
+
+@st.composite
+def _aside(draw: st.DrawFn) -> str:
+    """Markup whose '<' does not start an element."""
+    inner = f'<{draw(_XML_NAME)} a.b="1"/>'
+    kind = draw(st.sampled_from(["comment", "cdata", "pi", "text", "none"]))
+    return {
+        "comment": f"<!-- {inner} -->",
+        "cdata": f"<![CDATA[{inner}]]>",
+        "pi": f"<?pi {inner}?>",
+        "text": " &lt;x.y&gt; ",
+        "none": "",
+    }[kind]
+
+
+@st.composite
+def _node(draw: st.DrawFn, depth: int = 0) -> str:
+    tag = draw(_TAGS | _XML_NAME)
+    attrs = draw(_attrs())
+    children = [] if depth >= 3 else draw(st.lists(_node(depth + 1), max_size=3))
+    aside = draw(_aside())
+    if not children and draw(st.booleans()):
+        return f"{aside}<{tag}{attrs}/>"
+    return f"{aside}<{tag}{attrs}>\n{''.join(children)}</{tag}>"
+
+
+@st.composite
+def _model(draw: st.DrawFn) -> str:
+    entries = []
+    for _ in range(draw(st.integers(0, 3))):
+        tag = draw(_TAGS)
+        ports = "".join(
+            f"<{draw(st.sampled_from(['input_port', 'output_port', 'inout_port', 'other']))}"
+            f' name="{_escape(draw(_VALUE | _KEYS | _XML_NAME), draw)}"/>'
+            for _ in range(draw(st.integers(0, 3)))
+        )
+        entries.append(f'<{tag} ID="{_escape(draw(_VALUE | _XML_NAME), draw)}">{ports}</{tag}>')
+    return f"<TreeNodesModel>{''.join(entries)}</TreeNodesModel>"
+
+
+@st.composite
+def bt_documents(draw: st.DrawFn) -> str:
+    parts = []
+    for _ in range(draw(st.integers(0, 3))):
+        tree_id = _escape(draw(_VALUE | _XML_NAME), draw)
+        nodes = "".join(draw(st.lists(_node(), max_size=3)))
+        parts.append(f'<BehaviorTree ID="{tree_id}">{nodes}</BehaviorTree>')
+    if draw(st.booleans()):
+        parts.insert(draw(st.integers(0, len(parts))), draw(_model()))
+    if draw(st.booleans()):
+        parts.append(f"<{draw(_XML_NAME)}{draw(_attrs())}/>")  # ignored by BehaviorTree.CPP
+    newline = draw(st.sampled_from(["\n", "\r\n", "\r", ""]))
+    return f'<root BTCPP_format="4">{newline}{newline.join(parts)}</root>{newline}'
+
+
+@given(bt_documents())
+@settings(max_examples=EXAMPLES * 2, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def test_generated_documents_match_the_full_analysis(text: str) -> None:
+    assert early(text) == full_names(text)
+
+
+@given(st.sampled_from(CORPUS[:40]), st.data())
+@settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def test_edited_corpus_files_match_or_give_up(path: Path, data: st.DataObject) -> None:
+    text = path.read_text(encoding="utf-8", errors="replace")[:6000]
+    for _ in range(data.draw(st.integers(1, 3))):
+        start = data.draw(st.integers(0, len(text)))
+        end = data.draw(st.integers(start, min(len(text), start + 30)))
+        text = text[:start] + data.draw(xmlish) + text[end:]
+    found = early_name_diagnostics(text)
+    assert found is None or found == full_names(text)
+
+
+@given(xmlish)
+@settings(max_examples=EXAMPLES, deadline=None)
+def test_never_raises(text: str) -> None:
+    found = early_name_diagnostics(text)
+    assert found is None or found == full_names(text)
