@@ -21,16 +21,23 @@ from bt_lsp import __version__
 from bt_lsp.analysis import analyze
 from bt_lsp.codes import CODES
 from bt_lsp.diagnostics import Diagnostic, make, with_severities
-from bt_lsp.server.convert import to_diagnostic
+from bt_lsp.document import looks_like_bt
+from bt_lsp.early_names import early_name_diagnostics
+from bt_lsp.server.convert import diagnostic_at, to_diagnostic
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.settings import Settings
-from bt_lsp.text import Encoding, normalize_encoding
+from bt_lsp.text import Encoding, normalize_encoding, positions_of
 from bt_lsp.workspace import Workspace
 
 log = logging.getLogger(__name__)
 
 SECTION = "btLsp"
+
+# From this size (in characters) an opened document's name diagnostics are published
+# first, found by lxml in a fraction of the full analysis; smaller documents are analysed
+# in less time than an editor takes to notice.
+EARLY_NAMES_CHARS = 256 * 1024
 
 
 class BtServer(LanguageServer):
@@ -103,6 +110,33 @@ class BtServer(LanguageServer):
         return [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
 
     # -- publishing -------------------------------------------------------------------------
+
+    def publish_early_names(self, uri: str, text: str, version: int | None) -> None:
+        """Publish the name diagnostics of a large document being opened, found without
+        its full analysis (:mod:`bt_lsp.early_names`), ahead of the complete set."""
+        if self.pull_diagnostics or len(text) < EARLY_NAMES_CHARS or not looks_like_bt(text):
+            return
+        try:
+            found = early_name_diagnostics(text)
+        except Exception:  # the complete set follows anyway
+            self.log_error(f"finding the early name diagnostics of {uri}")
+            return
+        if found is None:
+            return
+        found = with_severities(found, self.settings.severity)
+        at = positions_of(text, [o for d in found for o in (d.start, d.end)], self.encoding)
+        self.text_document_publish_diagnostics(
+            types.PublishDiagnosticsParams(
+                uri=uri,
+                diagnostics=[
+                    diagnostic_at(
+                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])), d
+                    )
+                    for d in found
+                ],
+                version=version,
+            )
+        )
 
     def schedule(self, uri: str) -> None:
         """Diagnostics are due for ``uri``: push them after the debounce delay (clients

@@ -23,9 +23,14 @@ def to_offsets(lines: LineIndex, rng: types.Range, enc: Encoding) -> tuple[int, 
 
 
 def to_diagnostic(lines: LineIndex, d: Diagnostic, enc: Encoding) -> types.Diagnostic:
+    return diagnostic_at(to_range(lines, d.start, d.end, enc), d)
+
+
+def diagnostic_at(rng: types.Range, d: Diagnostic) -> types.Diagnostic:
+    """``d`` as an LSP diagnostic over ``rng`` (its offsets converted by the caller)."""
     info = CODES.get(d.code)
     return types.Diagnostic(
-        range=to_range(lines, d.start, d.end, enc),
+        range=rng,
         message=d.message,
         severity=types.DiagnosticSeverity(int(d.severity)),
         code=d.code,

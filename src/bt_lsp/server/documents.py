@@ -21,6 +21,7 @@ def register(server: BtServer) -> None:
     def did_open(ls: BtServer, params: types.DidOpenTextDocumentParams) -> None:
         item = params.text_document
         path = to_fs_path(item.uri) if item.uri.startswith("file:") else None
+        ls.publish_early_names(item.uri, item.text, item.version)
         od = OpenDocument(
             item.uri,
             Document(item.text, path or item.uri),
