@@ -2,7 +2,9 @@
 
 For each document size: start the server (time to the ``initialize`` result, beside a bare
 pygls server started the same way), open a generated document (time to its first
-diagnostics), type (a letter inserted at the end of a node's ``name`` or a port value and
+diagnostics, which for a large document are its name diagnostics, and to its complete
+diagnostics, the last published before the server answers a request sent right after the
+open), type (a letter inserted at the end of a node's ``name`` or a port value and
 deleted again, at places spread over the trees; time from each ``didChange`` to the
 diagnostics of that version), ask for a quick fix (``codeAction`` + ``codeAction/resolve``
 of its preferred action), a fix-all (the same for ``source.fixAll.bt-lsp``) and a hover.
@@ -146,7 +148,8 @@ def make_doc(size: int, folder: Path, edits: int, seed: int) -> Doc:
 @dataclass
 class Session:
     startup: float = math.nan
-    open: float = math.nan
+    open: float = math.nan  # to the first diagnostics published for the open
+    open_complete: float = math.nan  # to the last, the complete set
     edits: list[float] = field(default_factory=list)
     edit_cpu: float = math.nan  # server CPU seconds per edit (utime + stime)
     quick_fix: list[float] = field(default_factory=list)
@@ -214,10 +217,22 @@ async def session(doc: Doc, root: str, edits_per_place: int = 2, requests: int =
                 }
             },
         )
+        # Answered only after the server has handled the open and published everything.
+        barrier = asyncio.ensure_future(
+            client.request(
+                "textDocument/hover",
+                {"textDocument": {"uri": tiny_uri}, "position": {"line": 0, "character": 0}},
+                timeout=600,
+            )
+        )
         await client.drain()
         pub = await asyncio.wait_for(fut, 600)
         s.open = pub.at - t0
-        s.diagnostics = len(pub.diagnostics)
+        await barrier
+        last = client.latest(doc.uri)
+        assert last is not None and last.version == version
+        s.open_complete = last.at - t0
+        s.diagnostics = len(last.diagnostics)
         s.rss_open = rss_kib(client.pid)
 
         cpu0 = cpu_seconds(client.pid)
@@ -370,21 +385,33 @@ def python_floor_seconds(text: str) -> float:
 
 # The phases of a first analysis, as the server runs them on open (each one's result is
 # kept on the document and used by the next).
-PHASES = ("scan", "model", "own diagnostics", "workspace context", "semantic rules")
+PHASES = (
+    "early names",
+    "scan",
+    "model",
+    "own diagnostics",
+    "workspace context",
+    "semantic rules",
+)
 
 
 def phase_seconds(text: str, path: Path) -> dict[str, float]:
     """One first analysis of ``text`` (as if opened at ``path``, in its folder), in the
     benchmark process, timed by phase: where the time of an open goes, without the
-    protocol (reading the JSON, converting positions, writing the diagnostics)."""
+    protocol (reading the JSON, converting positions, writing the diagnostics).  The
+    first phase is the pass whose name diagnostics a large document's open publishes
+    first (:mod:`bt_lsp.early_names`); the others make the complete set."""
     from bt_lsp import semantics
     from bt_lsp.document import Document
+    from bt_lsp.early_names import early_name_diagnostics
     from bt_lsp.workspace import Workspace
 
     ws = Workspace([str(path.parent)])
     gc.collect()
     gc.disable()  # as the server does for these phases (bt_lsp.bulk)
     try:
+        t_early = time.perf_counter()
+        early_name_diagnostics(text)
         t0 = time.perf_counter()
         doc = Document(text, str(path))
         t1 = time.perf_counter()
@@ -399,7 +426,8 @@ def phase_seconds(text: str, path: Path) -> dict[str, float]:
         t5 = time.perf_counter()
     finally:
         gc.enable()
-    return dict(zip(PHASES, (t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4), strict=True))
+    times = (t0 - t_early, t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4)
+    return dict(zip(PHASES, times, strict=True))
 
 
 def corpus_files(corpus: Path) -> list[Path]:
@@ -518,6 +546,7 @@ def _size_result(
         "lxml": lx,
         "python floor": floor,
         "open": [s.open for s in sessions],
+        "open complete": [s.open_complete for s in sessions],
         "edit": cat(lambda s: s.edits),
         "quick fix": cat(lambda s: s.quick_fix),
         "fix-all": cat(lambda s: s.fix_all),
@@ -569,6 +598,7 @@ def table(results: dict[str, Any]) -> str:
     for key, label, ratio in (
         ("python floor", "Python reads every tag and attribute once, no rules (ms, × lxml)", True),
         ("open", "open → first diagnostics (ms, × lxml)", True),
+        ("open complete", "open → complete diagnostics (ms, × lxml)", True),
         ("edit", "1-character edit → its diagnostics (ms, × lxml)", True),
         ("quick fix", "quick fix: codeAction + resolve (ms)", False),
         ("fix-all", "fix-all: codeAction + resolve (ms)", False),
@@ -634,13 +664,13 @@ def targets(results: dict[str, Any]) -> list[tuple[str, bool, str]]:
     if one is not None:
         e, lx, o = one["edit"]["median"], one["lxml"]["median"], one["open"]["median"]
         out.append(("1 MB edit < lxml parse", e < lx, f"{ms(e)} vs {ms(lx)} ms"))
-        out.append(("1 MB open ≤ 5× lxml", o <= 5 * lx, f"{o / lx:.1f}×"))
+        out.append(("1 MB open → first diagnostics ≤ 5× lxml", o <= 5 * lx, f"{o / lx:.1f}×"))
         for v, name in ((one, "1 MB"), (four, "4 MB")):
             if v is not None:
                 used = v["memory"]["at end"] / v["bytes"]
                 out.append((f"{name} memory ≤ 20× document", used <= 20, f"{used:.1f}×"))
         if four is not None:
-            for key in ("open", "edit"):
+            for key in ("open", "open complete", "edit"):
                 r = four[key]["median"] / one[key]["median"]
                 out.append((f"4 MB {key} ≤ 4.5× 1 MB", r <= 4.5, f"{r:.2f}×"))
     st = results["startup"]

@@ -110,12 +110,37 @@ async def test_client_drives_the_server(tmp_path: Path) -> None:
     assert client.proc.returncode is not None
 
 
+async def test_a_large_open_publishes_names_first_then_the_complete_set(tmp_path: Path) -> None:
+    g = bench_generate.generate(300_000, seed=5)
+    path = tmp_path / "doc.xml"
+    path.write_text(g.text, encoding="utf-8")
+    uri = bench_client.path_uri(path)
+    client = await bench_client.LspClient.start(bench_run.SERVER)
+    try:
+        await client.initialize(bench_client.path_uri(tmp_path), {"debounceMs": 0})
+        first = client.expect_diagnostics(uri, 1)
+        client.notify(
+            "textDocument/didOpen",
+            {"textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": g.text}},
+        )
+        names = await first
+        complete = client.expect_diagnostics(uri, 1)
+        assert (await complete).diagnostics == names.diagnostics  # only names are planted
+        expected: Counter[str] = Counter()
+        for p in g.planted:
+            expected[p.code] += p.count
+        assert Counter(d["code"] for d in names.diagnostics) == expected
+    finally:
+        await client.close()
+
+
 def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "r.json"
     args = ["--sizes", "4K", "--repeat", "1", "--edits", "2", "--requests", "1"]
     assert bench_run.main([*args, "--no-check", "--json", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "| open → first diagnostics" in printed and "Start to `initialize`" in printed
+    assert "| open → complete diagnostics" in printed
     assert "| Python reads every tag" in printed
     for phase in bench_run.PHASES:
         assert f"| open, phase: {phase} (ms, × lxml) |" in printed
@@ -123,6 +148,7 @@ def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str
     (size,) = results["sizes"].values()
     samples = size["samples"]
     assert len(samples["open"]) == 1 and len(samples["edit"]) == 4
+    assert samples["open complete"][0] >= samples["open"][0]
     assert len(samples["quick fix"]) == len(samples["fix-all"]) == len(samples["hover"]) == 1
     assert all(x > 0 for v in samples.values() for x in v)
     assert size["diagnostics"] > 0 and size["memory"]["idle"] > 0
