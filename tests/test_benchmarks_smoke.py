@@ -67,11 +67,23 @@ def test_generator_command_line(tmp_path: Path) -> None:
     assert out.read_text(encoding="utf-8") == bench_generate.generate(12 * 1024, 2).text
 
 
+def _document(tmp_path: Path, text: str) -> str:
+    """The URI of ``text`` written to a file in ``tmp_path``."""
+    path = tmp_path / "doc.xml"
+    path.write_text(text, encoding="utf-8")
+    return bench_client.path_uri(path)
+
+
+def _open(client: bench_client.LspClient, uri: str, text: str) -> None:
+    client.notify(
+        "textDocument/didOpen",
+        {"textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": text}},
+    )
+
+
 async def test_client_drives_the_server(tmp_path: Path) -> None:
     g = bench_generate.generate(3_000, seed=5)
-    path = tmp_path / "doc.xml"
-    path.write_text(g.text, encoding="utf-8")
-    uri = bench_client.path_uri(path)
+    uri = _document(tmp_path, g.text)
     client = await bench_client.LspClient.start(bench_run.SERVER)
     try:
         result, seconds = await client.initialize(
@@ -81,10 +93,7 @@ async def test_client_drives_the_server(tmp_path: Path) -> None:
         assert bench_client.rss_kib(client.pid) > 0
 
         fut = client.expect_diagnostics(uri, 1)
-        client.notify(
-            "textDocument/didOpen",
-            {"textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": g.text}},
-        )
+        _open(client, uri, g.text)
         first = await fut
         expected: Counter[str] = Counter()
         for p in g.planted:
@@ -112,17 +121,12 @@ async def test_client_drives_the_server(tmp_path: Path) -> None:
 
 async def test_a_large_open_publishes_names_first_then_the_complete_set(tmp_path: Path) -> None:
     g = bench_generate.generate(300_000, seed=5)
-    path = tmp_path / "doc.xml"
-    path.write_text(g.text, encoding="utf-8")
-    uri = bench_client.path_uri(path)
+    uri = _document(tmp_path, g.text)
     client = await bench_client.LspClient.start(bench_run.SERVER)
     try:
         await client.initialize(bench_client.path_uri(tmp_path), {"debounceMs": 0})
         first = client.expect_diagnostics(uri, 1)
-        client.notify(
-            "textDocument/didOpen",
-            {"textDocument": {"uri": uri, "languageId": "xml", "version": 1, "text": g.text}},
-        )
+        _open(client, uri, g.text)
         names = await first
         complete = client.expect_diagnostics(uri, 1)
         assert (await complete).diagnostics == names.diagnostics  # only names are planted

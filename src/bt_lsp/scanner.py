@@ -231,24 +231,22 @@ def _text_token(length: int) -> Token:
     return tok
 
 
+def _keep(pool: dict[str, str], s: str) -> str:
+    """Keep ``s`` in ``pool`` (emptied when full) for the next equal string to share."""
+    if len(pool) >= _SHARED_MAX:
+        pool.clear()
+    pool[s] = s
+    return s
+
+
 def _name(name: str) -> str:
-    shared = _NAMES.get(name)
-    if shared is None:
-        if len(_NAMES) >= _SHARED_MAX:
-            _NAMES.clear()
-        shared = _NAMES[name] = name
-    return shared
+    return _NAMES.get(name) or _keep(_NAMES, name)
 
 
 def _value(raw: str) -> str:
     if len(raw) > _SHARED_VALUE_LENGTH:
         return raw
-    shared = _VALUES.get(raw)
-    if shared is None:
-        if len(_VALUES) >= _SHARED_MAX:
-            _VALUES.clear()
-        shared = _VALUES[raw] = raw
-    return shared
+    return _VALUES.get(raw) or _keep(_VALUES, raw)
 
 
 def _scan_text(text: str, pos: int, n: int) -> Token:

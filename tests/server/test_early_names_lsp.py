@@ -74,6 +74,15 @@ def _full(d: types.Diagnostic) -> tuple[object, ...]:
     return (d.code, d.range, d.message, d.severity, d.data, d.source, d.code_description)
 
 
+def _assert_names_of(
+    first: types.PublishDiagnosticsParams, complete: types.PublishDiagnosticsParams
+) -> None:
+    """``first`` holds the name diagnostics of ``complete``, field for field."""
+    assert [_full(d) for d in first.diagnostics] == [
+        _full(d) for d in names_only(complete.diagnostics)
+    ]
+
+
 async def _publications(client: BtClient, uri: str) -> list[types.PublishDiagnosticsParams]:
     await client.barrier()  # the server answers only after handling the open
     return client.published.get(uri, [])
@@ -93,10 +102,7 @@ async def test_names_first_then_everything(client: BtClient, newline: str) -> No
             for c, r in zip(codes, doc.ranges(client.encoding), strict=True)
         )
         assert summary(first.diagnostics) == expected
-        # The same diagnostics as in the complete set, field for field.
-        assert [_full(d) for d in first.diagnostics] == [
-            _full(d) for d in names_only(complete.diagnostics)
-        ]
+        _assert_names_of(first, complete)
         assert any(d not in names_only(complete.diagnostics) for d in complete.diagnostics)
     finally:
         client.close(uri)
@@ -111,9 +117,7 @@ async def test_names_first_follow_the_severity_settings(client: BtClient) -> Non
         levels = {(str(d.code), d.severity) for d in first.diagnostics}
         assert ("port-name-reserved", types.DiagnosticSeverity.Warning) in levels
         assert "instance-name-control-char" not in {code for code, _ in levels}
-        assert [_full(d) for d in first.diagnostics] == [
-            _full(d) for d in names_only(complete.diagnostics)
-        ]
+        _assert_names_of(first, complete)
     finally:
         client.close(uri)
 
