@@ -19,6 +19,7 @@ import pytest
 
 from bt_lsp import scanner
 from bt_lsp.analysis import analyze
+from bt_lsp.context import facts_of
 from bt_lsp.document import Document
 from bt_lsp.model import Model
 from bt_lsp.scanner import rescan, scan
@@ -195,3 +196,54 @@ def test_edit_distance_is_levenshtein_up_to_the_limit() -> None:
         b = "".join(rng.choice("abc") for _ in range(rng.randint(0, 8)))
         limit = rng.randint(0, 3)
         assert edit_distance(a, b, limit) == min(_levenshtein(a, b), limit + 1)
+
+
+# Trees enough that most edits have sections before and after them.
+MANY = MAIN.replace(
+    "  <TreeNodesModel>",
+    "".join(
+        f'  <BehaviorTree ID="T{i}"><Sequence><SubTree ID="T{i + 1}"/><Wait/></Sequence>'
+        "</BehaviorTree>\n"
+        for i in range(12)
+    )
+    + "  <TreeNodesModel>",
+)
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_declarations_after_edits_equal_fresh_ones(seed: int) -> None:
+    """The facts of an edited document are made from those of its last version (the
+    sections before and after the edit kept or moved): they equal a fresh extraction,
+    with several edits between two extractions too."""
+    rng = random.Random(300 + seed)
+    doc = Document(MANY, "/w/main.xml")
+    facts_of(doc)
+    for step in range(30):
+        for _ in range(rng.randint(1, 3) if step % 2 else 1):
+            _edit(rng, doc)
+        got, want = facts_of(doc), facts_of(Document(doc.text, "/w/main.xml"))
+        assert got == want
+        assert [t.call_spans for t in got.trees] == [t.call_spans for t in want.trees]
+        if want.layout is not None:
+            assert got.layout is not None
+            assert list(got.layout.origins) == list(want.layout.origins)
+            assert got.layout.trees_at == want.layout.trees_at
+            assert got.layout.models_at == want.layout.models_at
+            assert got.layout.subtree_models_at == want.layout.subtree_models_at
+
+
+def test_declarations_of_an_edit_are_made_from_the_last_version() -> None:
+    """Typing inside one tree keeps the declarations before it and moves those after it,
+    without making them again from their sections."""
+    doc = Document(MANY, "/w/main.xml")
+    before = facts_of(doc)
+    at = doc.text.index("<Wait/>", doc.text.index('<BehaviorTree ID="T5">')) + len("<Wait")
+    doc.edit(at, at, " ")
+    after = facts_of(doc)
+    k = [t.id for t in before.trees].index("T5")
+    assert after.trees[:k] == before.trees[:k]
+    assert all(a is b for a, b in zip(after.trees[:k], before.trees[:k], strict=True))
+    assert after.trees[k] == before.trees[k]  # the edit is after its ID
+    assert [t.start for t in after.trees[k + 1 :]] == [t.start + 1 for t in before.trees[k + 1 :]]
+    assert after.models[0].start == before.models[0].start + 1
+    assert facts_of(doc) is after

@@ -15,13 +15,16 @@ combining is proportional to the number of declarations, not to the size of the 
 from __future__ import annotations
 
 import weakref
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
+from itertools import chain, compress, count, repeat
+from operator import is_not, itemgetter, ne, or_
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Final, NamedTuple, cast
+from typing import TYPE_CHECKING, Final, NamedTuple, TypeVar, cast
 
 from bt_lsp.builtins import BUILTINS, Category, Direction, PortModel
-from bt_lsp.model import Element, Model, Zone
+from bt_lsp.model import Element, Model, Section, Zone
 
 if TYPE_CHECKING:
     from bt_lsp.document import Document
@@ -78,8 +81,9 @@ class TreeDecl(NamedTuple):
     """A ``<BehaviorTree ID>``: where it is and which trees it calls.
 
     ``start``/``end`` span the ``ID`` value.  ``calls`` are the IDs of its ``<SubTree>``
-    elements in document order (empty IDs left out) and ``call_spans`` the spans of those
-    ``ID`` values, index for index.
+    elements in document order (empty IDs left out) and ``call_offsets`` the spans of those
+    ``ID`` values relative to ``start``, index for index (:attr:`call_spans` places them),
+    so that moving a tree moves two numbers.
 
     Declarations are named tuples (immutable, and cheap to make: a document's are made
     again for the part of it that an edit moved).
@@ -90,7 +94,13 @@ class TreeDecl(NamedTuple):
     start: int
     end: int
     calls: tuple[str, ...] = ()
-    call_spans: tuple[tuple[int, int], ...] = ()
+    call_offsets: tuple[tuple[int, int], ...] = ()
+
+    @property
+    def call_spans(self) -> tuple[tuple[int, int], ...]:
+        """The spans of the called IDs, in the document's coordinates."""
+        o = self.start
+        return tuple([(s + o, e + o) for s, e in self.call_offsets])
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,6 +111,23 @@ class DocumentFacts:
     trees: tuple[TreeDecl, ...]
     models: tuple[ModelDecl, ...]  # Action/Condition/Control/Decorator entries
     subtree_models: tuple[ModelDecl, ...]  # <SubTree> entries
+    # For a model made of sections: where each section's declarations begin in the three
+    # tuples above, so that the facts of the document's next version are made from these
+    # by replacing what its changed sections declare and moving what follows.
+    layout: _Layout | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """The sections and origins facts were made from, and for each section ``k`` the index
+    of its first tree, model and SubTree model (``at[k]``; ``at[len(sections)]`` is the
+    count)."""
+
+    sections: Sequence[Section]
+    origins: Sequence[int]
+    trees_at: list[int]
+    models_at: list[int]
+    subtree_models_at: list[int]
 
 
 @dataclass(frozen=True, slots=True)
@@ -245,8 +272,6 @@ class Context:
 
 # --- extraction ---------------------------------------------------------------------------
 
-_new = tuple.__new__
-
 # Model -> facts, keyed by document; a cached entry is valid while the document's model is
 # the same object (a document builds a new model after every edit).
 _CACHE: weakref.WeakKeyDictionary[Document, tuple[Model, str | None, DocumentFacts]] = (
@@ -262,75 +287,164 @@ def facts_of(doc: Document, path: str | None = None) -> DocumentFacts:
     hit = _CACHE.get(doc)
     if hit is not None and hit[0] is model and hit[1] == path:
         return hit[2]
-    facts = extract_sections(model, path) if model.head is not None else extract(model, path)
+    if model.head is None:
+        facts = extract(model, path)
+    else:
+        facts = extract_sections(model, path, hit[2] if hit is not None else None)
     _CACHE[doc] = (model, path, facts)
     return facts
 
 
-def extract_sections(model: Model, path: str | None) -> DocumentFacts:
+def extract_sections(
+    model: Model, path: str | None, before: DocumentFacts | None = None
+) -> DocumentFacts:
     """:func:`extract` for a model made of sections: each section's declarations are
-    extracted once (they are kept on the section, in its coordinates) and moved here."""
+    extracted once (they are kept on the section, in its coordinates) and placed here.
+
+    With the facts ``before`` of an earlier version of the document, the sections both
+    versions begin and end with keep their declarations: those before the edit as they
+    are, those after it moved by the edit's length (in C: no Python code runs per tree),
+    so that an edit costs what its own sections declare.
+    """
+    sections, origins = model.sections, model.origins
+    if before is None or before.layout is None or before.path != path:
+        return _extract_all(sections, origins, model.root, path)
+    layout = before.layout
+    old_sections, old_origins = layout.sections, layout.origins
+    n_old, n_new = len(old_sections), len(sections)
+    most = min(n_old, n_new)
+    # The sections both begin with, where they were; then those both end with (moved).
+    moved = map(or_, map(is_not, old_sections, sections), map(ne, old_origins, origins))
+    p = next(compress(count(), moved), most)
+    q = next(compress(count(), map(is_not, reversed(old_sections), reversed(sections))), most)
+    q = min(q, most - p)
+    if p == n_old == n_new:
+        return before
+    delta = origins[n_new - q] - old_origins[n_old - q] if q else 0
+    mid = _extract_all(sections[p : n_new - q], origins[p : n_new - q], model.root, path)
+    assert mid.layout is not None
+    cut = _Cut(p, n_old - q, delta, path)
+    trees, trees_at = cut.splice(
+        before.trees, layout.trees_at, mid.trees, mid.layout.trees_at, _moved_trees
+    )
+    models, models_at = cut.splice(
+        before.models, layout.models_at, mid.models, mid.layout.models_at, _moved_models
+    )
+    subs, subs_at = cut.splice(
+        before.subtree_models,
+        layout.subtree_models_at,
+        mid.subtree_models,
+        mid.layout.subtree_models_at,
+        _moved_models,
+    )
+    return DocumentFacts(
+        path, trees, models, subs, _Layout(sections, origins, trees_at, models_at, subs_at)
+    )
+
+
+D = TypeVar("D", bound="tuple[object, ...]")  # a TreeDecl or a ModelDecl
+
+
+@dataclass(frozen=True, slots=True)
+class _Cut:
+    """An edit as the facts see it: old sections ``[first, stop)`` were replaced; those
+    from ``stop`` on moved by ``delta`` characters."""
+
+    first: int
+    stop: int
+    delta: int
+    path: str | None
+
+    def splice(
+        self,
+        old: tuple[D, ...],
+        old_at: list[int],
+        new: tuple[D, ...],
+        new_at: list[int],
+        move: Callable[[Sequence[D], int, str | None], Iterator[D]],
+    ) -> tuple[tuple[D, ...], list[int]]:
+        """One kind of declaration: the old ones of the sections kept, the new ones of the
+        sections in between, and where each section's begin."""
+        first, stop = self.first, self.stop
+        head_end: int = old_at[first]
+        tail_start: int = old_at[stop]
+        tail: Iterable[D] = old[tail_start:]
+        if self.delta:
+            tail = move(old[tail_start:], self.delta, self.path)
+        decls: tuple[D, ...] = tuple(chain(old[:head_end], new, tail))
+        shift = head_end + len(new) - tail_start
+        at = old_at[:first]
+        at.extend(map(head_end.__add__, new_at))
+        at.pop()  # the count of the new ones is where the tail begins
+        at.extend(map(shift.__add__, old_at[stop:]) if shift else old_at[stop:])
+        return decls, at
+
+
+def _extract_all(
+    sections: Sequence[Section], origins: Sequence[int], root: Element | None, path: str | None
+) -> DocumentFacts:
+    """The declarations of ``sections`` (at ``origins``), with their layout."""
     trees: list[TreeDecl] = []
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
-    root = model.root
-    for section, o in zip(model.sections, model.origins, strict=True):
-        # The section's declarations where it is now (kept while it does not move).
-        placed: _Placed | None = section.cache.get("placed facts")
-        if placed is None or placed[0] != o or placed[1] != path:
-            local: DocumentFacts | None = section.cache.get("facts")
-            if local is None:
-                local = section.cache["facts"] = extract(section.local_model(root), None)
-            placed = section.cache["placed facts"] = (o, path, *_moved(local, path, o))
-        if placed[2]:
-            trees.extend(placed[2])
-        if placed[3]:
-            models.extend(placed[3])
-        if placed[4]:
-            subtree_models.extend(placed[4])
-    return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
-
-
-_Placed = tuple[
-    int, str | None, tuple["TreeDecl", ...], tuple["ModelDecl", ...], tuple["ModelDecl", ...]
-]
-
-
-def _moved(
-    local: DocumentFacts, path: str | None, o: int
-) -> tuple[tuple[TreeDecl, ...], tuple[ModelDecl, ...], tuple[ModelDecl, ...]]:
-    """Declarations extracted in a section's coordinates, in the document's."""
-    if not local.models and not local.subtree_models and len(local.trees) == 1:
-        t = local.trees[0]  # the usual section: one tree
-        spans = tuple([(s + o, e + o) for s, e in t.call_spans]) if t.call_spans else ()
-        # Made without the named tuple's constructor: every edit moves every later section.
-        return (_new(TreeDecl, (t.id, path, t.start + o, t.end + o, t.calls, spans)),), (), ()
-    return (
-        tuple(
-            TreeDecl(
-                t.id,
-                path,
-                t.start + o,
-                t.end + o,
-                t.calls,
-                tuple([(s + o, e + o) for s, e in t.call_spans]) if t.call_spans else (),
-            )
-            for t in local.trees
-        )
-        if local.trees
-        else (),
-        tuple(
-            ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o) for m in local.models
-        )
-        if local.models
-        else (),
-        tuple(
-            ModelDecl(m.id, m.category, m.ports, path, m.start + o, m.end + o)
-            for m in local.subtree_models
-        )
-        if local.subtree_models
-        else (),
+    trees_at: list[int] = []
+    models_at: list[int] = []
+    subs_at: list[int] = []
+    for section, o in zip(sections, origins, strict=True):
+        trees_at.append(len(trees))
+        models_at.append(len(models))
+        subs_at.append(len(subtree_models))
+        local: DocumentFacts | None = section.cache.get("facts")
+        if local is None:
+            local = section.cache["facts"] = extract(section.local_model(root), None)
+        if not local.models and not local.subtree_models and len(local.trees) == 1:
+            t = local.trees[0]  # the usual section: one tree
+            # Made without the named tuple's constructor, as every tree of a first analysis.
+            trees.append(_new(TreeDecl, (t.id, path, t.start + o, t.end + o, t.calls, t[5])))
+            continue
+        if local.trees:
+            trees.extend(_moved_trees(local.trees, o, path))
+        if local.models:
+            models.extend(_moved_models(local.models, o, path))
+        if local.subtree_models:
+            subtree_models.extend(_moved_models(local.subtree_models, o, path))
+    trees_at.append(len(trees))
+    models_at.append(len(models))
+    subs_at.append(len(subtree_models))
+    return DocumentFacts(
+        path,
+        tuple(trees),
+        tuple(models),
+        tuple(subtree_models),
+        _Layout(sections, origins, trees_at, models_at, subs_at),
     )
+
+
+_new = tuple.__new__
+_make_tree = partial(_new, TreeDecl)
+_make_model = partial(_new, ModelDecl)
+_F0, _F1, _F2, _F3, _F4, _F5 = (itemgetter(i) for i in range(6))
+
+
+def _moved_trees(decls: Sequence[TreeDecl], by: int, path: str | None) -> Iterator[TreeDecl]:
+    """``decls`` moved by ``by`` characters, of ``path``, made by C code alone: a
+    megabyte has thousands of trees."""
+    paths = repeat(path)
+    add = by.__add__
+    starts, ends = map(add, map(_F2, decls)), map(add, map(_F3, decls))
+    ids, calls, offsets = map(_F0, decls), map(_F4, decls), map(_F5, decls)
+    columns = zip(ids, paths, starts, ends, calls, offsets, strict=False)
+    return map(_make_tree, columns)
+
+
+def _moved_models(decls: Sequence[ModelDecl], by: int, path: str | None) -> Iterator[ModelDecl]:
+    """:func:`_moved_trees` for model entries."""
+    paths = repeat(path)
+    add = by.__add__
+    starts, ends = map(add, map(_F4, decls)), map(add, map(_F5, decls))
+    ids, categories, ports = map(_F0, decls), map(_F1, decls), map(_F2, decls)
+    columns = zip(ids, categories, ports, paths, starts, ends, strict=False)
+    return map(_make_model, columns)
 
 
 def _id_span(el: Element) -> tuple[str | None, int, int]:
@@ -409,7 +523,9 @@ class _OpenTree:
     spans: list[tuple[int, int]] = field(default_factory=list)
 
     def close(self, path: str | None) -> TreeDecl:
-        return TreeDecl(self.id, path, self.start, self.end, tuple(self.calls), tuple(self.spans))
+        s = self.start
+        spans = tuple([(a - s, b - s) for a, b in self.spans])
+        return TreeDecl(self.id, path, s, self.end, tuple(self.calls), spans)
 
 
 @dataclass(slots=True)

@@ -263,8 +263,9 @@ def _report_cycle(
     for j in range(len(ids) - 1, k - 1, -1):
         decl = graph[ids[j]]
         idx = done[j] - 1
-        if st.ctx.is_own(decl) and 0 <= idx < len(decl.call_spans):
-            target = decl.call_spans[idx]
+        if st.ctx.is_own(decl) and 0 <= idx < len(decl.call_offsets):
+            s, e = decl.call_offsets[idx]
+            target = (decl.start + s, decl.start + e)
             break
     if target is None or target in flagged:
         return
