@@ -247,3 +247,20 @@ def test_declarations_of_an_edit_are_made_from_the_last_version() -> None:
     assert [t.start for t in after.trees[k + 1 :]] == [t.start + 1 for t in before.trees[k + 1 :]]
     assert after.models[0].start == before.models[0].start + 1
     assert facts_of(doc) is after
+
+
+def test_a_cycle_found_before_an_edit_is_reported_where_it_now_is() -> None:
+    """The walk for cycles is used again while the calls between trees are the same; its
+    report follows the call it names when an edit before the call moves it."""
+    doc = Document(MANY)
+    first = [d for d in analyze(doc) if d.code == "subtree-recursion"]
+    assert len(first) == 1
+    at = doc.text.index("<Sequence")
+    doc.edit(at, at, "<!-- moved -->")
+    (moved,) = [d for d in analyze(doc) if d.code == "subtree-recursion"]
+    assert (moved.start, moved.end) == (first[0].start + 14, first[0].end + 14)
+    assert doc.text[moved.start : moved.end] == "Main"
+    # A change of the calls is walked again: with Helper's call gone, no cycle is left.
+    call = doc.text.index('<SubTree ID="Main"/>')
+    doc.edit(call, call + len('<SubTree ID="Main"/>'), "<Wait/>")
+    assert not [d for d in analyze(doc) if d.code == "subtree-recursion"]

@@ -15,7 +15,7 @@ combining is proportional to the number of declarations, not to the size of the 
 from __future__ import annotations
 
 import weakref
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from itertools import chain, compress, count, repeat
@@ -221,53 +221,73 @@ class Context:
         """
         own_path = path if path is not None else own.path
         own_facts = facts_of(own, own_path)
-        models: dict[str, ModelDecl] = {}
-        subtree_models: dict[str, ModelDecl] = {}
-        trees: dict[str, list[TreeDecl]] = {}
-        workspace_trees: dict[str, list[TreeDecl]] = {}
-
-        def add_models(f: DocumentFacts) -> None:
-            for m in f.models:
-                if m.id not in BUILTINS:
-                    models.setdefault(m.id, m)
-            for m in f.subtree_models:
-                subtree_models.setdefault(m.id, m)
-
-        add_models(own_facts)
-        included: list[DocumentFacts] = []
+        # Gathered in the order of precedence, then grouped by ID in C (see _first_by_id).
+        models: list[tuple[ModelDecl, ...]] = [own_facts.models]
+        subtree_models: list[tuple[ModelDecl, ...]] = [own_facts.subtree_models]
+        trees: list[tuple[TreeDecl, ...]] = []
+        workspace_trees: list[tuple[TreeDecl, ...]] = []
         sources: list[object] = [own_path]
         for other_path, other, in_closure in others:
             if other_path == own_path:
                 continue
             f = facts_of(other, other_path)
             sources.append((f, in_closure))
-            add_models(f)
-            if in_closure:
-                included.append(f)
-            else:
-                for t in f.trees:
-                    workspace_trees.setdefault(t.id, []).append(t)
-        for f in (*included, own_facts):
-            for t in f.trees:
-                trees.setdefault(t.id, []).append(t)
+            models.append(f.models)
+            subtree_models.append(f.subtree_models)
+            (trees if in_closure else workspace_trees).append(f.trees)
+        trees.append(own_facts.trees)
         catalog = False
         for model_path, model_doc in model_files:
             f = facts_of(model_doc, model_path)
             sources.append(f)
-            add_models(f)
+            models.append(f.models)
+            subtree_models.append(f.subtree_models)
             catalog = catalog or any(m.id not in BUILTINS for m in f.models)
         has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
         return cls(
             path=own_path,
-            models=MappingProxyType(models),
-            subtree_models=MappingProxyType(subtree_models),
-            trees=MappingProxyType({k: tuple(v) for k, v in trees.items()}),
-            workspace_trees=MappingProxyType({k: tuple(v) for k, v in workspace_trees.items()}),
+            models=MappingProxyType(_first_by_id(models, BUILTINS)),
+            subtree_models=MappingProxyType(_first_by_id(subtree_models)),
+            trees=MappingProxyType(_all_by_id(trees)),
+            workspace_trees=MappingProxyType(_all_by_id(workspace_trees)),
             workspace_has_custom_models=has_custom,
             ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
             included_by=tuple(included_by),
             sources=(*sources, workspace_has_custom_models),
         )
+
+
+def _first_by_id(
+    groups: Iterable[tuple[ModelDecl, ...]], left_out: Collection[str] = ()
+) -> dict[str, ModelDecl]:
+    """The first declaration of each ID (but those in ``left_out``), in the order of their
+    first declarations.  Grouped in C when no ID repeats, as usual: an edit combines every
+    declaration of the document again."""
+    decls = list(chain.from_iterable(groups))
+    ids = list(map(_F0, decls))
+    if len(set(ids)) == len(ids):
+        out = dict(zip(ids, decls, strict=True))
+        for key in out.keys() & left_out:
+            del out[key]
+        return out
+    out = {}
+    for d in decls:
+        if d.id not in left_out:
+            out.setdefault(d.id, d)
+    return out
+
+
+def _all_by_id(groups: Iterable[tuple[TreeDecl, ...]]) -> dict[str, tuple[TreeDecl, ...]]:
+    """Every declaration of each ID in order, in the order of their first declarations
+    (grouped in C when no ID repeats)."""
+    decls = list(chain.from_iterable(groups))
+    ids = list(map(_F0, decls))
+    if len(set(ids)) == len(ids):
+        return dict(zip(ids, zip(decls), strict=True))  # zip of one makes 1-tuples
+    lists: dict[str, list[TreeDecl]] = {}
+    for d in decls:
+        lists.setdefault(d.id, []).append(d)
+    return {k: tuple(v) for k, v in lists.items()}
 
 
 # --- extraction ---------------------------------------------------------------------------

@@ -5,6 +5,7 @@ workspace live in :mod:`bt_lsp.semantics` and are combined in :mod:`bt_lsp.analy
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
@@ -109,6 +110,12 @@ def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
     return d.start, d.end, d.code
 
 
+# For each document, the sections of its last model and those of them with diagnostics.
+_NOISY: weakref.WeakKeyDictionary[Document, tuple[set[Section], set[Section]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
 def _own(section: Section) -> list[Diagnostic]:
     """The diagnostics of one section (in its coordinates), computed once."""
     out: list[Diagnostic] | None = section.cache.get("diagnostics")
@@ -127,16 +134,24 @@ def compute(doc: Document) -> list[Diagnostic]:
         out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
         out.extend(name_diagnostics(model))
     else:
-        # Each section's own diagnostics are kept on it; they are only moved here.
+        # Each section's own diagnostics are kept on it; they are only moved here, from
+        # the sections that have some.  Which those are is remembered for the document:
+        # an edit leaves all but a few sections as they were.
         out = list(_own(model.head))
-        for section, origin in zip(model.sections, model.origins, strict=True):
-            found = _own(section)
-            if found:
+        sections = model.sections
+        now = set(sections)
+        seen, noisy = _NOISY.get(doc, (set(), set()))
+        noisy = noisy & now
+        noisy.update(sec for sec in now - seen if _own(sec))
+        _NOISY[doc] = (now, noisy)
+        if noisy:
+            origins = model.origins
+            index = dict(zip(sections, range(len(sections)), strict=True))
+            for k in sorted(index[sec] for sec in noisy):
+                o = origins[k]
                 out.extend(
-                    Diagnostic(
-                        d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data
-                    )
-                    for d in found
+                    Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)
+                    for d in _own(sections[k])
                 )
         if model.tail is not None:
             out.extend(_own(model.tail))

@@ -30,7 +30,7 @@ from collections import OrderedDict
 from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
-from itertools import accumulate
+from itertools import accumulate, compress, count
 from typing import Any, NamedTuple, overload
 
 from bt_lsp.bulk import bulk
@@ -362,7 +362,8 @@ class Part:
             el.end + o if el.end >= 0 else -1,
             el.end_name_start + o if el.end_name_start >= 0 else -1,
             el.end_name_end + o if el.end_name_end >= 0 else -1,
-            [g(c) for c in el.children],
+            # Children are never the root (local 0): a top element may have thousands.
+            list(map((self.elem_base - 1).__add__, el.children)),
             el.content,
         )
 
@@ -638,10 +639,10 @@ class Model:
             tops = self.top_names
             if not any(name in tops for name in names):  # a search in C
                 return []
+            wanted = frozenset(names)  # looked up in C, over thousands of trees
             return [
                 _top(self.sections[k], self.origins[k], self.firsts[k], self.bases[k])
-                for k, name in enumerate(tops)
-                if name in names
+                for k in compress(count(), map(wanted.__contains__, tops))
             ]
         return [c for c in self.root_children() if c.name in names]
 

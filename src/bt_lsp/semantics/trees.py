@@ -27,12 +27,19 @@
 from __future__ import annotations
 
 import os
+import weakref
+from itertools import compress
+from operator import itemgetter
+from typing import TYPE_CHECKING
 
 from bt_lsp.builtins import BUILTINS
 from bt_lsp.codes import Severity
 from bt_lsp.context import TreeDecl
 from bt_lsp.model import Element
 from bt_lsp.semantics.base import State, TreeScope, quoted
+
+if TYPE_CHECKING:
+    from bt_lsp.document import Document
 
 
 def _where(st: State, decl: TreeDecl) -> str:
@@ -99,11 +106,12 @@ def begin_tree(st: State, el: Element) -> None:
 def check_duplicate_ids(st: State) -> None:
     """``duplicate-tree-id`` for this document's trees.  A document-wide rule: it compares
     the positions of the definitions, which every edit before them moves."""
-    for tree_id, decls in st.ctx.trees.items():
-        if len(decls) > 1:
-            for d in decls:
-                if st.ctx.is_own(d):
-                    _duplicate(st, tree_id, d.start, d.end)
+    trees = st.ctx.trees
+    # The IDs defined more than once, found in C: most documents have none.
+    for tree_id in compress(trees.keys(), map((1).__lt__, map(len, trees.values()))):
+        for d in trees[tree_id]:
+            if st.ctx.is_own(d):
+                _duplicate(st, tree_id, d.start, d.end)
 
 
 def _duplicate(st: State, tree_id: str, start: int, end: int) -> None:
@@ -194,30 +202,72 @@ def check_main_tree(st: State) -> None:
     _unknown_tree(st, a.value, s, e, "unknown-main-tree", "main_tree_to_execute names")
 
 
+# A cycle found: the tree whose call is reported, the index of that call among its calls,
+# and the cycle as shown.
+_Cycle = tuple[str, int, str]
+# What the walk reads: the main tree, this document's path, and the visible tree IDs with
+# the calls and path of the definition kept for each.
+_Graph = tuple[
+    str | None, str | None, tuple[str, ...], tuple[tuple[str, ...], ...], tuple[str | None, ...]
+]
+# The last walk of each document, used again while its graph is the same: typing inside a
+# tree rarely changes which trees call which.
+_WALKS: weakref.WeakKeyDictionary[Document, tuple[_Graph, list[_Cycle]]] = (
+    weakref.WeakKeyDictionary()
+)
+_LAST = itemgetter(-1)
+_PATH, _CALLS = itemgetter(1), itemgetter(4)
+
+
 def check_recursion(st: State) -> None:
     """Find SubTree cycles among the visible trees; report the closing calls that are ours."""
     ctx = st.ctx
     if not ctx.trees:
         return
-    # The definition BehaviorTree.CPP uses for each ID (the last one loaded), for the trees
-    # that call others: a tree that calls none cannot be on a cycle.
-    graph: dict[str, TreeDecl] = {
-        tid: decls[-1] for tid, decls in ctx.trees.items() if decls[-1].calls
-    }
-    if not graph:
-        return
-    order: list[str] = []
     root = st.model.root
     main = root.value("main_tree_to_execute") if root is not None else None
+    # The definition BehaviorTree.CPP uses for each ID is the last one loaded.  Made in C:
+    # an edit of a large document compares it with the last one instead of walking again.
+    kept: list[TreeDecl] = list(map(_LAST, ctx.trees.values()))
+    graph_key: _Graph = (
+        main,
+        ctx.path,
+        tuple(ctx.trees),
+        tuple(map(_CALLS, kept)),
+        tuple(map(_PATH, kept)),
+    )
+    last = _WALKS.get(st.doc)
+    if last is not None and last[0] == graph_key:
+        cycles = last[1]
+    else:
+        cycles = _walk(dict(zip(graph_key[2], kept, strict=True)), main, ctx.path)
+        _WALKS[st.doc] = (graph_key, cycles)
+    for tree_id, idx, shown in cycles:
+        decl = ctx.trees[tree_id][-1]
+        s, e = decl.call_offsets[idx]
+        st.add(
+            decl.start + s,
+            decl.start + e,
+            "subtree-recursion",
+            f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive trees",
+        )
+
+
+def _walk(kept: dict[str, TreeDecl], main: str | None, own: str | None) -> list[_Cycle]:
+    """The cycles of the calls between the trees ``kept`` (by ID), by a depth-first walk
+    from the main tree, then from this document's trees, then from the others."""
+    # A tree that calls none cannot be on a cycle.
+    graph = {tid: decl for tid, decl in kept.items() if decl.calls}
+    if not graph:
+        return []
+    order: list[str] = []
     if main:
         order.append(main)
-    # Then this document's trees: its declarations come last for each ID (see
-    # Context.trees), so a tree is ours when the one kept is.
-    own = ctx.path
     order.extend([tid for tid, decl in graph.items() if decl.path == own])
     order.extend(graph)
     state: dict[str, int] = {}  # 1 on the stack, 2 done
-    flagged: set[tuple[int, int]] = set()
+    found: list[_Cycle] = []
+    flagged: set[tuple[str, int]] = set()
     for start_id in order:
         if start_id not in graph or start_id in state:
             continue
@@ -242,38 +292,28 @@ def check_recursion(st: State) -> None:
                 ids.append(callee)
                 done.append(0)
             elif cs == 1:
-                _report_cycle(st, graph, ids, done, callee, flagged)
+                cycle = _cycle(graph, ids, done, callee, own)
+                if cycle is not None and cycle[:2] not in flagged:
+                    flagged.add(cycle[:2])
+                    found.append(cycle)
+    return found
 
 
-def _report_cycle(
-    st: State,
-    graph: dict[str, TreeDecl],
-    ids: list[str],
-    done: list[int],
-    callee: str,
-    flagged: set[tuple[int, int]],
-) -> None:
+def _cycle(
+    graph: dict[str, TreeDecl], ids: list[str], done: list[int], callee: str, own: str | None
+) -> _Cycle | None:
+    """The cycle that the call to ``callee`` closes, at the last of its calls that this
+    document makes (``None`` when it makes none)."""
     # The cycle is the stack from `callee` to the top; each tree's last followed call
     # (index done - 1) leads to the next one, the top's closes the cycle.
     k = len(ids) - 1
     while k > 0 and ids[k] != callee:
         k -= 1
     path = [*ids[k:], callee]
-    target: tuple[int, int] | None = None
     for j in range(len(ids) - 1, k - 1, -1):
         decl = graph[ids[j]]
         idx = done[j] - 1
-        if st.ctx.is_own(decl) and 0 <= idx < len(decl.call_offsets):
-            s, e = decl.call_offsets[idx]
-            target = (decl.start + s, decl.start + e)
-            break
-    if target is None or target in flagged:
-        return
-    flagged.add(target)
-    shown = " → ".join(path) if len(path) <= 8 else " → ".join([*path[:4], "…", *path[-3:]])
-    st.add(
-        target[0],
-        target[1],
-        "subtree-recursion",
-        f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive trees",
-    )
+        if decl.path == own and 0 <= idx < len(decl.call_offsets):
+            shown = " → ".join(path) if len(path) <= 8 else " → ".join([*path[:4], "…", *path[-3:]])
+            return ids[j], idx, shown
+    return None
