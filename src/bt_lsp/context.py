@@ -21,7 +21,7 @@ from functools import partial
 from itertools import chain, compress, count, repeat
 from operator import is_not, itemgetter, ne, or_
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Final, NamedTuple, TypeVar, cast
+from typing import TYPE_CHECKING, Any, Final, NamedTuple, TypeVar, cast
 
 from bt_lsp.builtins import BUILTINS, Category, Direction, PortModel
 from bt_lsp.model import Element, Model, Section, Zone
@@ -264,7 +264,7 @@ def _first_by_id(
     first declarations.  Grouped in C when no ID repeats, as usual: an edit combines every
     declaration of the document again."""
     decls = list(chain.from_iterable(groups))
-    ids = list(map(_F0, decls))
+    ids = list(map(_FIELDS[0], decls))
     if len(set(ids)) == len(ids):
         out = dict(zip(ids, decls, strict=True))
         for key in out.keys() & left_out:
@@ -281,7 +281,7 @@ def _all_by_id(groups: Iterable[tuple[TreeDecl, ...]]) -> dict[str, tuple[TreeDe
     """Every declaration of each ID in order, in the order of their first declarations
     (grouped in C when no ID repeats)."""
     decls = list(chain.from_iterable(groups))
-    ids = list(map(_F0, decls))
+    ids = list(map(_FIELDS[0], decls))
     if len(set(ids)) == len(ids):
         return dict(zip(ids, zip(decls), strict=True))  # zip of one makes 1-tuples
     lists: dict[str, list[TreeDecl]] = {}
@@ -381,7 +381,7 @@ class _Cut:
         old_at: list[int],
         new: tuple[D, ...],
         new_at: list[int],
-        move: Callable[[Sequence[D], int, str | None], Iterator[D]],
+        move: _Mover,
     ) -> tuple[tuple[D, ...], list[int]]:
         """One kind of declaration: the old ones of the sections kept, the new ones of the
         sections in between, and where each section's begin."""
@@ -441,30 +441,30 @@ def _extract_all(
 
 
 _new = tuple.__new__
-_make_tree = partial(_new, TreeDecl)
-_make_model = partial(_new, ModelDecl)
-_F0, _F1, _F2, _F3, _F4, _F5 = (itemgetter(i) for i in range(6))
+_FIELDS = tuple(itemgetter(i) for i in range(6))
 
 
-def _moved_trees(decls: Sequence[TreeDecl], by: int, path: str | None) -> Iterator[TreeDecl]:
-    """``decls`` moved by ``by`` characters, of ``path``, made by C code alone: a
-    megabyte has thousands of trees."""
-    paths = repeat(path)
-    add = by.__add__
-    starts, ends = map(add, map(_F2, decls)), map(add, map(_F3, decls))
-    ids, calls, offsets = map(_F0, decls), map(_F4, decls), map(_F5, decls)
-    columns = zip(ids, paths, starts, ends, calls, offsets, strict=False)
-    return map(_make_tree, columns)
+class _Mover(NamedTuple):
+    """Moves declarations of one kind: where their path and start are among their six
+    fields (the end follows the start)."""
+
+    make: Callable[[Iterable[object]], Any]
+    path_at: int
+    start_at: int
+
+    def __call__(self, decls: Sequence[D], by: int, path: str | None) -> Iterator[D]:
+        """``decls`` moved by ``by`` characters, of ``path``, made by C code alone: a
+        megabyte has thousands of trees."""
+        columns: list[Iterator[Any]] = [map(f, decls) for f in _FIELDS]
+        columns[self.path_at] = repeat(path)
+        add = by.__add__
+        s = self.start_at
+        columns[s], columns[s + 1] = map(add, columns[s]), map(add, columns[s + 1])
+        return map(self.make, zip(*columns, strict=False))
 
 
-def _moved_models(decls: Sequence[ModelDecl], by: int, path: str | None) -> Iterator[ModelDecl]:
-    """:func:`_moved_trees` for model entries."""
-    paths = repeat(path)
-    add = by.__add__
-    starts, ends = map(add, map(_F4, decls)), map(add, map(_F5, decls))
-    ids, categories, ports = map(_F0, decls), map(_F1, decls), map(_F2, decls)
-    columns = zip(ids, categories, ports, paths, starts, ends, strict=False)
-    return map(_make_model, columns)
+_moved_trees = _Mover(partial(_new, TreeDecl), *map(TreeDecl._fields.index, ("path", "start")))
+_moved_models = _Mover(partial(_new, ModelDecl), *map(ModelDecl._fields.index, ("path", "start")))
 
 
 def _id_span(el: Element) -> tuple[str | None, int, int]:
