@@ -388,9 +388,8 @@ class _Cut:
         first, stop = self.first, self.stop
         head_end: int = old_at[first]
         tail_start: int = old_at[stop]
-        tail: Iterable[D] = old[tail_start:]
-        if self.delta:
-            tail = move(old[tail_start:], self.delta, self.path)
+        kept = old[tail_start:]
+        tail: Iterable[D] = move(kept, self.delta, self.path) if self.delta else kept
         decls: tuple[D, ...] = tuple(chain(old[:head_end], new, tail))
         shift = head_end + len(new) - tail_start
         at = old_at[:first]
