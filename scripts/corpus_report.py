@@ -11,9 +11,9 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from bt_lsp.codes import Severity
-from bt_lsp.fileio import FileError, read_text
-from bt_lsp.workspace import Workspace, normalize
+from bt_lsp.project.fileio import FileError, read_text
+from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.rules.codes import Severity
 
 
 def main() -> int:

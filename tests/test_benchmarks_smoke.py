@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from bt_lsp.analysis import analyze
-from bt_lsp.document import Document
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.syntax.document import Document
 
 BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
 sys.path.insert(0, str(BENCH))

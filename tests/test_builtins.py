@@ -1,4 +1,4 @@
-"""Tests for bt_lsp.builtins: the built-in node table and literal conversions."""
+"""Tests for bt_lsp.rules.builtins: the built-in node table and literal conversions."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from bt_lsp.builtins import (
+from bt_lsp.rules.builtins import (
     BUILTINS,
     V3_RENAMES,
     NodeModel,

@@ -17,10 +17,11 @@ from typing import Any
 import pytest
 from lxml import etree
 
-from bt_lsp import __version__, fixes
-from bt_lsp.cli import main
-from bt_lsp.codes import CODES
-from bt_lsp.edits import TextEdit
+from bt_lsp import __version__
+from bt_lsp.cli.main import main
+from bt_lsp.ide import name_fixes as fixes
+from bt_lsp.rules.codes import CODES
+from bt_lsp.syntax.edits import TextEdit
 from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
 
 # 😋 (outside the BMP) sits before the bad port name on line 4: its column counts the emoji
@@ -156,7 +157,7 @@ def test_serve_calls_server_lazily(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_check_does_not_import_the_server(work: Path) -> None:
     _put(work / "a.xml", CLEAN)
     code = (
-        "import sys; from bt_lsp.cli import main; rc = main(['check', 'a.xml']); "
+        "import sys; from bt_lsp.cli.main import main; rc = main(['check', 'a.xml']); "
         "print(rc, sorted(m for m in sys.modules if m.split('.')[0] in "
         "('pygls', 'lsprotocol') or m.startswith('bt_lsp.server')))"
     )
@@ -211,8 +212,8 @@ def test_text_output_exact_positions(work: Path, capsys: pytest.CaptureFixture[s
 def test_full_line_format(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _put(work / "crlf.xml", CRLF)
     assert main(["check", "crlf.xml"]) == 1
-    from bt_lsp.analysis import analyze
-    from bt_lsp.document import Document
+    from bt_lsp.rules.analysis import analyze
+    from bt_lsp.syntax.document import Document
 
     (diag,) = analyze(Document(CRLF))
     assert capsys.readouterr().out == (
@@ -817,7 +818,7 @@ def test_fix_does_not_rewrite_a_clean_file(work: Path, capsys: pytest.CaptureFix
 def test_internal_error_names_the_file_and_goes_on(
     work: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from bt_lsp import analysis
+    from bt_lsp.rules import analysis
 
     real = analysis.analyze
 

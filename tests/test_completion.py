@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
-from bt_lsp.builtins import BUILTINS
-from bt_lsp.completion import Completions, Item, ItemKind, complete
-from bt_lsp.context import Context
-from bt_lsp.document import Document
+from bt_lsp.ide.completion import Completions, Item, ItemKind, complete
+from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
 from tests.marks import unmark
 
 CURSOR = "‸"

@@ -13,8 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.document import Document
-from bt_lsp.fileio import read_text
+from bt_lsp.project.fileio import read_text
+from bt_lsp.rules.diagnostics import own_diagnostics
+from bt_lsp.syntax.document import Document
 
 CORPUS = Path(__file__).parent / "data" / "corpus"
 ROWS = list(csv.DictReader((CORPUS / "FINDINGS.tsv").open(encoding="utf-8"), delimiter="\t"))
@@ -33,7 +34,7 @@ def recorded_names(row: dict[str, str]) -> set[str]:
 @pytest.mark.parametrize("row", ROWS, ids=[r["file"] for r in ROWS])
 def test_corpus_file(row: dict[str, str]) -> None:
     doc = Document(read_text(str(CORPUS / row["file"])).text)
-    diags = doc.diagnostics
+    diags = own_diagnostics(doc)
     flagged = {doc.text[d.start : d.end] for d in diags if d.is_name_rule}
     assert flagged == recorded_names(row)
     syntax = [d for d in diags if d.code == "xml-syntax"]

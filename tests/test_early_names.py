@@ -1,4 +1,4 @@
-"""The early name pass (bt_lsp.early_names): what it reports is exactly what the full
+"""The early name pass (bt_lsp.rules.early_names): what it reports is exactly what the full
 analysis reports for the name rules, or it gives up."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.analysis import analyze
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document
-from bt_lsp.early_names import early_name_diagnostics
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.early_names import early_name_diagnostics
+from bt_lsp.syntax.document import Document
 from tests.test_scanner import xmlish
 
 EXAMPLES = int(os.environ.get("BT_LSP_FUZZ_EXAMPLES", "150"))

@@ -13,8 +13,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bt_lsp import fileio
-from bt_lsp.fileio import (
+from bt_lsp.project import fileio
+from bt_lsp.project.fileio import (
     DEFAULT_MAX_BYTES,
     Decoded,
     FileError,

@@ -7,13 +7,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lxml import etree
 
-from bt_lsp.analysis import analyze
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document
-from bt_lsp.edits import apply_edits
-from bt_lsp.fixes import Fix, escape_value, fix_all, fixes_for
-from bt_lsp.hover import hover_at
-from bt_lsp.navigation import RenamePlan, RenameRefused, rename
+from bt_lsp.ide.hover import hover_at
+from bt_lsp.ide.name_fixes import Fix, escape_value, fix_all, fixes_for
+from bt_lsp.ide.navigation import RenamePlan, RenameRefused, rename
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import apply_edits
 
 DOC = (
     '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\n'
@@ -35,11 +35,11 @@ DOC = (
 
 
 def name_diags(doc: Document) -> list[str]:
-    return [d.code for d in doc.diagnostics if d.is_name_rule]
+    return [d.code for d in own_diagnostics(doc) if d.is_name_rule]
 
 
 def preferred_fix(doc: Document, name: str) -> tuple[str, str]:
-    for d in doc.diagnostics:
+    for d in own_diagnostics(doc):
         if d.is_name_rule and doc.text[d.start : d.end] == name:
             fixes = fixes_for(doc, d)
             assert fixes[0].preferred and not any(f.preferred for f in fixes[1:])
@@ -83,7 +83,7 @@ def test_replacement_is_unique() -> None:
 
 def test_fix_all_is_consistent_and_leaves_no_name_errors() -> None:
     doc = Document(DOC)
-    fixed = apply_edits(doc.text, fix_all(doc, doc.diagnostics).edits)
+    fixed = apply_edits(doc.text, fix_all(doc, own_diagnostics(doc)).edits)
     etree.fromstring(fixed.encode())  # still well-formed
     assert name_diags(Document(fixed)) == []
     assert fixed.count("Main_Tree") == 3 and fixed.count("Open_Door") == 4
@@ -94,7 +94,7 @@ def test_fix_all_gives_distinct_names_to_distinct_symbols() -> None:
         '<root><BehaviorTree ID="A B"><SubTree ID="A.B"/></BehaviorTree>'
         '<BehaviorTree ID="A.B"><AlwaysSuccess/></BehaviorTree></root>'
     )
-    fixed = Document(apply_edits(doc.text, fix_all(doc, doc.diagnostics).edits))
+    fixed = Document(apply_edits(doc.text, fix_all(doc, own_diagnostics(doc)).edits))
     ids = [r.text for r in fixed.model.refs if r.role == "tree ID"]
     assert len(set(ids)) == 2 and name_diags(fixed) == []
 
@@ -120,7 +120,7 @@ def test_fix_all_on_random_names_keeps_xml_well_formed(tree: str, node: str, por
         "</TreeNodesModel></root>"
     )
     doc = Document(text)
-    fixed = apply_edits(text, fix_all(doc, doc.diagnostics).edits)
+    fixed = apply_edits(text, fix_all(doc, own_diagnostics(doc)).edits)
     etree.fromstring(fixed.encode())
     assert name_diags(Document(fixed)) == []
 
@@ -196,7 +196,7 @@ def _diag_at(doc: Document, needle: str, nth: int = 0) -> Diagnostic:
     start = -1
     for _ in range(nth + 1):
         start = doc.text.index(needle, start + 1)
-    for d in doc.diagnostics:
+    for d in own_diagnostics(doc):
         if d.is_name_rule and start <= d.start and d.end <= start + len(needle):
             return d
     raise AssertionError(f"no name diagnostic in {needle!r} #{nth}")
@@ -290,7 +290,7 @@ def test_bare_same_key_is_written_out_with_braces() -> None:
 
 def test_fix_all_renames_tree_ports_with_their_keys() -> None:
     doc = Document(PORTS)
-    result = fix_all(doc, doc.diagnostics)
+    result = fix_all(doc, own_diagnostics(doc))
     assert result.notes == []
     fixed = apply_edits(PORTS, result.edits)
     # Greet's key "bad.port" is renamed, so the {=} passed on to Leaf becomes that new key
@@ -304,7 +304,7 @@ def test_fix_all_is_the_same_as_the_quick_fixes_one_after_the_other() -> None:
     text = PORTS
     while True:
         doc = Document(text)
-        diags = [d for d in doc.diagnostics if d.is_name_rule]
+        diags = [d for d in own_diagnostics(doc) if d.is_name_rule]
         if not diags:
             break
         text = apply_edits(text, fixes_for(doc, diags[0])[0].edits)
@@ -350,7 +350,7 @@ def test_refused_key_rename_falls_back_to_the_port_and_says_so() -> None:
     ]
     expected = AUTOREMAP.replace('name="bad.port"', 'name="bad_port"')
     assert apply_edits(AUTOREMAP, found[0].edits) == expected
-    result = fix_all(doc, doc.diagnostics)
+    result = fix_all(doc, own_diagnostics(doc))
     assert apply_edits(AUTOREMAP, result.edits) == expected
     assert result.notes == [
         "renamed 'bad.port' to 'bad_port' and left the key 'bad.port' in tree 'Sub' as it "
@@ -396,7 +396,7 @@ def test_a_new_name_that_would_merge_two_keys_is_passed_over() -> None:
         'value="{bad.port}"/></Sequence>', 'value="{badPort}"/></Sequence>'
     )
     assert apply_edits(text, found[0].edits) == expected
-    assert apply_edits(text, fix_all(doc, doc.diagnostics).edits) == expected
+    assert apply_edits(text, fix_all(doc, own_diagnostics(doc)).edits) == expected
     assert _semantic(Document(expected)) == _semantic(doc)
 
 
@@ -426,4 +426,4 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
         "{bad.port}", "{bad_port}"
     )
     # fix_all changes its own document only.
-    assert fix_all(models, models.diagnostics).edits == list(fix.edits)
+    assert fix_all(models, own_diagnostics(models)).edits == list(fix.edits)

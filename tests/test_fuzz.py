@@ -12,11 +12,11 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.analysis import analyze
-from bt_lsp.document import Document
-from bt_lsp.edits import apply_edits
-from bt_lsp.fixes import fix_all, fixes_for
-from bt_lsp.hover import hover_at
+from bt_lsp.ide.hover import hover_at
+from bt_lsp.ide.name_fixes import fix_all, fixes_for
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import apply_edits
 from tests.test_scanner import xmlish
 
 EXAMPLES = int(os.environ.get("BT_LSP_FUZZ_EXAMPLES", "150"))

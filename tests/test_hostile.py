@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.analysis import analyze
-from bt_lsp.document import Document
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.syntax.document import Document
 
 BILLION_LAUGHS = (
     '<?xml version="1.0"?>\n<!DOCTYPE lolz [\n <!ENTITY lol "lol">\n'
@@ -118,7 +118,7 @@ def test_checker_reads_no_entity_file_and_connects_nowhere(
     hostile: tuple[Path, Path, Listener],
 ) -> None:
     secret, doc, listener = hostile
-    code = AUDIT + "from bt_lsp.cli import main\nsys.exit(main(sys.argv[1:]))\n"
+    code = AUDIT + "from bt_lsp.cli.main import main\nsys.exit(main(sys.argv[1:]))\n"
     for args in (
         ["check", str(doc.parent)],
         ["check", "--fix", str(doc)],

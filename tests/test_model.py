@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from bt_lsp.document import Document
-from bt_lsp.model import Role, Zone
-from bt_lsp.names import NameKind
+from bt_lsp.rules.diagnostics import own_diagnostics
+from bt_lsp.rules.names import NameKind
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.model import Role, Zone
 from tests.marks import unmark
 
 # Every checked name position of the contract is marked; nothing else may be a checked name.
@@ -100,7 +101,9 @@ def test_zones() -> None:
 def xml_errors(text: str) -> list[tuple[str, str]]:
     doc = Document(text)
     return [
-        (doc.text[d.start : d.end], d.message) for d in doc.diagnostics if d.code == "xml-syntax"
+        (doc.text[d.start : d.end], d.message)
+        for d in own_diagnostics(doc)
+        if d.code == "xml-syntax"
     ]
 
 
@@ -129,7 +132,7 @@ def test_raw_amp_and_lt_in_values_are_warnings_only() -> None:
     doc = Document(
         '<root><BehaviorTree ID="T"><A _while="a && b&lt;1" _skipIf="x<1.0"/></BehaviorTree></root>'
     )
-    assert {d.code for d in doc.diagnostics} == {"xml-unescaped-char"}
+    assert {d.code for d in own_diagnostics(doc)} == {"xml-unescaped-char"}
 
 
 def test_invalid_xml_name_characters_not_covered_by_the_name_rules() -> None:

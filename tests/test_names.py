@@ -6,8 +6,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from bt_lsp.codes import CODES
-from bt_lsp.names import (
+from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.names import (
     BTCPP_RESERVED_ATTRIBUTES,
     FORBIDDEN,
     POSTCONDITIONS,

@@ -9,11 +9,7 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from bt_lsp.analysis import analyze
-from bt_lsp.builtins import BUILTINS
-from bt_lsp.document import Document
-from bt_lsp.edits import apply_edits
-from bt_lsp.navigation import (
+from bt_lsp.ide.navigation import (
     BUILTIN_CATALOG,
     DocSymbol,
     Fold,
@@ -32,7 +28,12 @@ from bt_lsp.navigation import (
     rename,
     workspace_symbols,
 )
-from bt_lsp.workspace import Workspace, normalize
+from bt_lsp.project.workspace import Workspace, links, normalize
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.diagnostics import own_diagnostics
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import apply_edits
 from tests.marks import unmark
 
 CURSOR = "‸"
@@ -195,7 +196,7 @@ def test_definition_across_files_prefers_the_include_closure(tmp_path: Path) -> 
     assert doc is not None
     others = {str(p): d for p, d in ws.bt_documents() if p != main}
     ctx = ws.context_for(main, doc)
-    includes = ws.includes(main, doc)
+    includes = links(ws.includes(main, doc))
     off = doc.text.index('"Dock"') + 2
     (place,) = definition(doc, off, others, ctx=ctx, includes=includes)
     assert place.path == str(dock)
@@ -331,7 +332,7 @@ def test_rename_model_reaches_element_names_end_tags_ids_and_entry() -> None:
     new = apply_edits(doc.text, plan.edits)
     assert "MoveBase" not in new and new.count("Drive") == 6
     etree.fromstring(new.encode())
-    assert not [d for d in Document(new).diagnostics if d.is_name_rule]
+    assert not [d for d in own_diagnostics(Document(new)) if d.is_name_rule]
 
 
 def test_rename_port_reaches_uses_of_that_model_only() -> None:

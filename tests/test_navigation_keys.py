@@ -6,10 +6,8 @@ from __future__ import annotations
 import pytest
 from lxml import etree
 
-from bt_lsp.blackboard import KeyForm, blackboard_keys, key_uses
-from bt_lsp.document import Document
-from bt_lsp.edits import apply_edits
-from bt_lsp.navigation import (
+from bt_lsp.ide.blackboard import KeyForm, blackboard_keys, key_uses
+from bt_lsp.ide.navigation import (
     Place,
     RenamePlan,
     RenameRefused,
@@ -19,6 +17,8 @@ from bt_lsp.navigation import (
     references,
     rename,
 )
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import apply_edits
 from tests.test_navigation import at, parse
 
 # Tree "Main" uses the key "target" in port values and in every kind of script; tree

@@ -9,8 +9,8 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 from lxml import etree
 
-from bt_lsp.names import NameKind, check_name, is_allowed_port_name
-from bt_lsp.sanitize import candidates, is_xml_name, sanitize
+from bt_lsp.ide.sanitize import candidates, is_xml_name, sanitize
+from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 
 MODEL = NameKind.MODEL
 PORT = NameKind.PORT

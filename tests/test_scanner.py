@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.scanner import Kind, decode_value, rescan, scan
+from bt_lsp.syntax.scanner import Kind, decode_value, rescan, scan
 
 # Text built from the pieces that matter to a tag scanner, so hypothesis reaches the
 # interesting states (half tags, quotes, references) far more often than with raw text.

@@ -1,4 +1,4 @@
-"""Tests for bt_lsp.script: BehaviorTree.CPP script syntax check."""
+"""Tests for bt_lsp.rules.script: BehaviorTree.CPP script syntax check."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.script import ScriptError, _Checker, check_script, identifiers
+from bt_lsp.rules.script import ScriptError, _Checker, check_script, identifiers
 
 # Every distinct script found in the real corpus (shared/corpus/real): Script/ScriptCondition
 # `code`, Precondition `if` and the eight pre/post-condition attributes, XML-decoded.

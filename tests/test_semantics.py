@@ -3,18 +3,18 @@
 Each case is an XML text with ``⟦…⟧`` around every expected diagnostic and the list of
 expected (code, severity) pairs in the order of the marks; the check must report exactly
 these, nothing more.  The rows of bt-xml.md §f that can be checked statically are all here
-(named after the row), plus every code of :mod:`bt_lsp.semantics`.
+(named after the row), plus every code of :mod:`bt_lsp.rules.semantics`.
 """
 
 from __future__ import annotations
 
 import pytest
 
-from bt_lsp import semantics
-from bt_lsp.analysis import analyze
-from bt_lsp.codes import CODES, Severity
-from bt_lsp.context import Context
-from bt_lsp.document import Document
+from bt_lsp.rules import semantics
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
 from tests.marks import unmark
 
 E, W, INFO, H = Severity.ERROR, Severity.WARNING, Severity.INFORMATION, Severity.HINT

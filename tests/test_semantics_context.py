@@ -6,9 +6,9 @@ import dataclasses
 
 import pytest
 
-from bt_lsp.builtins import PortModel
-from bt_lsp.context import Context, ModelDecl, TreeDecl, facts_of
-from bt_lsp.document import Document
+from bt_lsp.rules.builtins import PortModel
+from bt_lsp.rules.context import Context, ModelDecl, TreeDecl, facts_of
+from bt_lsp.syntax.document import Document
 
 MAIN = """<root BTCPP_format="4" main_tree_to_execute="Main">
   <BehaviorTree ID="Main">

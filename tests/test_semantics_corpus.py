@@ -22,11 +22,11 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp import semantics
-from bt_lsp.codes import Severity
-from bt_lsp.context import Context
-from bt_lsp.document import Document
-from bt_lsp.fileio import read_text
+from bt_lsp.project.fileio import read_text
+from bt_lsp.rules import semantics
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
 
 HERE = Path(__file__).parent
 LOCAL = HERE / "data" / "corpus"

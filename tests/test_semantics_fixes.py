@@ -7,15 +7,16 @@ from hypothesis import given
 from hypothesis import strategies as st
 from lxml import etree
 
-from bt_lsp import semantics
-from bt_lsp.analysis import analyze
-from bt_lsp.context import Context
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document
-from bt_lsp.edits import apply_edits
-from bt_lsp.fixes import Fix
-from bt_lsp.scanner import decode_value
-from bt_lsp.semantics.scripts import raw_offsets, raw_span
+from bt_lsp.ide import semantic_fixes
+from bt_lsp.ide.name_fixes import Fix
+from bt_lsp.rules import semantics
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.semantics.scripts import raw_offsets, raw_span
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import apply_edits
+from bt_lsp.syntax.scanner import decode_value
 from tests.marks import unmark
 from tests.test_semantics import CASES, R, T
 
@@ -24,7 +25,7 @@ def fixes(doc: Document, code: str, ctx: Context | None = None) -> tuple[Diagnos
     ctx = ctx if ctx is not None else Context.from_document(doc)
     diags = [d for d in analyze(doc, ctx) if d.code == code]
     assert diags, f"no {code}"
-    return diags[0], semantics.fixes_for(doc, ctx, diags[0])
+    return diags[0], semantic_fixes.fixes_for(doc, ctx, diags[0])
 
 
 def applied(doc: Document, fix: Fix) -> Document:
@@ -207,7 +208,7 @@ def test_unescaped_chars() -> None:
     assert len(diags) == 3
     edits = []
     for d in diags:
-        found = semantics.fixes_for(doc, ctx, d)
+        found = semantic_fixes.fixes_for(doc, ctx, d)
         assert len(found) == 1 and found[0].preferred
         edits.extend(found[0].edits)
     new = Document(apply_edits(doc.text, edits))
@@ -229,7 +230,7 @@ def test_every_fix_removes_its_diagnostic(marked: str) -> None:
     doc = Document(unmark(marked)[0])
     ctx = Context.from_document(doc)
     for diag in semantics.check(doc, ctx):
-        for fix in semantics.fixes_for(doc, ctx, diag):
+        for fix in semantic_fixes.fixes_for(doc, ctx, diag):
             new = Document(apply_edits(doc.text, fix.edits))
             after = analyze(new)
             assert not any(d.code == "xml-syntax" for d in after) or any(
@@ -282,5 +283,5 @@ def test_check_and_fixes_never_raise(tokens: list[str]) -> None:
     ctx = Context.from_document(doc)
     for diag in analyze(doc, ctx):
         assert 0 <= diag.start <= diag.end <= len(doc.text)
-        for fix in semantics.fixes_for(doc, ctx, diag):
+        for fix in semantic_fixes.fixes_for(doc, ctx, diag):
             apply_edits(doc.text, fix.edits)

@@ -1,4 +1,4 @@
-"""Tests for bt_lsp.text: line index and LSP position conversion."""
+"""Tests for bt_lsp.syntax.text: line index and LSP position conversion."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.text import Encoding, LineIndex, normalize_encoding, positions_of
+from bt_lsp.syntax.text import Encoding, LineIndex, normalize_encoding, positions_of
 
 ENCODINGS: tuple[Encoding, ...] = get_args(Encoding)
 CODECS = {"utf-8": ("utf-8", 1), "utf-16": ("utf-16-le", 2), "utf-32": ("utf-32-le", 4)}

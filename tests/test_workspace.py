@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from bt_lsp.document import Document
-from bt_lsp.settings import Settings
-from bt_lsp.workspace import Workspace, normalize
+from bt_lsp.project.settings import Settings
+from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.syntax.document import Document
 
 
 def tree(body: str = "", includes: tuple[str, ...] = ()) -> str:

@@ -2,6 +2,6 @@
 
 import sys
 
-from bt_lsp.cli import main
+from bt_lsp.cli.main import main
 
 sys.exit(main())

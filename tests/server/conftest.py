@@ -7,7 +7,7 @@ profile per test module.  Tests open documents under fresh URIs, and what a test
 closed after it (open documents form one workspace), so tests do not see each other.
 
 Positions are computed here from code-point offsets by encoding the prefix of each line,
-independently of the server's :class:`bt_lsp.text.LineIndex`, so the tests do not trust
+independently of the server's :class:`bt_lsp.syntax.text.LineIndex`, so the tests do not trust
 the code under test.
 """
 
@@ -31,7 +31,7 @@ from pygls.protocol import default_converter
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
-from bt_lsp.codes import CODES
+from bt_lsp.rules.codes import CODES
 from tests.marks import unmark
 
 # The server under test, as users start it.

@@ -14,15 +14,15 @@ from typing import TYPE_CHECKING, Any
 from lsprotocol import types
 from pygls.uris import from_fs_path
 
-from bt_lsp import semantics
-from bt_lsp.context import Context
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document
-from bt_lsp.edits import TextEdit
-from bt_lsp.fixes import Fix, fix_all, fixes_for
+from bt_lsp.ide import semantic_fixes
+from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for
+from bt_lsp.project.workspace import normalize
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.workspace import normalize
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -73,7 +73,7 @@ def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
             if od.path is not None
             else Context.from_document(od.doc)
         )
-        fixes += semantics.fixes_for(od.doc, ctx, diag)
+        fixes += semantic_fixes.fixes_for(od.doc, ctx, diag)
     return fixes
 
 

@@ -18,17 +18,17 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
-from bt_lsp.analysis import analyze
-from bt_lsp.codes import CODES
-from bt_lsp.diagnostics import Diagnostic, make, with_severities
-from bt_lsp.document import looks_like_bt
-from bt_lsp.early_names import early_name_diagnostics
+from bt_lsp.project.settings import Settings
+from bt_lsp.project.workspace import Workspace
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.diagnostics import Diagnostic, make, own_diagnostics, with_severities
+from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.server.convert import diagnostic_at, to_diagnostic
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.settings import Settings
-from bt_lsp.text import Encoding, normalize_encoding, positions_of
-from bt_lsp.workspace import Workspace
+from bt_lsp.syntax.document import looks_like_bt
+from bt_lsp.syntax.text import Encoding, normalize_encoding, positions_of
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +87,7 @@ class BtServer(LanguageServer):
         else:
             size = od.doc.utf8_size
             if size > self.settings.max_document_bytes:
-                result = list(od.doc.diagnostics)
+                result = list(own_diagnostics(od.doc))
                 result.append(
                     make(
                         0,
@@ -113,7 +113,7 @@ class BtServer(LanguageServer):
 
     def publish_early_names(self, uri: str, text: str, version: int | None) -> None:
         """Publish the name diagnostics of a large document being opened, found without
-        its full analysis (:mod:`bt_lsp.early_names`), ahead of the complete set."""
+        its full analysis (:mod:`bt_lsp.rules.early_names`), ahead of the complete set."""
         if self.pull_diagnostics or len(text) < EARLY_NAMES_CHARS or not looks_like_bt(text):
             return
         try:

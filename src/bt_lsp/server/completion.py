@@ -1,5 +1,5 @@
 """textDocument/completion: node types, ports, reserved attributes, tree IDs, blackboard
-keys (see :mod:`bt_lsp.completion`), as snippets when the client takes them."""
+keys (see :mod:`bt_lsp.ide.completion`), as snippets when the client takes them."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from lsprotocol import types
 
-from bt_lsp.completion import ItemKind, complete
+from bt_lsp.ide.completion import ItemKind, complete
 from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, offset_of
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from bt_lsp.codes import CODES
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.edits import TextEdit
-from bt_lsp.text import Encoding, LineIndex
+from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.syntax.edits import TextEdit
+from bt_lsp.syntax.text import Encoding, LineIndex
 
 
 def to_range(lines: LineIndex, start: int, end: int, enc: Encoding) -> types.Range:

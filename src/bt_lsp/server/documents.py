@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 from lsprotocol import types
 from pygls.uris import to_fs_path
 
-from bt_lsp.document import Document
 from bt_lsp.server.convert import to_offsets
 from bt_lsp.server.state import OpenDocument
+from bt_lsp.syntax.document import Document
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 from lsprotocol import types
 
-from bt_lsp.hover import hover_at
+from bt_lsp.ide.hover import hover_at
 from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, offset_of
 

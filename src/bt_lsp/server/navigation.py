@@ -1,6 +1,6 @@
 """Navigation features: definition, references, highlights, rename, document and workspace
 symbols, folding ranges and linked editing.  Each handler converts positions with the
-document's own line index in the negotiated encoding and calls :mod:`bt_lsp.navigation`.
+document's own line index in the negotiated encoding and calls :mod:`bt_lsp.ide.navigation`.
 """
 
 from __future__ import annotations
@@ -15,9 +15,16 @@ from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 from pygls.uris import from_fs_path
 
-from bt_lsp import __version__, navigation
-from bt_lsp.edits import TextEdit
-from bt_lsp.navigation import BUILTIN_CATALOG, DocSymbol, Place, RenameRefused, SymbolKind
+from bt_lsp import __version__
+from bt_lsp.ide import navigation
+from bt_lsp.ide.navigation import (
+    BUILTIN_CATALOG,
+    DocSymbol,
+    Place,
+    RenameRefused,
+    SymbolKind,
+)
+from bt_lsp.project.workspace import links
 from bt_lsp.server.convert import to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,
@@ -28,7 +35,8 @@ from bt_lsp.server.lookup import (
     workspace_sources,
 )
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.text import Encoding, LineIndex
+from bt_lsp.syntax.edits import TextEdit
+from bt_lsp.syntax.text import Encoding, LineIndex
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -164,7 +172,7 @@ def register(server: BtServer) -> None:
             offset_of(ls, od, params.position),
             {k: s.doc for k, s in sources.items()},
             ctx=context_of(ls, od),
-            includes=includes_of(ls, od),
+            includes=links(includes_of(ls, od)),
         )
         return _locations(ls, od, places, sources) or None
 

@@ -1,7 +1,7 @@
 """pygls's protocol without its own copy of open documents.
 
 pygls keeps a second copy of every document and re-splits it into lines on each change
-(with the line-end bugs noted in the README).  bt-lsp's :class:`~bt_lsp.document.Document`
+(with the line-end bugs noted in the README).  bt-lsp's :class:`~bt_lsp.syntax.document.Document`
 is the only copy, updated incrementally, so the built-in sync handlers only hand the
 notification on to ours.
 """

@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bt_lsp.diagnostics import Diagnostic
-from bt_lsp.document import Document
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.syntax.document import Document
 
 
 @dataclass(slots=True)

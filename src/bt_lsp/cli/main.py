@@ -1,0 +1,144 @@
+"""The ``bt-lsp`` command line: ``serve``, ``check`` and ``--version``.
+
+``check`` never imports the language server (or pygls): the server is imported only when
+``serve`` runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+from collections.abc import Sequence
+
+from bt_lsp import __version__
+from bt_lsp.project.fileio import DEFAULT_MAX_BYTES
+
+_UNITS = {"": 1, "k": 1024, "m": 1024**2, "g": 1024**3}
+
+
+def _size(text: str) -> int:
+    """A size in bytes, with an optional ``K``/``M``/``G`` suffix (powers of 1024)."""
+    m = re.fullmatch(r"\s*(\d+)\s*([kmg]?)i?b?\s*", text, re.IGNORECASE)
+    if m is None or int(m.group(1)) <= 0:
+        raise argparse.ArgumentTypeError(f"invalid size {text!r} (e.g. 64M)")
+    return int(m.group(1)) * _UNITS[m.group(2).lower()]
+
+
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"invalid port {text!r}")
+    return port
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="bt-lsp",
+        description="Language server and checker for BehaviorTree.CPP XML.",
+    )
+    parser.add_argument("--version", action="version", version=f"bt-lsp {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    serve = sub.add_parser(
+        "serve",
+        help="run the language server (stdio by default)",
+        description="Run the language server on stdio (default) or TCP.",
+    )
+    serve.add_argument("--stdio", action="store_true", help="talk over stdin/stdout (the default)")
+    serve.add_argument("--tcp", action="store_true", help="listen on TCP instead of stdio")
+    serve.add_argument("--host", default="127.0.0.1", help="TCP host (default: %(default)s)")
+    serve.add_argument("--port", type=_port, default=2087, help="TCP port (default: %(default)s)")
+
+    check = sub.add_parser(
+        "check",
+        help="check files and print their diagnostics",
+        description=(
+            "Check BehaviorTree.CPP XML files (directories are searched for *.xml) and print "
+            "every diagnostic as 'path:line:col: severity code message'. Exit status: 0 no "
+            "errors, 1 at least one error, 2 usage error or a file that cannot be read."
+        ),
+    )
+    check.add_argument("paths", nargs="+", metavar="PATH", help="files or directories")
+    check.add_argument(
+        "--format",
+        choices=("text", "json", "sarif"),
+        default="text",
+        help="output format (default: %(default)s)",
+    )
+    check.add_argument(
+        "--fix",
+        action="store_true",
+        help="apply every preferred fix in place, then report what is left",
+    )
+    check.add_argument(
+        "--severity",
+        action="append",
+        default=[],
+        metavar="CODE=LEVEL",
+        help="override a code's severity: error, warning, information, hint or off "
+        "(repeatable; several may be joined with commas)",
+    )
+    check.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+    check.add_argument(
+        "--max-file-size",
+        type=_size,
+        default=DEFAULT_MAX_BYTES,
+        metavar="SIZE",
+        help="refuse files larger than this (e.g. 64M; default: 64M)",
+    )
+    check.set_defaults(subparser=check)
+    return parser
+
+
+def _serve(args: argparse.Namespace) -> int:
+    from bt_lsp.server import serve
+
+    serve(tcp=args.tcp, host=args.host, port=args.port)
+    return 0
+
+
+def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    from bt_lsp.cli import check
+
+    try:
+        severities = check.parse_severities(args.severity)
+    except ValueError as e:
+        parser.error(f"--severity: {e}")
+    options = check.Options(
+        format=args.format,
+        fix=args.fix,
+        severities=severities,
+        progress=not args.no_progress,
+        max_bytes=args.max_file_size,
+    )
+    return check.run(args.paths, options)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit status (2 for a usage error)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command == "serve":
+            return _serve(args)
+        if args.command == "check":
+            return _check(args.subparser, args)
+        parser.print_help(sys.stderr)
+        return 2
+    except SystemExit as e:
+        return e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        # The reader went away (e.g. `| head`): stop quietly.
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 1

@@ -1,0 +1,278 @@
+"""Blackboard keys: where each tree of a document uses a key.
+
+BehaviorTree.CPP gives every tree instance a blackboard of its own, so a key belongs to a
+tree.  A tree uses a key
+
+* as a port value that is a blackboard reference: ``goal="{key}"`` (spaces around the
+  braces and inside them are trimmed), ``goal="{=}"`` or ``goal="="`` (the key named like
+  the port), exactly when BehaviorTree.CPP's ``isBlackboardPointer`` reads the whole value
+  as one (``"Hello {name}"`` is a literal text, not a key);
+* as an identifier in a script: the pre- and post-condition attributes (``_skipIf`` …
+  ``_post``) of any node, ``code`` of ``<Script>`` and ``<ScriptCondition>`` and ``if`` of
+  ``<Precondition>`` (unless the value is itself a blackboard reference).  Identifiers
+  are found with the script tokenizer of :mod:`bt_lsp.rules.script`: never inside a string, and
+  ``true``/``false`` are literals.  Enum names are identifiers too (they are registered
+  in C++), so an identifier spelled like a key is taken for that key.
+
+Port values count in attributes whose names break the port naming rules (``goal.x="{g}"``):
+those are errors that the name fixes correct, and the key is the tree's once they do.
+Reserved attributes, the underscore attributes BehaviorTree.CPP ignores (``_x``) and valid
+names it cannot read as ports (starting with a non-ASCII letter) are never ports.
+
+Every use has the span of the key as written in the file: values are decoded (entity
+references replaced) before they are read, and spans are mapped back through the
+references, so ``&amp;&amp;`` before a key does not shift it.  A key whose own characters
+are written with references (``{go&#97;l}``) is flagged ``entities``.
+"""
+
+from __future__ import annotations
+
+import re
+from bisect import bisect_right
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from bt_lsp.rules.builtins import BUILTINS, is_blackboard_reference
+from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
+from bt_lsp.rules.script import identifiers
+from bt_lsp.rules.semantics.scripts import CONDITION_ATTRS, SCRIPT_PORTS, raw_offsets
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.model import Element, Model, Zone
+from bt_lsp.syntax.scanner import Attr
+
+__all__ = [
+    "KeyForm",
+    "KeyRef",
+    "TreeKeys",
+    "blackboard_keys",
+    "enclosing_tree",
+    "key_at",
+    "key_uses",
+    "mentions",
+    "port_value_key",
+    "subtree_range",
+    "tree_keys",
+    "unread_mentions",
+]
+
+
+class KeyForm(StrEnum):
+    """How a key is written."""
+
+    BRACES = "braces"  # goal="{key}"
+    SAME = "same"  # goal="{=}": the key named like the port; the span is the '='
+    BARE_SAME = "bare"  # goal="=": likewise, without braces
+    SCRIPT = "script"  # an identifier of a script
+
+
+@dataclass(frozen=True, slots=True)
+class KeyRef:
+    """A use of a blackboard key: ``start``/``end`` span the key as written (without braces
+    and surrounding spaces; the ``=`` of ``{=}``), ``element`` is the element index of its
+    node and ``tree`` of its ``<BehaviorTree>``.  ``attr`` is the attribute it is written
+    in, ``quote`` that attribute's quote, ``entities`` whether the key's own characters
+    are written with entity or character references."""
+
+    key: str
+    start: int
+    end: int
+    element: int
+    tree: int
+    form: KeyForm = KeyForm.BRACES
+    attr: str = ""
+    quote: str = '"'
+    entities: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class TreeKeys:
+    """The key uses of one tree, and the script texts it could not read: ``unread`` holds,
+    for each script with a lexical error, the decoded text after the error (BehaviorTree.CPP
+    rejects the script there, and which of its words are keys is unknown)."""
+
+    uses: list[KeyRef] = field(default_factory=list)
+    unread: list[str] = field(default_factory=list)
+
+    def of(self, key: str) -> list[KeyRef]:
+        return [k for k in self.uses if k.key == key]
+
+
+def enclosing_tree(model: Model, index: int) -> int:
+    """Index of the ``<BehaviorTree>`` holding element ``index`` (itself included), or -1."""
+    els = model.elements
+    while index >= 0:
+        if els[index].zone == Zone.TREE:
+            return index
+        index = els[index].parent
+    return -1
+
+
+def subtree_range(model: Model, index: int) -> range:
+    """Indexes of element ``index`` and its descendants (elements are in document order)."""
+    els = model.elements
+    depth = els[index].depth
+    stop = index + 1
+    while stop < len(els) and els[stop].depth > depth:
+        stop += 1
+    return range(index, stop)
+
+
+_SPACES = " \t\r\n"
+
+
+class _Value:
+    """An attribute value: decoded, and how its code points map to the raw text."""
+
+    __slots__ = ("base", "decoded", "offs")
+
+    def __init__(self, doc: Document, el: Element, a: Attr) -> None:
+        vs, ve = el.span_of_value(a)
+        raw = doc.text[vs:ve]
+        self.base = vs
+        self.decoded = a.value if a.value is not None else raw
+        self.offs = raw_offsets(raw) if "&" in raw else None
+
+    def span(self, start: int, end: int) -> tuple[int, int, bool]:
+        """The absolute raw span of ``decoded[start:end]``, and whether references are
+        written in it."""
+        if self.offs is None:
+            return self.base + start, self.base + end, False
+        last = len(self.offs) - 1
+        rs, re_ = self.offs[min(start, last)], self.offs[min(end, last)]
+        return self.base + rs, self.base + re_, (re_ - rs) != (end - start)
+
+
+def _is_script_port(el: Element, a: Attr) -> bool:
+    """``code`` of ``Script``/``ScriptCondition``, ``if`` of ``Precondition``."""
+    node_id = el.node_id
+    return node_id is not None and node_id in BUILTINS and (node_id, a.name) in SCRIPT_PORTS
+
+
+def _port_key(
+    doc: Document, el: Element, a: Attr, idx: int, tree: int, value: str
+) -> KeyRef | None:
+    v = _Value(doc, el, a)
+    stripped = value.strip(" ")
+    lead = len(value) - len(value.lstrip(" "))
+    if stripped == "=":
+        s, e, _ = v.span(lead, lead + 1)
+        return KeyRef(a.name, s, e, idx, tree, KeyForm.BARE_SAME, a.name, a.quote)
+    inner = stripped[1:-1]
+    if inner == "=":
+        s, e, _ = v.span(lead + 1, lead + 2)
+        return KeyRef(a.name, s, e, idx, tree, KeyForm.SAME, a.name, a.quote)
+    key = inner.strip(_SPACES)
+    if not key:
+        return None
+    ks = lead + 1 + len(inner) - len(inner.lstrip(_SPACES))
+    s, e, ent = v.span(ks, ks + len(key))
+    return KeyRef(key, s, e, idx, tree, KeyForm.BRACES, a.name, a.quote, ent)
+
+
+def _script_keys(doc: Document, el: Element, a: Attr, idx: int, tree: int, out: TreeKeys) -> None:
+    v = _Value(doc, el, a)
+    code = v.decoded
+    spans, stop = identifiers(code)
+    for ds, de in spans:
+        s, e, ent = v.span(ds, de)
+        out.uses.append(KeyRef(code[ds:de], s, e, idx, tree, KeyForm.SCRIPT, a.name, a.quote, ent))
+    if stop < len(code):
+        out.unread.append(code[stop:])
+
+
+def _is_port(name: str) -> bool:
+    """Whether a node attribute gives a port: an allowed port name, or a port name that
+    breaks the naming rules (an error to fix, after which its value is the port's)."""
+    if is_allowed_port_name(name):
+        return True
+    return not name.startswith("_") and bool(check_name(name, NameKind.PORT))
+
+
+def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
+    el = doc.model.elements[idx]
+    if el.zone != Zone.NODE:
+        return
+    for a in el.attrs:
+        value = a.value
+        if value is None:
+            continue
+        if a.name in CONDITION_ATTRS:
+            _script_keys(doc, el, a, idx, tree, out)
+        elif not _is_port(a.name):
+            continue  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
+        elif is_blackboard_reference(value):
+            k = _port_key(doc, el, a, idx, tree, value)
+            if k is not None:
+                out.uses.append(k)
+        elif _is_script_port(el, a):
+            _script_keys(doc, el, a, idx, tree, out)
+
+
+def port_value_key(doc: Document, idx: int, a: Attr) -> KeyRef | None:
+    """The key a port attribute of node ``idx`` is given (``{key}``, ``{=}``, ``=``), or
+    ``None`` when its value is not a blackboard reference."""
+    el = doc.model.elements[idx]
+    value = a.value
+    if el.zone != Zone.NODE or value is None or not is_blackboard_reference(value):
+        return None
+    return _port_key(doc, el, a, idx, enclosing_tree(doc.model, idx), value)
+
+
+def tree_keys(doc: Document, tree: int) -> TreeKeys:
+    """Every key use in the nodes of one tree (by element index), in document order."""
+    model = doc.model
+    out = TreeKeys()
+    if not 0 <= tree < len(model.elements) or model.elements[tree].zone != Zone.TREE:
+        return out
+    for i in subtree_range(model, tree):
+        _element_keys(doc, i, tree, out)
+    return out
+
+
+def key_uses(doc: Document, tree: int) -> list[KeyRef]:
+    """Every key use in the nodes of one tree (by element index): port values and scripts."""
+    return tree_keys(doc, tree).uses
+
+
+def blackboard_keys(doc: Document, tree: int) -> list[KeyRef]:
+    """Every key written ``{key}`` in the port values of the nodes of one tree."""
+    return [k for k in key_uses(doc, tree) if k.form == KeyForm.BRACES]
+
+
+def key_at(doc: Document, offset: int) -> KeyRef | None:
+    """The key use under ``offset`` (its end counts), in a port value or a script."""
+    model = doc.model
+    els = model.elements
+    # Start tags do not overlap: the one holding ``offset`` is the last to start before it.
+    i = bisect_right(els, offset, key=_token_start) - 1
+    if i < 0:
+        return None
+    el = els[i]
+    if el.zone != Zone.NODE or el.token_start + doc.scan.tokens[el.token_index].length < offset:
+        return None
+    out = TreeKeys()
+    _element_keys(doc, i, enclosing_tree(model, i), out)
+    for k in out.uses:
+        if k.start <= offset <= k.end:
+            return k
+    return None
+
+
+def _token_start(el: Element) -> int:
+    return el.token_start
+
+
+_WORD_CHARS = "A-Za-z0-9_"
+
+
+def unread_mentions(keys: TreeKeys, key: str) -> bool:
+    """Whether ``key`` is written as a word in a script text the tree could not read."""
+    if not keys.unread:
+        return False
+    word = re.compile(rf"(?<![{_WORD_CHARS}@]){re.escape(key)}(?![{_WORD_CHARS}])")
+    return any(word.search(text) for text in keys.unread)
+
+
+def mentions(keys: TreeKeys, key: str) -> bool:
+    """Whether a tree uses ``key``, or may use it in a script it could not read."""
+    return any(k.key == key for k in keys.uses) or unread_mentions(keys, key)

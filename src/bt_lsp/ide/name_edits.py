@@ -1,0 +1,82 @@
+"""Renaming a name token: where its symbol occurs, the edits that write a new name there,
+and the names a new one must avoid.
+
+Pure, and blind to blackboard keys: :mod:`bt_lsp.ide.navigation` builds renames (keys
+included) on top of these, and :mod:`bt_lsp.ide.name_fixes` uses those renames.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+from bt_lsp.syntax.edits import TextEdit, escape_value
+from bt_lsp.syntax.model import Model, NameRef, Symbol
+
+__all__ = [
+    "namespace",
+    "occurrences",
+    "other_file_edits",
+    "rename_edits",
+    "shown",
+    "taken_names",
+]
+
+
+def shown(name: str) -> str:
+    """A name with its control characters written visibly (``U+0007``)."""
+    return "".join(c if c.isprintable() or c == " " else f"U+{ord(c):04X}" for c in name)
+
+
+def _written(ref: NameRef, new_name: str) -> str:
+    return escape_value(new_name, ref.quote) if ref.quote else new_name
+
+
+def occurrences(model: Model, ref: NameRef) -> list[NameRef]:
+    """Every name token of ``model`` with the symbol of ``ref``, ``ref`` included."""
+    if ref.symbol is None:
+        return [ref]
+    return model.refs_to(ref.symbol)
+
+
+def rename_edits(refs: Iterable[NameRef], new_name: str) -> list[TextEdit]:
+    """The edits writing ``new_name`` over the name tokens ``refs``."""
+    return sorted({TextEdit(r.start, r.end, _written(r, new_name)) for r in refs})
+
+
+def namespace(symbol: Symbol) -> tuple[str, ...]:
+    """Names in one namespace must stay distinct: trees and models share one (a tree ID may
+    not be a node type), a port's namespace is its owner's ports."""
+    return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
+
+
+def _names_in(model: Model, ns: tuple[str, ...]) -> set[str]:
+    return {sym[-1] for sym in model.by_symbol if namespace(sym) == ns}
+
+
+def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = ()) -> set[str]:
+    """Names a new name for ``symbol`` must avoid: the others in its namespace, in this
+    document and in the other workspace documents."""
+    if symbol is None:
+        return set()
+    ns = namespace(symbol)
+    others = list(others)
+    taken: set[str] = set()
+    for m in (model, *others):
+        taken |= _names_in(m, ns)
+    if not any(symbol in m.by_symbol for m in others):
+        taken.discard(symbol[-1])
+    return taken
+
+
+def other_file_edits(
+    symbol: Symbol | None, new_name: str, others: Mapping[str, Model]
+) -> dict[str, tuple[TextEdit, ...]]:
+    """The edits renaming ``symbol`` in other workspace documents (by path)."""
+    if symbol is None:
+        return {}
+    out: dict[str, tuple[TextEdit, ...]] = {}
+    for path, m in others.items():
+        refs = m.refs_to(symbol)
+        if refs:
+            out[path] = tuple(rename_edits(refs, new_name))
+    return out

@@ -1,0 +1,263 @@
+"""Fixes for name diagnostics: sanitized, unique replacements, renamed as a rename would.
+
+A fix renames a bad name exactly as :func:`bt_lsp.ide.navigation.rename` renames it to the same
+new name, through the same :class:`~bt_lsp.ide.navigation.Renamer`: every reference in the
+document and in the other workspace documents, a tree's port together with its uses as a
+blackboard key inside the tree, and the ``{=}`` of a renamed port attribute written out.
+Where the rename refuses:
+
+* a refusal of the new name (it is taken, or would merge two keys): the next candidate
+  name is tried, and numbered ones (``_2``, ``_3`` …) when no candidate will do;
+* a refusal of the tree port's key itself (shared through ``_autoremap``, reached as
+  ``@key``, written with references or after a script's syntax error): the fix renames the
+  port's own names only, and its title says that the key is left as it is.
+
+Pure: these functions return edits; the front ends decide whether to apply them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Set as AbstractSet
+from dataclasses import dataclass, field
+
+from bt_lsp.ide.fix import Fix
+from bt_lsp.ide.name_edits import (
+    namespace,
+    occurrences,
+    other_file_edits,
+    rename_edits,
+    shown,
+    taken_names,
+)
+from bt_lsp.ide.navigation import RenamePlan, Renamer, RenameRefused, combined
+from bt_lsp.ide.sanitize import candidates, sanitize
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit, escape_value
+from bt_lsp.syntax.model import NameRef, Symbol
+
+__all__ = [
+    "Fix",
+    "FixAll",
+    "Renaming",
+    "escape_value",
+    "fix_all",
+    "fixes_for",
+    "occurrences",
+    "other_file_edits",
+    "preferred_renaming",
+    "rename_edits",
+    "renamings",
+    "shown",
+    "taken_names",
+]
+
+# Numbered names tried when the rename refuses every candidate name.
+_MORE_NAMES = 20
+
+
+@dataclass(frozen=True, slots=True)
+class Renaming:
+    """A new name for a bad name, and the edits of renaming it.  ``kept`` names what the
+    rename leaves as it is (``"key 'x' in tree 'T'"``) because the full rename was refused,
+    and ``why`` is that refusal."""
+
+    old: str
+    new: str
+    plan: RenamePlan
+    kept: str | None = None
+    why: str | None = None
+
+    @property
+    def title(self) -> str:
+        places = self.plan.places
+        where = "1 place" if places == 1 else f"{places} places"
+        n = len(self.plan.other_edits)
+        if n:
+            where += f", {n} other file{'s' if n > 1 else ''}"
+        old = shown(self.old)
+        title = (
+            f"Clear '{old}' ({where})"
+            if not self.new
+            else f"Rename '{old}' to '{shown(self.new)}' ({where})"
+        )
+        if self.kept is not None:
+            title += f"; {self.kept} left as it is"
+        return title
+
+    @property
+    def note(self) -> str | None:
+        """What the fix leaves as it is and why, for reports (``None``: nothing)."""
+        if self.kept is None:
+            return None
+        return (
+            f"renamed '{shown(self.old)}' to '{shown(self.new)}' and left the {self.kept} "
+            f"as it is: {self.why}"
+        )
+
+
+class _Without(AbstractSet[str]):
+    """A set minus one name, without copying the set."""
+
+    def __init__(self, names: AbstractSet[str], left_out: str) -> None:
+        self._names, self._left_out = names, left_out
+
+    def __contains__(self, name: object) -> bool:
+        return name != self._left_out and name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return (n for n in self._names if n != self._left_out)
+
+    def __len__(self) -> int:
+        return len(self._names) - (self._left_out in self._names)
+
+
+class _With(AbstractSet[str]):
+    """The union of a set and a few more names, without copying the set."""
+
+    def __init__(self, names: AbstractSet[str], more: AbstractSet[str]) -> None:
+        self._names, self._more = names, more
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._more or name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self._names
+        yield from (n for n in self._more if n not in self._names)
+
+    def __len__(self) -> int:
+        return len(self._names) + sum(1 for n in self._more if n not in self._names)
+
+
+def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str]) -> Renaming | None:
+    try:
+        return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken))
+    except RenameRefused as e:
+        sym = ref.symbol
+        if e.new_name or sym is None or sym[:2] != ("port", "tree"):
+            return None
+        why = e.message
+    try:
+        plan = renamer.plan(ref, new, keys=False, taken=taken)
+    except RenameRefused:
+        return None
+    kept = f"key '{shown(sym[3])}' in tree '{shown(sym[2])}'"
+    return Renaming(ref.text, new, plan, kept, why)
+
+
+def renamings(renamer: Renamer, ref: NameRef, taken: AbstractSet[str]) -> Iterator[Renaming]:
+    """The renamings of the bad name ``ref`` (of the renamer's document), best first: one
+    for each candidate name (:func:`bt_lsp.ide.sanitize.candidates`) that the rename accepts,
+    else for the first numbered name it accepts.  ``taken`` are the names of the symbol's
+    namespace that the new name must avoid."""
+    kind = ref.kind
+    if kind is None:
+        return
+    tried: set[str] = set()
+    found = False
+    for new in candidates(ref.text, kind, taken):
+        if new == ref.text or new in tried:
+            continue
+        tried.add(new)
+        r = _renaming(renamer, ref, new, taken)
+        if r is not None:
+            found = True
+            yield r
+    if found:
+        return
+    for _ in range(_MORE_NAMES):
+        new = sanitize(ref.text, kind, _With(taken, tried))
+        if new == ref.text or new in tried:
+            return
+        tried.add(new)
+        r = _renaming(renamer, ref, new, taken)
+        if r is not None:
+            yield r
+            return
+
+
+def _name_ref(doc: Document, diag: Diagnostic) -> NameRef | None:
+    """The name token a name diagnostic is about."""
+    if not diag.is_name_rule:
+        return None
+    ref = doc.model.ref_at(diag.start)
+    if ref is None or ref.start != diag.start or ref.end != diag.end or ref.kind is None:
+        return None
+    return ref
+
+
+def preferred_renaming(
+    doc: Document, ref: NameRef, others: Mapping[str, Document] | None = None
+) -> Renaming | None:
+    """The renaming of the preferred fix for the bad name ``ref``."""
+    others = others or {}
+    taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
+    return next(renamings(Renamer(doc, others), ref, taken), None)
+
+
+def fixes_for(
+    doc: Document, diag: Diagnostic, others: Mapping[str, Document] | None = None
+) -> list[Fix]:
+    """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.
+    ``others`` are the other workspace documents, by path: references there are renamed
+    too."""
+    ref = _name_ref(doc, diag)
+    if ref is None:
+        return []
+    others = others or {}
+    taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
+    return [
+        Fix(r.title, r.plan.edits, i == 0, diag, r.plan.other_edits)
+        for i, r in enumerate(renamings(Renamer(doc, others), ref, taken))
+    ]
+
+
+@dataclass(frozen=True, slots=True)
+class FixAll:
+    """The edits of every preferred name fix of a document, and a note for each fix that
+    left a key as it is (see :attr:`Renaming.note`)."""
+
+    edits: list[TextEdit]
+    notes: list[str] = field(default_factory=list)
+
+
+def fix_all(doc: Document, diags: Iterable[Diagnostic]) -> FixAll:
+    """Every preferred name fix at once, consistently: one new name per symbol, all
+    distinct from each other and from the names that stay.  Each symbol is renamed as a
+    rename renames it (its keys included), in the document seen alone: fix-all changes no
+    other file, so it takes no name or key of another file into account either (a file
+    fixed before would otherwise make the next one choose another name for the same
+    symbol, as ``bt-lsp check --fix`` fixes the files of a folder one after the other)."""
+    model = doc.model
+    renamer = Renamer(doc)
+    done: set[Symbol | tuple[int, int]] = set()
+    plans: list[RenamePlan] = []
+    notes: list[str] = []
+    taken_by_ns: dict[tuple[str, ...], set[str]] = {}
+    for sym in model.by_symbol:
+        taken_by_ns.setdefault(namespace(sym), set()).add(sym[-1])
+    for diag in diags:
+        ref = _name_ref(doc, diag)
+        if ref is None:
+            continue
+        key: Symbol | tuple[int, int] = (
+            ref.symbol if ref.symbol is not None else (ref.start, ref.end)
+        )
+        if key in done:
+            continue
+        done.add(key)
+        names: set[str] | None = None
+        taken: AbstractSet[str] = frozenset()
+        if ref.symbol is not None:
+            names = taken_by_ns.setdefault(namespace(ref.symbol), set())
+            taken = _Without(names, ref.symbol[-1])
+        r = next(renamings(renamer, ref, taken), None)
+        if r is None:
+            continue
+        if names is not None:
+            names.add(r.new)
+        plans.append(RenamePlan(r.plan.edits, written_out=r.plan.written_out))
+        if r.note is not None:
+            notes.append(r.note)
+    return FixAll(list(combined(plans).edits), notes)

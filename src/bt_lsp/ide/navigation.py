@@ -1,0 +1,1252 @@
+"""Navigation over BT XML: definitions, references, highlights, rename, symbols, folding and
+linked editing.
+
+Pure: everything here works on :class:`~bt_lsp.syntax.document.Document` values and returns
+code-point offsets (or lines, for folding); the server converts them to LSP positions.
+The rest of the workspace comes in as plain data: ``others`` are the other BT documents
+by path, ``ctx`` is the document's :class:`~bt_lsp.rules.context.Context` and ``includes`` its
+resolved ``<include>`` elements.
+
+A :class:`Place` names a span in some document: ``path=None`` is the document asked about,
+:data:`BUILTIN_CATALOG` is the generated catalog of BehaviorTree.CPP's built-in nodes
+(:func:`builtin_catalog`), anything else a workspace path.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Collection, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from enum import StrEnum
+from functools import cache
+from typing import NamedTuple, NoReturn
+
+from bt_lsp.ide.blackboard import (
+    KeyForm,
+    KeyRef,
+    TreeKeys,
+    blackboard_keys,
+    enclosing_tree,
+    key_at,
+    mentions,
+    port_value_key,
+    subtree_range,
+    tree_keys,
+    unread_mentions,
+)
+from bt_lsp.ide.name_edits import other_file_edits, rename_edits, shown, taken_names
+from bt_lsp.rules.builtins import BUILTINS, PortModel
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit, escape_value
+from bt_lsp.syntax.model import (
+    EXPLICIT_TAGS,
+    XML_NAME_RE,
+    Element,
+    Model,
+    NameRef,
+    Role,
+    Symbol,
+    Zone,
+)
+from bt_lsp.syntax.scanner import Kind
+
+__all__ = [
+    "BUILTIN_CATALOG",
+    "Catalog",
+    "DocSymbol",
+    "Fold",
+    "Highlight",
+    "KeyForm",
+    "KeyRef",
+    "Place",
+    "RenamePlan",
+    "RenameRefused",
+    "RenameTarget",
+    "Renamer",
+    "SymbolKind",
+    "WorkspaceSymbol",
+    "blackboard_keys",
+    "builtin_catalog",
+    "combined",
+    "definition",
+    "document_symbols",
+    "element_end",
+    "enclosing_tree",
+    "folding_ranges",
+    "highlights",
+    "key_at",
+    "linked_editing_ranges",
+    "ports_of",
+    "prepare_rename",
+    "references",
+    "rename",
+    "workspace_symbols",
+]
+
+BUILTIN_CATALOG = "bt-lsp:builtins.xml"
+"""The ``path`` of places in the built-in node catalog (see :func:`builtin_catalog`)."""
+
+
+class IncludeLink(NamedTuple):
+    """An ``<include path>`` value's span and the file it resolves to (the project layer
+    resolves it; this layer reads no files)."""
+
+    start: int
+    end: int
+    target: str
+
+
+@dataclass(frozen=True, slots=True, order=True)
+class Place:
+    """A span in a document: ``None`` for the document asked about, else a path (or
+    :data:`BUILTIN_CATALOG`)."""
+
+    path: str | None
+    start: int
+    end: int
+
+
+# --- elements and blackboard keys ---------------------------------------------------------
+
+
+def element_end(doc: Document, el: Element) -> int:
+    """Offset after an element: after its end tag, or after its start tag when it was
+    never closed."""
+    if el.end >= 0:
+        return el.end
+    return el.token_start + doc.scan.tokens[el.token_index].length
+
+
+def _element_at_tag(model: Model, offset: int) -> tuple[int, bool] | None:
+    """The element whose start-tag name (``False``) or end-tag name (``True``) holds
+    ``offset`` (its end counts)."""
+    for i, el in enumerate(model.elements):
+        if el.name_start <= offset <= el.name_end:
+            return i, False
+        if el.end_name_start >= 0 and el.end_name_start <= offset <= el.end_name_end:
+            return i, True
+    return None
+
+
+# --- the built-in catalog -----------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Catalog:
+    """A ``<TreeNodesModel>`` of BehaviorTree.CPP's built-in nodes, and where each node's
+    ``ID`` (symbol ``("model", id)``) and each port's ``name`` (``("port", "model", id,
+    port)``) are written in it."""
+
+    text: str
+    spans: Mapping[Symbol, tuple[int, int]]
+
+
+def _xml_text(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def _comment(text: str) -> str:
+    text = " ".join(text.split())
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text.rstrip("-")
+
+
+@cache
+def builtin_catalog() -> Catalog:
+    """The built-in nodes written as a ``<TreeNodesModel>``, each with its description, for
+    "go to definition" on a built-in node or port."""
+    parts: list[str] = [
+        '<?xml version="1.0" encoding="UTF-8"?>\n',
+        "<!-- The node types that a default BehaviorTree.CPP 4.x factory registers, "
+        "with their ports.\n     Generated by bt-lsp for reference; editing it changes "
+        "nothing. -->\n",
+        '<root BTCPP_format="4">\n  <TreeNodesModel>\n',
+    ]
+    spans: dict[Symbol, tuple[int, int]] = {}
+    pos = sum(len(p) for p in parts)
+
+    def add(s: str) -> None:
+        nonlocal pos
+        parts.append(s)
+        pos += len(s)
+
+    for node in sorted(BUILTINS.values(), key=lambda n: (n.category, n.id)):
+        if node.category == "SubTree":
+            continue  # <SubTree> is a call of a tree, never a node type of its own
+        add(f"    <!-- {_comment(node.description)} -->\n")
+        add(f'    <{node.category} ID="')
+        spans[("model", node.id)] = (pos, pos + len(node.id))
+        add(node.id)
+        if not node.ports:
+            add('"/>\n')
+            continue
+        add('">\n')
+        for p in node.ports:
+            add(f'      <{p.direction}_port name="')
+            spans[("port", "model", node.id, p.name)] = (pos, pos + len(p.name))
+            add(p.name)
+            add(f'" type="{escape_value(p.type, chr(34))}"')
+            if p.default is not None:
+                add(f' default="{escape_value(p.default, chr(34))}"')
+            add(f">{_xml_text(p.description)}</{p.direction}_port>\n")
+        add(f"    </{node.category}>\n")
+    add("  </TreeNodesModel>\n</root>\n")
+    return Catalog("".join(parts), spans)
+
+
+# --- definition ---------------------------------------------------------------------------
+
+
+def _declarations(
+    doc: Document, others: Mapping[str, Document], symbol: Symbol, role: Role
+) -> list[Place]:
+    """Occurrences of ``symbol`` in the ``role`` that declares it: this document's first."""
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(symbol) if r.role == role]
+    if own:
+        return own
+    return [
+        Place(path, r.start, r.end)
+        for path, d in others.items()
+        for r in d.model.refs_to(symbol)
+        if r.role == role
+    ]
+
+
+def _place(ctx: Context, path: str | None, start: int, end: int) -> Place:
+    return Place(None if path == ctx.path else path, start, end)
+
+
+def _tree_definition(
+    doc: Document, others: Mapping[str, Document], ctx: Context | None, tree_id: str
+) -> list[Place]:
+    sym: Symbol = ("tree", tree_id)
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.TREE_DEF]
+    if own:
+        return own
+    if ctx is not None:
+        decls = ctx.trees.get(tree_id) or ctx.workspace_trees.get(tree_id)
+        if decls:
+            return [_place(ctx, t.path, t.start, t.end) for t in decls]
+    found = _declarations(doc, others, sym, Role.TREE_DEF)
+    return found or _declarations(doc, others, sym, Role.MODEL_DEF)
+
+
+def _model_definition(
+    doc: Document, others: Mapping[str, Document], ctx: Context | None, model_id: str
+) -> list[Place]:
+    sym: Symbol = ("model", model_id)
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.MODEL_DEF]
+    if own:
+        return own
+    if ctx is not None:
+        decl = ctx.models.get(model_id)
+        if decl is not None:
+            return [_place(ctx, decl.path, decl.start, decl.end)]
+    found = _declarations(doc, others, sym, Role.MODEL_DEF)
+    if found:
+        return found
+    span = builtin_catalog().spans.get(sym)
+    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+
+
+def _port_definition(doc: Document, others: Mapping[str, Document], sym: Symbol) -> list[Place]:
+    found = _declarations(doc, others, sym, Role.PORT_DECL)
+    if found:
+        return found
+    span = builtin_catalog().spans.get(sym)
+    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+
+
+def definition(
+    doc: Document,
+    offset: int,
+    others: Mapping[str, Document] | None = None,
+    *,
+    ctx: Context | None = None,
+    includes: Sequence[IncludeLink] = (),
+) -> list[Place]:
+    """Where the name under ``offset`` is declared.
+
+    A ``<SubTree ID>`` or ``main_tree_to_execute`` leads to its ``<BehaviorTree>``, a node
+    to its ``<TreeNodesModel>`` entry (a built-in to the built-in catalog), a port
+    attribute to its port declaration, an ``<include path>`` to the start of that file.
+    A declaration leads to itself.
+    """
+    others = others or {}
+    for start, end, target in includes:
+        if start <= offset <= end:
+            return [Place(target, 0, 0)]
+    ref = doc.model.ref_at(offset)
+    if ref is None or ref.symbol is None:
+        return []
+    if ref.declaration:
+        return [Place(None, ref.start, ref.end)]
+    sym = ref.symbol
+    if sym[0] == "tree":
+        return _tree_definition(doc, others, ctx, sym[1])
+    if sym[0] == "model":
+        return _model_definition(doc, others, ctx, sym[1])
+    if sym[0] == "port":
+        return _port_definition(doc, others, sym)
+    return []
+
+
+# --- blackboard keys across trees ---------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Tree:
+    """A ``<BehaviorTree>``, by element index, of the document asked about (``path=None``)
+    or of another workspace document."""
+
+    path: str | None
+    doc: Document
+    index: int
+
+    @property
+    def id(self) -> str | None:
+        return self.doc.model.elements[self.index].value("ID")
+
+    def shown(self) -> str:
+        tid = self.id
+        name = f"tree '{shown(tid)}'" if tid is not None else "a tree without ID"
+        return name if self.path is None else f"{name} (in {os.path.basename(self.path)})"
+
+
+@dataclass(frozen=True, slots=True)
+class _Call:
+    """A ``<SubTree ID>`` call: the tree it is in, the tree it calls, whether it sets
+    ``_autoremap``, and the ports it remaps explicitly."""
+
+    caller: _Tree
+    callee: str
+    autoremap: bool
+    remapped: frozenset[str]
+
+
+_TRUE_WORDS = frozenset({"1", "true", "True", "TRUE"})
+
+
+def _call_at(path: str | None, doc: Document, idx: int) -> _Call | None:
+    model = doc.model
+    el = model.elements[idx]
+    callee = el.value("ID")
+    if el.zone != Zone.NODE or el.name != "SubTree" or callee is None:
+        return None
+    tree = enclosing_tree(model, idx)
+    if tree < 0:
+        return None
+    remapped = frozenset(a.name for a in el.attrs if is_allowed_port_name(a.name))
+    return _Call(_Tree(path, doc, tree), callee, el.value("_autoremap") in _TRUE_WORDS, remapped)
+
+
+class _Workspace:
+    """The document and the other workspace documents, as seen by the features on keys."""
+
+    def __init__(self, doc: Document, others: Mapping[str, Document]) -> None:
+        self.doc = doc
+        self.others = others
+        self.docs: list[tuple[str | None, Document]] = [(None, doc), *others.items()]
+        self._keys: dict[_Tree, TreeKeys] = {}
+
+    def keys(self, t: _Tree) -> TreeKeys:
+        found = self._keys.get(t)
+        if found is None:
+            found = self._keys[t] = tree_keys(t.doc, t.index)
+        return found
+
+    def refs(self, sym: Symbol) -> list[tuple[str | None, Document, NameRef]]:
+        return [(path, d, r) for path, d in self.docs for r in d.model.refs_to(sym)]
+
+    def trees(self, tid: str) -> list[_Tree]:
+        """The trees with ID ``tid``."""
+        return [
+            _Tree(path, d, r.element)
+            for path, d, r in self.refs(("tree", tid))
+            if r.role == Role.TREE_DEF
+        ]
+
+    def calls_to(self, tid: str) -> list[_Call]:
+        out: list[_Call] = []
+        for path, d, r in self.refs(("tree", tid)):
+            if r.role == Role.SUBTREE_CALL:
+                c = _call_at(path, d, r.element)
+                if c is not None:
+                    out.append(c)
+        return out
+
+    def calls_from(self, t: _Tree) -> list[_Call]:
+        els = t.doc.model.elements
+        out: list[_Call] = []
+        for i in subtree_range(t.doc.model, t.index):
+            if els[i].name == "SubTree":
+                c = _call_at(t.path, t.doc, i)
+                if c is not None:
+                    out.append(c)
+        return out
+
+    def shared(self, start: _Tree, key: str) -> list[_Tree]:
+        """``start`` and the trees whose blackboards reach its ``key`` by name through
+        ``<SubTree _autoremap="true">`` calls, either way and transitively.  A call that
+        remaps the port of that name explicitly does not share it; private keys
+        (``_key``) and root keys (``@key``) are never autoremapped."""
+        found = [start]
+        if key.startswith(("_", "@")):
+            return found
+        seen = {start}
+        i = 0
+        while i < len(found):
+            t = found[i]
+            i += 1
+            linked: list[_Tree] = []
+            for c in self.calls_from(t):
+                if c.autoremap and key not in c.remapped:
+                    linked.extend(self.trees(c.callee))
+            tid = t.id
+            if tid is not None:
+                linked.extend(
+                    c.caller for c in self.calls_to(tid) if c.autoremap and key not in c.remapped
+                )
+            for o in linked:
+                if o not in seen:
+                    seen.add(o)
+                    found.append(o)
+        return found
+
+    def may_be_root(self, t: _Tree) -> bool:
+        """Whether ``t`` may run as the main tree, whose blackboard is the root one: it is a
+        ``main_tree_to_execute``, or no ``<SubTree>`` calls it."""
+        tid = t.id
+        if tid is None:
+            return True
+        roles = {r.role for _, _, r in self.refs(("tree", tid))}
+        return Role.MAIN_TREE in roles or Role.SUBTREE_CALL not in roles
+
+    def root_users(self, key: str) -> list[_Tree]:
+        """The trees that use ``@key``, the key ``key`` of the root blackboard."""
+        name = "@" + key
+        out: list[_Tree] = []
+        for path, d in self.docs:
+            if name not in d.text:
+                continue
+            for i, el in enumerate(d.model.elements):
+                if el.zone == Zone.TREE:
+                    t = _Tree(path, d, i)
+                    if mentions(self.keys(t), name):
+                        out.append(t)
+        return out
+
+    def has_port(self, t: _Tree, name: str) -> bool:
+        tid = t.id
+        return tid is not None and bool(self.refs(("port", "tree", tid, name)))
+
+
+@dataclass(slots=True)
+class _KeyTargets:
+    """What renaming a key changes: its uses in the trees that own it and, when the key is
+    a port of its tree (declared in a ``<SubTree>`` model or remapped by a ``<SubTree>``
+    call), that port's names."""
+
+    key: str
+    homes: list[_Tree]
+    uses: list[tuple[_Tree, KeyRef]]
+    port: Symbol | None = None
+    port_refs: list[tuple[str | None, Document, NameRef]] = field(default_factory=list)
+
+    def places(self) -> list[tuple[str | None, int, int, bool]]:
+        """``(path, start, end, declaration)`` of every occurrence."""
+        out = [(t.path, u.start, u.end, False) for t, u in self.uses]
+        out.extend((path, r.start, r.end, r.declaration) for path, _, r in self.port_refs)
+        return out
+
+
+def _port_targets(ws: _Workspace, sym: Symbol, home: _Tree | None = None) -> _KeyTargets:
+    """A port of a tree (``("port", "tree", id, name)``): in the tree, the key ``name``."""
+    key = sym[3]
+    homes = ws.trees(sym[2])
+    if home is not None and home not in homes:
+        homes.insert(0, home)
+    uses = [(t, u) for t in homes for u in ws.keys(t).of(key)]
+    return _KeyTargets(key, homes, uses, sym, ws.refs(sym))
+
+
+def _key_targets(ws: _Workspace, home: _Tree, key: str) -> _KeyTargets:
+    tid = home.id
+    if tid is not None and not key.startswith("@"):
+        sym: Symbol = ("port", "tree", tid, key)
+        if ws.refs(sym):
+            return _port_targets(ws, sym, home)
+    return _KeyTargets(key, [home], [(home, u) for u in ws.keys(home).of(key)])
+
+
+def _is_tree_port(sym: Symbol | None) -> bool:
+    return sym is not None and len(sym) == 4 and sym[:2] == ("port", "tree")
+
+
+# --- references and highlights ------------------------------------------------------------
+
+
+def references(
+    doc: Document,
+    offset: int,
+    others: Mapping[str, Document] | None = None,
+    *,
+    include_declaration: bool = True,
+) -> list[Place]:
+    """Every occurrence of the name under ``offset`` in this document and the others (end
+    tags left out: they repeat their start tag).
+
+    A blackboard key's references are its uses in its tree (port values and script
+    identifiers) and, when the key is a port of its tree, that port's declarations and the
+    ``<SubTree>`` attributes that remap it: the places a rename of the key changes.  A
+    tree's port likewise includes its uses as a key inside the tree."""
+    ws = _Workspace(doc, others or {})
+    ref = doc.model.ref_at(offset)
+    if ref is None:
+        key = key_at(doc, offset)
+        if key is None or key.tree < 0:
+            return []
+        targets = _key_targets(ws, _Tree(None, doc, key.tree), key.key)
+        return [
+            Place(path, s, e)
+            for path, s, e, decl in targets.places()
+            if include_declaration or not decl
+        ]
+    if ref.symbol is None:
+        return [Place(None, ref.start, ref.end)]
+
+    def keep(r: NameRef) -> bool:
+        return r.role != Role.NODE_TYPE_END and (include_declaration or not r.declaration)
+
+    out = [Place(path, r.start, r.end) for path, _, r in ws.refs(ref.symbol) if keep(r)]
+    if _is_tree_port(ref.symbol):
+        out.extend(Place(t.path, u.start, u.end) for t, u in _port_targets(ws, ref.symbol).uses)
+    return out
+
+
+@dataclass(frozen=True, slots=True, order=True)
+class Highlight:
+    """An occurrence in the document: ``write`` for a declaration, else a read (or plain
+    text, ``text``, for tag names that are not names of the BT model)."""
+
+    start: int
+    end: int
+    write: bool = False
+    text: bool = False
+
+
+def highlights(doc: Document, offset: int) -> list[Highlight]:
+    """The occurrences, in this document, of the name under ``offset``: a tree, node type,
+    port or instance name, a blackboard key (as :func:`references` finds it), or an
+    element's start and end tag names."""
+    model = doc.model
+    ws = _Workspace(doc, {})
+    ref = model.ref_at(offset)
+    if ref is not None:
+        if ref.symbol is None:
+            return [Highlight(ref.start, ref.end)]
+        found = {Highlight(r.start, r.end, r.declaration) for r in model.refs_to(ref.symbol)}
+        if _is_tree_port(ref.symbol):
+            found.update(Highlight(u.start, u.end) for _, u in _port_targets(ws, ref.symbol).uses)
+        return sorted(found)
+    key = key_at(doc, offset)
+    if key is not None:
+        if key.tree < 0:
+            return [Highlight(key.start, key.end)]
+        targets = _key_targets(ws, _Tree(None, doc, key.tree), key.key)
+        return sorted({Highlight(s, e, decl) for _, s, e, decl in targets.places()})
+    hit = _element_at_tag(model, offset)
+    if hit is None:
+        return []
+    el = model.elements[hit[0]]
+    out = [Highlight(el.name_start, el.name_end, text=True)]
+    if el.end_name_start >= 0:
+        out.append(Highlight(el.end_name_start, el.end_name_end, text=True))
+    return out
+
+
+# --- rename -------------------------------------------------------------------------------
+
+
+class RenameRefused(Exception):
+    """A rename that cannot be done; the message says why.  ``new_name`` tells a refusal of
+    the new name (another name may do: it breaks a rule, is taken, or would merge two
+    keys) from a refusal of the rename itself (the name or key cannot be renamed)."""
+
+    def __init__(self, message: str, *, new_name: bool = False) -> None:
+        super().__init__(message)
+        self.message = message
+        self.new_name = new_name
+
+
+@dataclass(frozen=True, slots=True)
+class RenameTarget:
+    """What a rename at a position changes: the span of the name and its current text;
+    ``ref`` is the name token, or ``key`` the blackboard key use."""
+
+    start: int
+    end: int
+    placeholder: str
+    ref: NameRef | None = None
+    key: KeyRef | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class RenamePlan:
+    """Edits to the document, and to the other documents by path.
+
+    ``written_out`` holds ``(path, start, end)`` (``path=None`` for the document) of the
+    edits that only write out the key a port attribute already has (its ``{=}`` or ``=``,
+    see :func:`rename`): when renames are combined, another rename's edit of the same span
+    wins, since it renames that key."""
+
+    edits: tuple[TextEdit, ...]
+    other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
+    written_out: frozenset[tuple[str | None, int, int]] = frozenset()
+
+    @property
+    def places(self) -> int:
+        return len(self.edits) + sum(len(e) for e in self.other_edits.values())
+
+
+def _refuse_key_use(k: KeyRef) -> None:
+    if k.key.startswith("@"):
+        raise RenameRefused(
+            f"'{shown(k.key)}' is a key of the root blackboard (the '@' prefix), which every "
+            "tree of the running program shares; it cannot be renamed from one tree"
+        )
+    if k.entities:
+        raise RenameRefused(
+            f"The key '{shown(k.key)}' is written with character or entity references in "
+            f"'{k.attr}'; write it out plainly to rename it"
+        )
+
+
+def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
+    """The name a rename at ``offset`` would change, ``None`` when there is none there.
+
+    Raises :class:`RenameRefused` for names that cannot be renamed from XML (the built-in
+    nodes of BehaviorTree.CPP and their ports) and for blackboard keys that cannot be
+    renamed (see :func:`rename`)."""
+    ref = doc.model.ref_at(offset)
+    if ref is None:
+        key = key_at(doc, offset)
+        if key is None or key.tree < 0:
+            return None
+        _refuse_key_use(key)
+        return RenameTarget(key.start, key.end, key.key, key=key)
+    sym = ref.symbol
+    if sym is not None and sym[0] == "model" and sym[1] in BUILTINS:
+        raise RenameRefused(
+            f"'{shown(sym[1])}' is a built-in node type of BehaviorTree.CPP; it cannot be renamed"
+        )
+    if (
+        sym is not None
+        and sym[:2] == ("port", "model")
+        and sym[2] in BUILTINS
+        and BUILTINS[sym[2]].port(sym[3]) is not None
+    ):
+        raise RenameRefused(
+            f"'{shown(sym[3])}' is a port of the built-in node '{sym[2]}'; "
+            "BehaviorTree.CPP declares it, so it cannot be renamed"
+        )
+    return RenameTarget(ref.start, ref.end, ref.text, ref)
+
+
+def _kind_of(ref: NameRef) -> NameKind:
+    if ref.kind is not None:
+        return ref.kind
+    return NameKind.MODEL  # main_tree_to_execute, end tags
+
+
+def _refuse_new_name(new_name: str, why: str) -> NoReturn:
+    raise RenameRefused(f"Cannot rename to '{shown(new_name)}': {why}", new_name=True)
+
+
+def _check_new_name(
+    ref: NameRef,
+    new_name: str,
+    model: Model,
+    others: Mapping[str, Document],
+    taken: Collection[str] | None = None,
+) -> None:
+    """Refuse a new name that breaks a rule of the name, or that another name of its
+    namespace has (``taken``: those names, when the caller knows them already)."""
+    kind = _kind_of(ref)
+    sym = ref.symbol
+    violations = check_name(new_name, kind, declaration=kind is NameKind.PORT)
+    if violations:
+        _refuse_new_name(new_name, violations[0].message)
+    if kind is NameKind.INSTANCE or sym is None:
+        return
+    all_refs = [r for m in (model, *(d.model for d in others.values())) for r in m.refs_to(sym)]
+    if kind is NameKind.PORT:
+        if not is_allowed_port_name(new_name):
+            _refuse_new_name(
+                new_name,
+                "a port name must start with an ASCII letter, or BehaviorTree.CPP does not "
+                "read the attribute as a port",
+            )
+        if any(r.role == Role.PORT_USE for r in all_refs) and not XML_NAME_RE.fullmatch(new_name):
+            _refuse_new_name(
+                new_name,
+                "the port is written as an attribute name, and this is not a valid XML name",
+            )
+    elif not XML_NAME_RE.fullmatch(new_name) and any(
+        r.role in (Role.NODE_TYPE, Role.NODE_TYPE_END) for r in all_refs
+    ):
+        _refuse_new_name(
+            new_name,
+            "the node type is written as an element name, and this is not a valid XML name",
+        )
+    if new_name == sym[-1]:
+        return
+    if sym[0] != "port" and new_name in BUILTINS:
+        _refuse_new_name(
+            new_name,
+            "it is a built-in node type of BehaviorTree.CPP, and trees and node types share "
+            "one namespace",
+        )
+    if taken is None:
+        taken = taken_names(model, sym, (d.model for d in others.values()))
+    if new_name in taken:
+        if sym[0] == "port":
+            owner = f"tree '{sym[2]}'" if sym[1] == "tree" else f"node type '{sym[2]}'"
+            _refuse_new_name(new_name, f"the {owner} already has a port with that name")
+        _refuse_new_name(
+            new_name,
+            "a tree or node type with that name already exists (trees and node types share "
+            "one namespace)",
+        )
+
+
+_SCRIPT_IDENTIFIER_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _check_key_name(new_name: str, in_script: bool) -> None:
+    """Refuse a new name that cannot be a blackboard key where the key is written."""
+    if not new_name:
+        _refuse_new_name(new_name, "a blackboard key cannot be empty")
+    if "{" in new_name or "}" in new_name:
+        _refuse_new_name(
+            new_name,
+            "a blackboard key cannot contain '{' or '}', which delimit it in a port value",
+        )
+    if new_name != new_name.strip(" \t\r\n"):
+        _refuse_new_name(new_name, "BehaviorTree.CPP trims the white space around a key")
+    if new_name == "=":
+        _refuse_new_name(new_name, "'{=}' stands for the key named like its port")
+    if new_name.startswith("@"):
+        _refuse_new_name(
+            new_name,
+            "a key starting with '@' is a key of the root blackboard; a rename cannot move "
+            "a key there",
+        )
+    if any(c < " " or c == "\x7f" for c in new_name):
+        _refuse_new_name(new_name, "a blackboard key cannot contain control characters")
+    if in_script and (
+        _SCRIPT_IDENTIFIER_RE.fullmatch(new_name) is None or new_name in ("true", "false")
+    ):
+        _refuse_new_name(
+            new_name,
+            "the key is used in a script, where it must be an identifier: an ASCII letter or "
+            "'_', then ASCII letters, digits or '_' (and not 'true' or 'false')",
+        )
+
+
+def _check_key_movable(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
+    """Refuse a key rename that would not change every use of the key in the blackboards of
+    the running program (whatever the new name)."""
+    key = targets.key
+    homes = targets.homes
+    for t, u in targets.uses:
+        if u.entities:
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': it is written with character or entity "
+                f"references in '{u.attr}' in {t.shown()}; write it out plainly first"
+            )
+    for t in homes:
+        if unread_mentions(ws.keys(t), key):
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': a script in {t.shown()} has a syntax error "
+                f"before a '{shown(key)}' that may be this key; fix the script first"
+            )
+    if new_name == key:
+        return
+    for t in homes:
+        group = ws.shared(t, key)
+        for o in group:
+            if o not in homes and mentions(ws.keys(o), key):
+                raise RenameRefused(
+                    f"Cannot rename '{shown(key)}': {o.shown()} shares it with {t.shown()} "
+                    'through <SubTree _autoremap="true">, and renaming it in one tree '
+                    "would disconnect them"
+                )
+        root = next((o for o in group if ws.may_be_root(o)), None)
+        users = ws.root_users(key) if root is not None else []
+        if root is not None and users:
+            raise RenameRefused(
+                f"Cannot rename '{shown(key)}': '@{shown(key)}' in {users[0].shown()} is this "
+                f"key (of the root blackboard) when {root.shown()} runs as the main tree"
+            )
+
+
+def _check_no_merge(ws: _Workspace, targets: _KeyTargets, new_name: str) -> None:
+    """Refuse a new name that is already a key of the trees owning the key (or of a tree
+    sharing it): the two keys would become one."""
+    if new_name == targets.key:
+        return
+    for t in targets.homes:
+        group = ws.shared(t, new_name)
+        for o in group:
+            if mentions(ws.keys(o), new_name) or ws.has_port(o, new_name):
+                how = "" if o == t else f", shared with {t.shown()} through _autoremap"
+                _refuse_new_name(
+                    new_name,
+                    f"{o.shown()} already uses a key '{shown(new_name)}'{how}; the two keys "
+                    "would become one",
+                )
+        root = next((o for o in group if ws.may_be_root(o)), None)
+        users = ws.root_users(new_name) if root is not None else []
+        if root is not None and users:
+            _refuse_new_name(
+                new_name,
+                f"'@{shown(new_name)}' in {users[0].shown()} is that key (of the root "
+                f"blackboard) when {root.shown()} runs as the main tree; the two keys would "
+                "become one",
+            )
+
+
+def _key_edit(u: KeyRef, new_name: str) -> TextEdit:
+    if u.form == KeyForm.SCRIPT:
+        return TextEdit(u.start, u.end, new_name)
+    text = escape_value(new_name, u.quote)
+    return TextEdit(u.start, u.end, "{" + text + "}" if u.form == KeyForm.BARE_SAME else text)
+
+
+def _spelled_out(d: Document, r: NameRef) -> TextEdit | None:
+    """For a port attribute about to be renamed whose value is ``{=}`` or ``=`` (the key
+    named like the port): that key written out, so that it stays the same key."""
+    if r.role != Role.PORT_USE:
+        return None
+    a = d.model.elements[r.element].attr(r.text)
+    k = port_value_key(d, r.element, a) if a is not None else None
+    if k is None or k.form not in (KeyForm.SAME, KeyForm.BARE_SAME):
+        return None
+    return _key_edit(k, k.key)
+
+
+class _Edits:
+    """Edits by path (``None``: the document), one per span.  A written-out key gives way
+    to any other edit of its span."""
+
+    def __init__(self) -> None:
+        self.by_path: dict[str | None, dict[tuple[int, int], TextEdit]] = {}
+        self.written_out: set[tuple[str | None, int, int]] = set()
+
+    def add(self, path: str | None, e: TextEdit, written_out: bool = False) -> None:
+        spans = self.by_path.setdefault(path, {})
+        span = (e.start, e.end)
+        if written_out:
+            if span in spans and (path, e.start, e.end) not in self.written_out:
+                return
+            self.written_out.add((path, e.start, e.end))
+        else:
+            self.written_out.discard((path, e.start, e.end))
+        spans[span] = e
+
+    def plan(self) -> RenamePlan:
+        own = self.by_path.get(None, {})
+        return RenamePlan(
+            tuple(sorted(own.values())),
+            {
+                path: tuple(sorted(e.values()))
+                for path, e in self.by_path.items()
+                if path is not None and e
+            },
+            frozenset(self.written_out),
+        )
+
+
+def combined(plans: Iterable[RenamePlan]) -> RenamePlan:
+    """Several renames (of different names) as one: one edit per span, where an edit that
+    only writes out a key gives way to another rename's edit of the same span."""
+    edits = _Edits()
+    for p in plans:
+        out = p.written_out
+        for e in p.edits:
+            edits.add(None, e, (None, e.start, e.end) in out)
+        for path, file_edits in p.other_edits.items():
+            for e in file_edits:
+                edits.add(path, e, (path, e.start, e.end) in out)
+    return edits.plan()
+
+
+def _port_edits(ws: _Workspace, sym: Symbol, new_name: str) -> _Edits:
+    """Renaming a port: its names, and the ``{=}`` values of renamed attributes spelled out."""
+    edits = _Edits()
+    for path, d, r in ws.refs(sym):
+        fix = _spelled_out(d, r)
+        if fix is not None:
+            edits.add(path, fix, written_out=True)
+        for e in rename_edits([r], new_name):
+            edits.add(path, e)
+    return edits
+
+
+def _rename_keys(
+    ws: _Workspace, targets: _KeyTargets, new_name: str, port_checked: bool = False
+) -> RenamePlan:
+    if targets.uses or not targets.port:
+        _check_key_name(new_name, any(u.form == KeyForm.SCRIPT for _, u in targets.uses))
+    if targets.port_refs and not port_checked:
+        _check_new_name(targets.port_refs[0][2], new_name, ws.doc.model, ws.others)
+    _check_key_movable(ws, targets, new_name)
+    _check_no_merge(ws, targets, new_name)
+    edits = _port_edits(ws, targets.port, new_name) if targets.port is not None else _Edits()
+    for t, u in targets.uses:
+        edits.add(t.path, _key_edit(u, new_name))
+    return edits.plan()
+
+
+class Renamer:
+    """Renames of the names of one document, by the rules of :func:`rename`, with the other
+    workspace documents (by path).  One renamer serves many renames of the same documents
+    (the name fixes use it so): what it reads of their trees is read once."""
+
+    def __init__(self, doc: Document, others: Mapping[str, Document] | None = None) -> None:
+        self._ws = _Workspace(doc, others or {})
+
+    def plan(
+        self,
+        ref: NameRef,
+        new_name: str,
+        *,
+        keys: bool = True,
+        taken: Collection[str] | None = None,
+    ) -> RenamePlan:
+        """The edits renaming the name token ``ref`` of the document (and every reference to
+        its symbol) to ``new_name``, as :func:`rename` makes them; raises
+        :class:`RenameRefused` like it.
+
+        ``keys=False`` leaves the blackboard keys of a tree's port as they are: only the
+        port's own names change (a ``{=}`` of a renamed attribute is still written out), and
+        only the new name is checked, also against the keys of the tree.  ``taken`` are the
+        names the new one must avoid in its namespace, when the caller knows them already
+        (by default they are collected from the documents)."""
+        ws = self._ws
+        _check_new_name(ref, new_name, ws.doc.model, ws.others, taken)
+        sym = ref.symbol
+        if sym is None:
+            return RenamePlan(tuple(rename_edits([ref], new_name)))
+        if _is_tree_port(sym):
+            targets = _port_targets(ws, sym)
+            if keys:
+                return _rename_keys(ws, targets, new_name, port_checked=True)
+            _check_no_merge(ws, targets, new_name)
+            return _port_edits(ws, sym, new_name).plan()
+        if sym[0] == "port":
+            return _port_edits(ws, sym, new_name).plan()
+        return RenamePlan(
+            tuple(rename_edits(ws.doc.model.refs_to(sym), new_name)),
+            other_file_edits(sym, new_name, {p: d.model for p, d in ws.others.items()}),
+        )
+
+    def key_plan(self, key: KeyRef, new_name: str) -> RenamePlan:
+        """The edits renaming the blackboard key used at ``key`` (a use in the document)
+        in its tree, and the port it is, as :func:`rename` makes them."""
+        ws = self._ws
+        home = _Tree(None, ws.doc, key.tree)
+        return _rename_keys(ws, _key_targets(ws, home, key.key), new_name)
+
+
+def rename(
+    doc: Document, offset: int, new_name: str, others: Mapping[str, Document] | None = None
+) -> RenamePlan | None:
+    """Rename the name under ``offset`` and every reference to it in the workspace.
+
+    ``None`` when there is no name there; raises :class:`RenameRefused` when the name cannot
+    be renamed or ``new_name`` breaks a rule (the message gives the rule's reason).  A port
+    attribute renamed while its value is ``{=}`` or ``=`` (the key named like the port)
+    gets that key written out, so that the node keeps its key.
+
+    A blackboard key (under the cursor in ``{key}``, at the ``=`` of ``{=}`` or as a script
+    identifier) is renamed in the tree that uses it, because BehaviorTree.CPP gives each
+    tree instance a blackboard of its own: every use in the port values and scripts of
+    that tree's nodes, nothing in other trees (the ``port="{key}"`` of a ``<SubTree>``
+    call belongs to the calling tree).  When the key is also a port of its tree (declared
+    in a ``<SubTree>`` model entry or remapped by ``<SubTree>`` calls: inside a subtree the
+    port's name is its key), the port is renamed with it across the workspace; renaming
+    such a port likewise renames the key inside the tree.
+
+    Refused with the reason, rather than done partly or with a changed meaning:
+
+    * a key starting with ``@``: a key of the root blackboard, which every tree of the
+      running program shares, so no rename inside one tree can follow it;
+    * a key that some tree reaches as ``@key``, in a tree that may run as the main tree
+      (its document's ``main_tree_to_execute``, or called by no ``<SubTree>``): the main
+      tree's blackboard is the root one;
+    * a key shared through ``_autoremap``: a ``<SubTree _autoremap="true">`` call that does
+      not remap a port of that name gives caller and subtree one entry for every key not
+      starting with ``_`` (transitively, either way), so renaming the key where another
+      tree of that chain uses it would disconnect the two;
+    * a new name that would merge two keys: one already used in the tree or in a tree
+      sharing it through ``_autoremap``, a port of the tree, or a key that ``@name``
+      reaches while the tree may be the main one;
+    * a key written with character or entity references (``{go&#97;l}``), and a key that
+      appears after a syntax error in a script of the tree (which cannot be read further);
+    * a new name that is empty, contains ``{`` or ``}`` or control characters, has white
+      space around it, is ``=``, starts with ``@`` or, for a key used in a script, is not an
+      identifier (``[A-Za-z_][A-Za-z0-9_]*``, not ``true`` or ``false``); for a key that
+      is a port too, the port name rules apply as well.
+
+    A refusal of the new name itself (a rule it breaks, a name already taken in its
+    namespace, two keys it would merge) carries :attr:`RenameRefused.new_name`: another
+    name may do.
+    """
+    target = prepare_rename(doc, offset)
+    if target is None:
+        return None
+    renamer = Renamer(doc, others)
+    if target.key is not None:
+        return renamer.key_plan(target.key, new_name)
+    ref = target.ref
+    if ref is None:  # pragma: no cover - a target is a name or a key
+        return None
+    return renamer.plan(ref, new_name)
+
+
+# --- document symbols ---------------------------------------------------------------------
+
+
+class SymbolKind(StrEnum):
+    TREE = "tree"
+    NODE = "node"
+    SUBTREE = "subtree call"
+    MODELS = "TreeNodesModel"
+    MODEL = "model"
+    PORT = "port"
+    INCLUDE = "include"
+
+
+@dataclass(slots=True)
+class DocSymbol:
+    """A symbol of the outline: ``start``/``end`` span its element, ``sel_start``/
+    ``sel_end`` its name."""
+
+    name: str
+    detail: str
+    kind: SymbolKind
+    start: int
+    end: int
+    sel_start: int
+    sel_end: int
+    children: list[DocSymbol] = field(default_factory=list)
+
+
+def _category(node_id: str | None, ctx: Context | None) -> str:
+    if node_id is None:
+        return ""
+    b = BUILTINS.get(node_id)
+    if b is not None:
+        return b.category
+    if ctx is not None:
+        decl = ctx.models.get(node_id)
+        if decl is not None:
+            return decl.category
+    return ""
+
+
+def _id_span(el: Element) -> tuple[str, int, int]:
+    a = el.attr("ID")
+    if a is not None and a.value is not None:
+        s, e = el.span_of_value(a)
+        return a.value, s, e
+    return "", el.name_start, el.name_end
+
+
+def _symbol_of(el: Element, ctx: Context | None) -> DocSymbol | None:
+    zone = el.zone
+    if zone == Zone.TREE:
+        tid, s, e = _id_span(el)
+        return DocSymbol(tid or "(no ID)", "BehaviorTree", SymbolKind.TREE, 0, 0, s, e)
+    if zone == Zone.NODE:
+        label = el.value("name")
+        if el.name == "SubTree":
+            tid, s, e = _id_span(el)
+            return DocSymbol(
+                label or tid or "SubTree", f"SubTree {tid}".strip(), SymbolKind.SUBTREE, 0, 0, s, e
+            )
+        if el.name in EXPLICIT_TAGS:
+            nid, s, e = _id_span(el)
+            detail = f"{el.name} {nid}".strip()
+        else:
+            nid, s, e = el.name, el.name_start, el.name_end
+            detail = _category(nid, ctx)
+            detail = f"{detail} {nid}".strip() if label else detail
+        return DocSymbol(label or nid or el.name, detail, SymbolKind.NODE, 0, 0, s, e)
+    if zone == Zone.MODELS:
+        return DocSymbol(el.name, "", SymbolKind.MODELS, 0, 0, el.name_start, el.name_end)
+    if zone == Zone.MODEL_ENTRY:
+        mid, s, e = _id_span(el)
+        return DocSymbol(mid or el.name, el.name, SymbolKind.MODEL, 0, 0, s, e)
+    if zone == Zone.PORT_DECL:
+        a = el.attr("name")
+        if a is not None and a.value is not None:
+            s, e = el.span_of_value(a)
+            pname = a.value
+        else:
+            pname, s, e = "", el.name_start, el.name_end
+        ptype = el.value("type")
+        detail = el.name.replace("_", " ") + (f": {ptype}" if ptype else "")
+        return DocSymbol(pname or "(no name)", detail, SymbolKind.PORT, 0, 0, s, e)
+    if zone == Zone.INCLUDE:
+        a = el.attr("path")
+        if a is not None and a.value is not None:
+            s, e = el.span_of_value(a)
+            return DocSymbol(a.value or "(no path)", "include", SymbolKind.INCLUDE, 0, 0, s, e)
+        return DocSymbol(
+            "(no path)", "include", SymbolKind.INCLUDE, 0, 0, el.name_start, el.name_end
+        )
+    return None
+
+
+def document_symbols(doc: Document, ctx: Context | None = None) -> list[DocSymbol]:
+    """The outline: the trees with their nodes as a hierarchy, the ``<TreeNodesModel>``
+    with its entries and their ports, and the includes.  A symbol's range holds its
+    children's ranges; names are never empty."""
+    model = doc.model
+    if ctx is None:
+        ctx = Context.from_document(doc)
+    made: dict[int, DocSymbol] = {}
+    top: list[DocSymbol] = []
+    for i, el in enumerate(model.elements):
+        sym = _symbol_of(el, ctx)
+        if sym is None:
+            continue
+        sym.start, sym.end = el.token_start, element_end(doc, el)
+        made[i] = sym
+        parent = made.get(el.parent)
+        (parent.children if parent is not None else top).append(sym)
+    # A parent's range must hold its children's (an unclosed element ends at its tag).
+    for i in sorted(made, reverse=True):
+        sym = made[i]
+        for c in sym.children:
+            sym.end = max(sym.end, c.end)
+    return top
+
+
+@dataclass(frozen=True, slots=True)
+class WorkspaceSymbol:
+    """A tree or a ``<TreeNodesModel>`` entry somewhere in the workspace."""
+
+    name: str
+    kind: SymbolKind
+    detail: str
+    path: str
+    start: int
+    end: int
+
+
+def _matches(query: str, name: str) -> bool:
+    """Case-insensitive subsequence match (what editors expect of a symbol search)."""
+    if not query:
+        return True
+    it = iter(name.lower())
+    return all(c in it for c in query.lower())
+
+
+def workspace_symbols(
+    docs: Iterable[tuple[str, Document]], query: str = "", limit: int = 1000
+) -> list[WorkspaceSymbol]:
+    """The trees and model entries of ``docs`` (by key, usually a path or URI) whose name
+    matches ``query``, at most ``limit``."""
+    out: list[WorkspaceSymbol] = []
+    for key, doc in docs:
+        for r in doc.model.refs:
+            if r.role == Role.TREE_DEF:
+                kind, detail = SymbolKind.TREE, "BehaviorTree"
+            elif r.role == Role.MODEL_DEF:
+                kind = SymbolKind.MODEL
+                detail = doc.model.elements[r.element].name
+            else:
+                continue
+            if not r.text or not _matches(query, r.text):
+                continue
+            out.append(WorkspaceSymbol(r.text, kind, detail, key, r.start, r.end))
+            if len(out) >= limit:
+                return out
+    return out
+
+
+# --- folding and linked editing -----------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True, order=True)
+class Fold:
+    """Lines to fold (0-based, both included); ``comment`` for comments."""
+
+    start_line: int
+    end_line: int
+    comment: bool = False
+
+
+def folding_ranges(doc: Document) -> list[Fold]:
+    """Elements that span several lines (the line of their end tag stays visible when the
+    end tag starts its line), and comments that span several lines."""
+    lines = doc.lines
+    text = doc.text
+    out: set[Fold] = set()
+    for el in doc.model.elements:
+        first = lines.line_of(el.token_start)
+        end = element_end(doc, el)
+        last = lines.line_of(max(end - 1, el.token_start))
+        if el.end_name_start >= 0:
+            tag = el.end_name_start - 2  # '</'
+            line_start = lines.line_start(last)
+            if text[line_start:tag].strip() == "" and last > first:
+                last -= 1
+        if last > first:
+            out.add(Fold(first, last))
+    for start, tok in zip(doc.scan.starts, doc.scan.tokens, strict=True):
+        if tok.kind == Kind.COMMENT:
+            first = lines.line_of(start)
+            last = lines.line_of(start + tok.length - 1)
+            if last > first:
+                out.add(Fold(first, last, comment=True))
+    return sorted(out)
+
+
+def linked_editing_ranges(doc: Document, offset: int) -> list[tuple[int, int]] | None:
+    """The start-tag and end-tag names of the element whose tag name holds ``offset``, so
+    that editing one edits the other; ``None`` outside a tag name or without an end tag."""
+    model = doc.model
+    hit = _element_at_tag(model, offset)
+    if hit is None:
+        return None
+    el = model.elements[hit[0]]
+    if el.end_name_start < 0:
+        return None
+    return [(el.name_start, el.name_end), (el.end_name_start, el.end_name_end)]
+
+
+# --- shared by completion and hover -------------------------------------------------------
+
+
+def ports_of(el: Element, ctx: Context | None) -> tuple[PortModel, ...] | None:
+    """The declared ports of a node element, ``None`` when its model is unknown."""
+    node_id = el.node_id
+    if node_id is None:
+        return None
+    if el.name == "SubTree":
+        decl = ctx.subtree_models.get(node_id) if ctx is not None else None
+        return decl.ports if decl is not None else None
+    b = BUILTINS.get(node_id)
+    if b is not None:
+        return b.ports
+    decl = ctx.models.get(node_id) if ctx is not None else None
+    return decl.ports if decl is not None else None

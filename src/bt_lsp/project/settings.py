@@ -1,0 +1,75 @@
+"""User settings (the ``btLsp`` section), parsed leniently: a bad value is ignored and
+reported, never fatal."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from bt_lsp.rules.codes import CODES, Severity
+
+DEFAULT_MAX_DOCUMENT_BYTES = 8 * 1024 * 1024
+MAX_DEBOUNCE_MS = 60_000
+
+
+@dataclass(frozen=True)
+class Settings:
+    debounce_ms: int = 200
+    severity: Mapping[str, Severity | None] = field(default_factory=dict)
+    # Above this size (UTF-8 bytes) only the lexical and name checks run.
+    max_document_bytes: int = DEFAULT_MAX_DOCUMENT_BYTES
+    # ROS package name -> folder, for <include ros_pkg="...">.
+    ros_packages: Mapping[str, str] = field(default_factory=dict)
+    # Extra files that declare models (a generated TreeNodesModel, a Groot2 .btproj).
+    model_files: tuple[str, ...] = ()
+
+    @classmethod
+    def parse(cls, raw: Any, problems: list[str] | None = None) -> Settings:
+        """Settings from the client's JSON (``btLsp`` section or initializationOptions)."""
+        problems = problems if problems is not None else []
+        if not isinstance(raw, Mapping):
+            if raw is not None:
+                problems.append("btLsp settings must be an object")
+            return cls()
+        section: Mapping[str, Any] = raw
+        if isinstance(section.get("btLsp"), Mapping):
+            section = section["btLsp"]
+        raw = section
+        kw: dict[str, Any] = {}
+        debounce = raw.get("debounceMs")
+        if debounce is not None:
+            if (
+                isinstance(debounce, int | float)
+                and not isinstance(debounce, bool)
+                and 0 <= debounce <= MAX_DEBOUNCE_MS  # also rejects NaN and infinity
+            ):
+                kw["debounce_ms"] = int(debounce)
+            else:
+                problems.append(
+                    f"debounceMs must be a number from 0 to {MAX_DEBOUNCE_MS}, not {debounce!r}"
+                )
+        sev = raw.get("severity")
+        if isinstance(sev, Mapping):
+            parsed: dict[str, Severity | None] = {}
+            for code, word in sev.items():
+                if code not in CODES:
+                    problems.append(f"severity: unknown code {code!r}")
+                    continue
+                try:
+                    parsed[code] = Severity.parse(str(word))
+                except ValueError:
+                    problems.append(f"severity: {word!r} for {code} is not a severity")
+            kw["severity"] = parsed
+        elif sev is not None:
+            problems.append("severity must be an object of code -> level")
+        size = raw.get("maxDocumentBytes")
+        if isinstance(size, int) and not isinstance(size, bool) and size > 0:
+            kw["max_document_bytes"] = size
+        ros = raw.get("rosPackages")
+        if isinstance(ros, Mapping):
+            kw["ros_packages"] = {str(k): str(v) for k, v in ros.items()}
+        models = raw.get("modelFiles")
+        if isinstance(models, list):
+            kw["model_files"] = tuple(str(m) for m in models)
+        return cls(**kw)

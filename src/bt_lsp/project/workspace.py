@@ -1,0 +1,373 @@
+"""The workspace: open documents, the BT XML files around them, and their includes.
+
+This is the only layer that reads files.  It resolves ``<include path>`` the way
+BehaviorTree.CPP does (relative to the including file; ``ros_pkg`` through the
+``rosPackages`` setting), finds include cycles, collects the other BT files of the
+workspace folders, and gives each document the :class:`~bt_lsp.rules.context.Context` that the
+semantic rules read.  Files are read lazily and cached by modification time and size.
+Nothing here ever fetches a URL or follows a DOCTYPE.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from bt_lsp.ide.navigation import IncludeLink
+from bt_lsp.project.fileio import FileError, read_text
+from bt_lsp.project.settings import Settings
+from bt_lsp.rules import analysis
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.diagnostics import Diagnostic, limited, make
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.gcpause import with_gc_paused
+from bt_lsp.syntax.model import Model
+
+# Folders that never hold a project's own trees (build outputs, VCS, dependencies).
+SKIP_DIRS = frozenset(
+    {
+        ".git",
+        ".hg",
+        ".svn",
+        "node_modules",
+        "build",
+        "install",
+        "log",
+        "__pycache__",
+        ".venv",
+        "venv",
+        ".tox",
+        ".mypy_cache",
+        ".ruff_cache",
+        ".pytest_cache",
+    }
+)
+MAX_WORKSPACE_FILES = 5000
+MAX_INCLUDE_FILES = 1000
+
+
+def normalize(path: str | os.PathLike[str]) -> Path:
+    """An absolute, normalized path (``..`` folded lexically, symlinks kept)."""
+    return Path(os.path.normpath(os.path.abspath(os.fspath(path))))
+
+
+@dataclass(frozen=True, slots=True)
+class Include:
+    """One ``<include>`` of a document: the span of its ``path`` value and where it leads."""
+
+    start: int
+    end: int
+    written: str
+    target: Path | None  # None when it cannot be resolved (no path, unknown ros_pkg)
+    ros_pkg: str | None
+
+
+def links(includes: Iterable[Include]) -> list[IncludeLink]:
+    """The resolved includes as the editing layer takes them (spans and target paths)."""
+    return [IncludeLink(i.start, i.end, str(i.target)) for i in includes if i.target is not None]
+
+
+def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
+    out: list[Include] = []
+    for el in doc.model.root_children_named(("include",)):  # the INCLUDE zone
+        a = el.attr("path")
+        if a is None or a.value is None or not a.value.strip():
+            continue  # include-missing-path is a semantic rule of the document itself
+        start, end = el.span_of_value(a)
+        written = a.value.strip()
+        pkg = el.value("ros_pkg")
+        target: Path | None
+        if os.path.isabs(written):
+            target = normalize(written)
+        elif pkg:
+            base = settings.ros_packages.get(pkg)
+            target = normalize(Path(base) / written) if base else None
+        else:
+            target = normalize(path.parent / written)
+        out.append(Include(start, end, written, target, pkg or None))
+    return out
+
+
+class Workspace:
+    def __init__(
+        self, roots: Sequence[str | os.PathLike[str]] = (), settings: Settings | None = None
+    ) -> None:
+        self.roots = [normalize(r) for r in roots]
+        self.settings = settings or Settings()
+        self._open: dict[Path, Document] = {}
+        self._disk: dict[Path, tuple[tuple[int, int], Document | None, str | None]] = {}
+        self._files: list[Path] | None = None
+        self._includes: dict[Path, tuple[Model, Settings, list[Include]]] = {}
+        self._paths: tuple[tuple[int, tuple[Path, ...]], list[Path]] | None = None
+        self.generation = 0  # bumps whenever a file other than an edited open one changes
+
+    # -- documents --------------------------------------------------------------------------
+
+    def open(self, path: str | os.PathLike[str], doc: Document) -> None:
+        self._open[normalize(path)] = doc
+
+    def close(self, path: str | os.PathLike[str]) -> None:
+        self._open.pop(normalize(path), None)
+        self.generation += 1
+
+    def is_open(self, path: Path) -> bool:
+        return path in self._open
+
+    def document(self, path: Path) -> Document | None:
+        """The open document at ``path``, else the file on disk (cached), else ``None``."""
+        doc = self._open.get(path)
+        if doc is not None:
+            return doc
+        return self._read(path)[0]
+
+    def read_error(self, path: Path) -> str | None:
+        if path in self._open:
+            return None
+        return self._read(path)[1]
+
+    def _read(self, path: Path) -> tuple[Document | None, str | None]:
+        """Read a file once; it is read again only after :meth:`file_changed` (the server
+        hears of changes through watched-file notifications) or :meth:`refresh`."""
+        cached = self._disk.get(path)
+        if cached is not None:
+            return cached[1], cached[2]
+        try:
+            st = path.stat()
+        except OSError as e:
+            self._disk[path] = ((0, 0), None, e.strerror or str(e))
+            return None, e.strerror or str(e)
+        except ValueError as e:  # a path the OS cannot look up ("embedded null byte")
+            self._disk[path] = ((0, 0), None, str(e))
+            return None, str(e)
+        if not path.is_file():
+            self._disk[path] = ((0, 0), None, "not a file")
+            return None, "not a file"
+        stamp = (st.st_mtime_ns, st.st_size)
+        try:
+            decoded = read_text(str(path), max_bytes=self.settings.max_document_bytes)
+            doc: Document | None = Document(decoded.text, str(path))
+            err = None
+        except FileError as e:
+            doc, err = None, e.message
+        self._disk[path] = (stamp, doc, err)
+        return doc, err
+
+    def file_changed(self, path: str | os.PathLike[str]) -> None:
+        """A file was created, changed or deleted on disk (workspace/didChangeWatchedFiles)."""
+        p = normalize(path)
+        self._disk.pop(p, None)
+        self._files = None
+        self.generation += 1
+
+    def refresh(self) -> None:
+        """Forget everything read from disk (for clients that do not report file changes)."""
+        self._disk.clear()
+        self._files = None
+        self.generation += 1
+
+    def set_settings(self, settings: Settings) -> None:
+        self.settings = settings
+        self._disk.clear()
+        self.generation += 1
+
+    # -- the workspace's BT files -------------------------------------------------------------
+
+    def files(self) -> list[Path]:
+        """Every BT XML file under the workspace folders and the model files from the
+        settings (sorted; a bounded number, skipping build and VCS folders)."""
+        if self._files is None:
+            found: set[Path] = set()
+            for root in self.roots:
+                for p in _walk_xml(root):
+                    found.add(p)
+                    if len(found) >= MAX_WORKSPACE_FILES:
+                        break
+            found.update(self.model_files())
+            self._files = sorted(found)
+        return self._files
+
+    def model_files(self) -> list[Path]:
+        """The model files named in the settings (relative to the first workspace folder)."""
+        out = []
+        for m in self.settings.model_files:
+            mp = Path(m)
+            out.append(normalize(mp if mp.is_absolute() or not self.roots else self.roots[0] / mp))
+        return out
+
+    def bt_documents(self) -> Iterator[tuple[Path, Document]]:
+        key = (self.generation, tuple(self._open))
+        if self._paths is None or self._paths[0] != key:
+            self._paths = (key, sorted(set(self.files()) | set(self._open)))
+        for p in self._paths[1]:
+            doc = self.document(p)
+            if doc is not None and (doc.is_bt or p.suffix == ".btproj"):
+                yield p, doc
+
+    # -- includes -----------------------------------------------------------------------------
+
+    def includes(self, path: Path, doc: Document | None = None) -> list[Include]:
+        doc = doc if doc is not None else self.document(path)
+        if doc is None:
+            return []
+        # Kept per path while the document's model and the settings are the same (every
+        # document's includes are looked at for every other one).
+        model = doc.model
+        hit = self._includes.get(path)
+        if hit is not None and hit[0] is model and hit[1] is self.settings:
+            return hit[2]
+        found = includes_of(path, doc, self.settings)
+        self._includes[path] = (model, self.settings, found)
+        return found
+
+    def include_closure(self, path: Path, doc: Document | None = None) -> list[Path]:
+        """Files reachable through includes from ``path`` (not ``path`` itself), in
+        depth-first order; iterative and bounded, cycles are cut."""
+        seen = {path}
+        order: list[Path] = []
+        stack: list[Path] = [
+            inc.target for inc in reversed(self.includes(path, doc)) if inc.target is not None
+        ]
+        while stack and len(order) < MAX_INCLUDE_FILES:
+            p = stack.pop()
+            if p in seen:
+                continue
+            seen.add(p)
+            order.append(p)
+            for inc in reversed(self.includes(p)):
+                if inc.target is not None and inc.target not in seen:
+                    stack.append(inc.target)
+        return order
+
+    def _reaches(self, start: Path, goal: Path) -> list[Path] | None:
+        """A chain of includes from ``start`` to ``goal`` (both included), or None."""
+        parent: dict[Path, Path | None] = {start: None}
+        stack = [start]
+        while stack and len(parent) < MAX_INCLUDE_FILES:
+            p = stack.pop()
+            if p == goal:
+                chain = [p]
+                while parent[chain[-1]] is not None:
+                    prev = parent[chain[-1]]
+                    assert prev is not None
+                    chain.append(prev)
+                return chain[::-1]
+            for inc in self.includes(p):
+                t = inc.target
+                if t is not None and t not in parent:
+                    parent[t] = p
+                    stack.append(t)
+        return None
+
+    def include_diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
+        """``include-not-found`` and ``include-cycle`` for the includes of one document."""
+        out: list[Diagnostic] = []
+        for inc in self.includes(path, doc):
+            if inc.target is None:
+                continue  # no path / unmapped ros_pkg: the document's own rules say so
+            if inc.target == path:
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-cycle",
+                        f"'{inc.written}' includes this file itself; BehaviorTree.CPP "
+                        "recurses until it crashes",
+                    )
+                )
+                continue
+            if self.document(inc.target) is None:
+                why = self.read_error(inc.target) or "cannot be read"
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-not-found",
+                        f"Included file '{inc.written}' not found ({inc.target}: {why})",
+                    )
+                )
+                continue
+            chain = self._reaches(inc.target, path)
+            if chain is not None:
+                names = " → ".join(_short(p, path) for p in [path, *chain])
+                out.append(
+                    make(
+                        inc.start,
+                        inc.end,
+                        "include-cycle",
+                        f"Include cycle: {names}; BehaviorTree.CPP fails with a "
+                        "misleading 'file not found' or crashes",
+                    )
+                )
+        return out
+
+    # -- what one document sees ----------------------------------------------------------------
+
+    def context_for(self, path: Path, doc: Document) -> Context:
+        """The rest of the workspace as ``doc`` (at ``path``) sees it: its include closure
+        (trees join its namespace) and every other BT file (models count)."""
+        closure = self.include_closure(path, doc)
+        in_closure = set(closure)
+        others: list[tuple[str, Document, bool]] = []
+        # BehaviorTree.CPP loads included documents depth-first before the includer.
+        for p in reversed(closure):
+            d = self.document(p)
+            if d is not None:
+                others.append((str(p), d, True))
+        included_by: list[str] = []
+        model_paths = set(self.model_files())
+        model_files: list[tuple[str, Document]] = []
+        for p, d in self.bt_documents():
+            if p == path or p in in_closure:
+                continue
+            if p in model_paths:
+                model_files.append((str(p), d))
+                continue
+            others.append((str(p), d, False))
+            if any(inc.target == path for inc in self.includes(p, d)):
+                included_by.append(str(p))
+        return Context.combine(
+            doc,
+            others,
+            path=str(path),
+            ros_pkg_paths=self.settings.ros_packages,
+            model_files=model_files,
+            included_by=included_by,
+        )
+
+    @with_gc_paused
+    def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
+        """Every diagnostic of ``doc`` in this workspace."""
+        out = analysis.analyze(doc, self.context_for(path, doc))
+        out.extend(self.include_diagnostics(path, doc))
+        out.sort(key=lambda d: (d.start, d.end, d.code))
+        return limited(out)
+
+    def other_documents(self, path: Path) -> dict[str, Document]:
+        """The other BT documents of the workspace (open ones as edited), by path: what a
+        rename or a name fix of the document at ``path`` reaches and checks."""
+        return {str(p): d for p, d in self.bt_documents() if p != path}
+
+    def dependents(self, path: Path) -> list[Path]:
+        """Open documents whose include closure contains ``path``."""
+        return [p for p in self._open if p != path and path in self.include_closure(p)]
+
+
+def _short(p: Path, base: Path) -> str:
+    try:
+        return os.path.relpath(p, base.parent)
+    except ValueError:
+        return str(p)
+
+
+def _walk_xml(root: Path) -> Iterable[Path]:
+    if root.is_file():
+        if root.suffix in (".xml", ".btproj"):
+            yield root
+        return
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = sorted(d for d in dirnames if d not in SKIP_DIRS and not d.startswith("."))
+        for f in sorted(filenames):
+            if f.endswith((".xml", ".btproj")):
+                yield normalize(Path(dirpath) / f)

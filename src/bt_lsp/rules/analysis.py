@@ -1,0 +1,23 @@
+"""All diagnostics of a document: its own (cached on it) plus the BehaviorTree.CPP
+semantic rules, which also see the rest of the workspace through a context."""
+
+from __future__ import annotations
+
+from bt_lsp.rules import semantics
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.diagnostics import Diagnostic, limited, own_diagnostics
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.gcpause import with_gc_paused
+
+
+@with_gc_paused
+def analyze(doc: Document, ctx: Context | None = None) -> list[Diagnostic]:
+    """The document's own diagnostics and the semantic ones, sorted by (start, end, code).
+
+    Without ``ctx`` the document is checked as if it were alone
+    (:meth:`Context.from_document`).
+    """
+    out = list(own_diagnostics(doc))
+    out.extend(semantics.check(doc, ctx if ctx is not None else Context.from_document(doc)))
+    out.sort(key=lambda d: (d.start, d.end, d.code))
+    return limited(out)

@@ -1,0 +1,206 @@
+"""Diagnostics that depend on one document alone: lexical problems, XML structure and
+the name rules.  They are cached on the document; rules that also need the rest of the
+workspace live in :mod:`bt_lsp.rules.semantics` and are combined in :mod:`bt_lsp.rules.analysis`.
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.names import NameKind, Violation, check_name
+from bt_lsp.syntax.model import Model, NameRef, Role, Section
+from bt_lsp.syntax.scanner import Scan
+
+if TYPE_CHECKING:
+    from bt_lsp.syntax.document import Document
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """A finding over code-point offsets ``[start, end)`` of the document text."""
+
+    start: int
+    end: int
+    code: str
+    message: str
+    severity: Severity
+    data: Mapping[str, Any] | None = field(default=None, compare=True)
+
+    @property
+    def is_name_rule(self) -> bool:
+        return CODES[self.code].family == "names"
+
+
+def make(
+    start: int, end: int, code: str, message: str, data: Mapping[str, Any] | None = None
+) -> Diagnostic:
+    return Diagnostic(start, end, code, message, CODES[code].severity, data)
+
+
+# The violations of each name text, per role (a role decides the kind and whether the
+# name is declared): model and port names repeat (every use of a node type or port), and
+# a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
+# names rarely repeat and their rule is quick: they are not kept (they would cost memory
+# in proportion to the documents).  Bounded.
+_VIOLATIONS: dict[Role, dict[str, tuple[Violation, ...]]] = {role: {} for role in Role}
+_MAX_CACHED = 4096
+
+
+def violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
+    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role)."""
+    cache = _VIOLATIONS[role]
+    found = cache.get(text)
+    if found is None:
+        found = check_name(text, kind, declaration=role is Role.PORT_DECL)
+        if kind is not NameKind.INSTANCE:
+            if len(cache) >= _MAX_CACHED:
+                cache.clear()
+            cache[text] = found
+    return found
+
+
+def name_violations(ref: NameRef) -> tuple[Violation, ...]:
+    if ref.kind is None:
+        return ()
+    return violations(ref.text, ref.kind, ref.role)
+
+
+def name_diagnostics(model: Model) -> list[Diagnostic]:
+    return ref_diagnostics(model.refs)
+
+
+def ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
+    """The name-rule diagnostics of ``refs``."""
+    out: list[Diagnostic] = []
+    caches = _VIOLATIONS
+    # Unpacked rather than read by field: this runs for every name of a document.
+    for start, end, text, kind, role, _symbol, _element, _quote in refs:
+        if kind is None:
+            continue
+        found = caches[role].get(text)
+        if found is None:
+            found = violations(text, kind, role)
+        for v in found:
+            out.append(
+                make(
+                    start,
+                    end,
+                    v.code,
+                    v.message,
+                    {"name": text, "kind": str(kind), "role": str(role)},
+                )
+            )
+    return out
+
+
+def lexical_diagnostics(scan: Scan) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    for start, tok in zip(scan.starts, scan.tokens, strict=True):
+        if tok.problems:
+            for p in tok.problems:
+                out.append(make(start + p.start, start + p.end, p.code, p.message))
+    return out
+
+
+def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
+    return d.start, d.end, d.code
+
+
+# For each document, the sections of its last model and those of them with diagnostics.
+_NOISY: weakref.WeakKeyDictionary[Document, tuple[set[Section], set[Section]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _own(section: Section) -> list[Diagnostic]:
+    """The diagnostics of one section (in its coordinates), computed once."""
+    out: list[Diagnostic] | None = section.cache.get("diagnostics")
+    if out is None:
+        out = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
+        out.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
+        out.extend(ref_diagnostics(section.refs))
+        section.cache["diagnostics"] = out
+    return out
+
+
+def compute(doc: Document) -> list[Diagnostic]:
+    model = doc.model
+    if model.head is None:
+        out = lexical_diagnostics(doc.scan)
+        out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
+        out.extend(name_diagnostics(model))
+    else:
+        # Each section's own diagnostics are kept on it; they are only moved here, from
+        # the sections that have some.  Which those are is remembered for the document:
+        # an edit leaves all but a few sections as they were.
+        out = list(_own(model.head))
+        sections = model.sections
+        now = set(sections)
+        seen, noisy = _NOISY.get(doc, (set(), set()))
+        noisy = noisy & now
+        noisy.update(sec for sec in now - seen if _own(sec))
+        _NOISY[doc] = (now, noisy)
+        if noisy:
+            origins = model.origins
+            index = dict(zip(sections, range(len(sections)), strict=True))
+            for k in sorted(index[sec] for sec in noisy):
+                o = origins[k]
+                out.extend(
+                    Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)
+                    for d in _own(sections[k])
+                )
+        if model.tail is not None:
+            out.extend(_own(model.tail))
+    out.sort(key=_sort_key)
+    return out
+
+
+def with_severities(
+    diags: Iterable[Diagnostic], overrides: Mapping[str, Severity | None]
+) -> list[Diagnostic]:
+    """Apply per-code severity settings; a code set to ``None`` ("off") is dropped."""
+    if not overrides:
+        return list(diags)
+    out: list[Diagnostic] = []
+    for d in diags:
+        if d.code in overrides:
+            sev = overrides[d.code]
+            if sev is None:
+                continue
+            d = replace(d, severity=sev)
+        out.append(d)
+    return out
+
+
+MAX_DIAGNOSTICS = 2000
+
+
+def limited(diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS) -> list[Diagnostic]:
+    """At most ``maximum`` diagnostics (the first by position), plus one that says how many
+    were left out: hostile or binary input must not flood the client."""
+    if len(diags) <= maximum:
+        return diags
+    kept = diags[:maximum]
+    kept.append(
+        make(
+            0,
+            0,
+            "too-many-problems",
+            f"{len(diags) - maximum} more problems are not shown "
+            f"(only the first {maximum} are reported)",
+        )
+    )
+    return kept
+
+
+def own_diagnostics(doc: Document) -> list[Diagnostic]:
+    """The diagnostics of ``doc`` alone (lexical, XML structure, names), kept on it until
+    its next edit."""
+    found: list[Diagnostic] | None = doc.own_diagnostics
+    if found is None:
+        found = doc.own_diagnostics = compute(doc)
+    return found

@@ -1,0 +1,177 @@
+"""The name diagnostics of a well-formed document, found before its full analysis.
+
+A first analysis of a megabyte of BT XML takes a few hundred milliseconds: the scanner
+reads every token with exact positions, the model and the rules visit every element in
+Python.  lxml's C parser reads the same bytes twenty times faster.  Whether an element
+breaks a name rule needs neither positions nor a model, only its tag, its attributes and
+where it sits, which lxml's parse gives in document order.  So this pass checks the names
+of every element as lxml reads them (the checks are cached by text), and places only the
+elements with a suspect name: their start tags are found by counting start tags, scanned by
+the real scanner and named by the model's own code (:func:`bt_lsp.syntax.model.start_tag_refs`).
+Every diagnostic found is therefore one the full analysis makes too, with the same range,
+code and message; the server publishes them first and the complete set when it is ready.
+
+The pass gives up (``None``) on what it does not follow exactly: text lxml rejects, cannot
+take or warns about, a DOCTYPE, XML namespaces.  Such a document waits for the full analysis.
+Parsing reads nothing but the text: no DTD, no entities, no network.
+"""
+
+from __future__ import annotations
+
+import re
+from bisect import bisect_right
+from typing import cast
+
+from lxml import etree
+
+from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, ref_diagnostics, violations
+from bt_lsp.rules.names import RESERVED_PORT_NAMES, NameKind, may_hold_bad_instance_name
+from bt_lsp.syntax.model import (
+    EXPLICIT_TAGS,
+    Element,
+    Role,
+    Zone,
+    start_tag_element,
+    start_tag_refs,
+    zone_in,
+)
+
+__all__ = ["early_name_diagnostics"]
+
+_MODEL, _PORT, _INSTANCE = NameKind.MODEL, NameKind.PORT, NameKind.INSTANCE
+_NODE, _TREE, _ENTRY, _PORT_DECL = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
+# A tag that names its node type by its ID attribute rather than by itself.
+_BY_ID = EXPLICIT_TAGS | {"SubTree"}
+
+
+class _Reader:
+    """An lxml parser target: follows each element's zone and notes those with a name
+    that breaks a rule (a superset of what the model reports: the model decides)."""
+
+    __slots__ = ("count", "good_keys", "good_models", "instances", "stack", "suspects")
+
+    def __init__(self, instances: bool) -> None:
+        self.instances = instances  # whether instance names can break their rule here
+        self.count = 0
+        self.stack: list[tuple[int, Zone]] = []  # the open elements: index and zone
+        self.suspects: list[tuple[int, Zone, int]] = []  # index, zone, parent's index
+        # Texts seen to break no rule as a node type (or ID), or as an attribute of a
+        # node (a valid port name, or a reserved attribute, which is not a port).
+        self.good_models: set[str] = set(_BY_ID)
+        self.good_keys: set[str] = set(RESERVED_PORT_NAMES)
+
+    def start(self, tag: str, attrib: dict[str, str]) -> None:
+        index = self.count
+        self.count = index + 1
+        stack = self.stack
+        if stack:
+            parent, pz = stack[-1]
+            zone = zone_in(tag, pz)
+        else:
+            parent, zone = -1, Zone.ROOT
+        stack.append((index, zone))
+        if zone == _NODE:
+            suspect = self._node_suspect(tag, attrib)
+        elif zone in (_TREE, _ENTRY):
+            value = attrib.get("ID")
+            role = Role.TREE_DEF if zone == _TREE else Role.MODEL_DEF
+            suspect = value is not None and bool(violations(value, _MODEL, role))
+        elif zone == _PORT_DECL:
+            value = attrib.get("name")
+            suspect = value is not None and bool(violations(value, _PORT, Role.PORT_DECL))
+        else:
+            suspect = False
+        if suspect:
+            self.suspects.append((index, zone, parent))
+
+    def _node_suspect(self, tag: str, attrib: dict[str, str]) -> bool:
+        good_models, good_keys = self.good_models, self.good_keys
+        if tag not in good_models:
+            if violations(tag, _MODEL, Role.NODE_TYPE):
+                return True
+            good_models.add(tag)
+        for key in attrib:
+            if key not in good_keys:
+                if violations(key, _PORT, Role.PORT_USE):
+                    return True
+                good_keys.add(key)
+        value = attrib.get("ID")
+        if value is not None and value not in good_models:
+            if violations(value, _MODEL, Role.NODE_ID):
+                return True
+            good_models.add(value)
+        if not self.instances:
+            return False
+        value = attrib.get("name")
+        return value is not None and bool(violations(value, _INSTANCE, Role.INSTANCE))
+
+    def end(self, tag: str) -> None:
+        self.stack.pop()
+
+    def close(self) -> None:
+        return None
+
+
+# In well-formed XML without a DOCTYPE, every '<' starts a tag, a comment, a CDATA section
+# or a processing instruction, except within the last three.
+_START_TAG = re.compile(r"<[^/!?]")
+_SKIPPED = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>", re.S)
+
+
+def _start_tags(text: str) -> list[int]:
+    """The offsets of the start tags of a well-formed ``text``, in document order."""
+    starts = [m.start() for m in _START_TAG.finditer(text)]
+    skipped = [m.span() for m in _SKIPPED.finditer(text)]
+    if skipped:
+        ends = [e for _, e in skipped]
+        starts = [
+            at
+            for at in starts
+            if (k := bisect_right(ends, at)) == len(skipped) or at < skipped[k][0]
+        ]
+    return starts
+
+
+_PIECE = 1 << 16
+
+
+def early_name_diagnostics(text: str) -> list[Diagnostic] | None:
+    """The name-rule diagnostics of ``text``, or ``None`` when the pass cannot vouch for
+    them (see the module docstring)."""
+    if "<!DOCTYPE" in text or "xmlns" in text:
+        return None
+    reader = _Reader(may_hold_bad_instance_name(text))
+    parser = etree.XMLParser(
+        # lxml calls only the methods a target has: none for text or comments.
+        target=cast("etree.ParserTarget", reader),
+        encoding="utf-8",
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=True,
+    )
+    try:
+        # Fed in pieces: a copy of the whole text would be memory the allocator keeps.
+        for i in range(0, len(text), _PIECE):
+            parser.feed(text[i : i + _PIECE].encode("utf-8"))
+        parser.close()
+    except (etree.XMLSyntaxError, UnicodeEncodeError, ValueError):  # lone surrogates too
+        return None
+    if len(parser.feed_error_log):  # e.g. an undeclared namespace prefix, which lxml drops
+        return None
+    suspects = reader.suspects
+    if len(suspects) >= MAX_DIAGNOSTICS:
+        return None  # the complete set may leave some out (``limited``)
+    if not suspects:
+        return []
+    offsets = _start_tags(text)
+    if len(offsets) != reader.count:  # not a text this pass follows
+        return None
+    out: list[Diagnostic] = []
+    for index, zone, parent_index in suspects:
+        parent: Element | None = None
+        if zone == _PORT_DECL:
+            parent = start_tag_element(text, offsets[parent_index], _ENTRY)
+        out.extend(ref_diagnostics(start_tag_refs(text, offsets[index], zone, parent)))
+    out.sort(key=lambda d: (d.start, d.end, d.code))
+    return out

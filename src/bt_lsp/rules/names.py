@@ -1,0 +1,365 @@
+"""The name rules for BT XML: model (node type) names, port names and instance names.
+
+The rules are the seed rules (``name-validation-rules.md``), followed where BehaviorTree.CPP
+is stricter (``root`` is reserved as well as ``Root``). Everything here is pure: no I/O and no
+LSP types. :func:`check_name` runs on every name of a document, so the common valid case
+costs one precompiled regex search and a few set look-ups.
+
+Offsets and columns are counted in code points within the name (0-based ``offset``,
+1-based column in messages); converting them to document positions is the caller's job.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Final
+
+from bt_lsp.syntax.vocabulary import (
+    BTCPP_RESERVED_ATTRIBUTES,
+    FORBIDDEN,
+    POSTCONDITIONS,
+    PRECONDITIONS,
+    RESERVED_MODEL_NAMES,
+    RESERVED_PORT_NAMES,
+    NameKind,
+)
+
+__all__ = [
+    "BTCPP_RESERVED_ATTRIBUTES",
+    "FORBIDDEN",
+    "POSTCONDITIONS",
+    "PRECONDITIONS",
+    "RESERVED_MODEL_NAMES",
+    "RESERVED_PORT_NAMES",
+    "RULES",
+    "BadChar",
+    "NameKind",
+    "Violation",
+    "check_name",
+    "is_allowed_port_name",
+    "may_hold_bad_instance_name",
+]
+
+
+# The reserved port names in the seed's order, for messages and rule texts.
+_RESERVED_PORT_ORDER: Final[tuple[str, ...]] = (
+    "ID",
+    "name",
+    "_description",
+    "_skipIf",
+    "_successIf",
+    "_failureIf",
+    "_while",
+    "_onSuccess",
+    "_onFailure",
+    "_onHalted",
+    "_post",
+    "_autoremap",
+    "__shared_blackboard",
+)
+
+# --- character table -------------------------------------------------------------------
+
+_WHITESPACE = "whitespace"
+_XML_SPECIAL = "XML special"
+_PATH = "path separator"
+_WILDCARD = "wildcard"
+_PERIOD = "period"
+_CONTROL = "control character"
+
+# category -> (the seed table's reason, a clause explaining it in a message)
+_REASONS: Final[dict[str, tuple[str, str]]] = {
+    _WHITESPACE: (
+        "breaks XML element/attribute names",
+        "whitespace breaks XML element/attribute names",
+    ),
+    _XML_SPECIAL: ("reserved in XML", "XML special characters are reserved in XML"),
+    _PATH: ("filesystem conflicts", "path separators cause filesystem conflicts"),
+    _WILDCARD: ("shell/glob conflicts", "wildcards cause shell/glob conflicts"),
+    _PERIOD: (
+        "ambiguous in port names (e.g. request.name)",
+        "a period is ambiguous in names (e.g. request.name)",
+    ),
+    _CONTROL: ("non-printable", "control characters are non-printable"),
+}
+
+# char -> (category, visible name)
+_CHAR_INFO: Final[dict[str, tuple[str, str]]] = {
+    " ": (_WHITESPACE, "space"),
+    "\t": (_WHITESPACE, "tab"),
+    "\n": (_WHITESPACE, "line feed"),
+    "\r": (_WHITESPACE, "carriage return"),
+    "<": (_XML_SPECIAL, "less-than sign"),
+    ">": (_XML_SPECIAL, "greater-than sign"),
+    "&": (_XML_SPECIAL, "ampersand"),
+    '"': (_XML_SPECIAL, "double quote"),
+    "'": (_XML_SPECIAL, "apostrophe"),
+    "/": (_PATH, "slash"),
+    "\\": (_PATH, "backslash"),
+    ":": (_PATH, "colon"),
+    "*": (_WILDCARD, "asterisk"),
+    "?": (_WILDCARD, "question mark"),
+    "|": (_WILDCARD, "vertical bar"),
+    ".": (_PERIOD, "period"),
+}
+for _code in (*range(0x20), 0x7F):
+    _CHAR_INFO.setdefault(chr(_code), (_CONTROL, "control character"))
+del _code
+
+# Any character forbidden in a model or port name (ASCII 0-31, 127 and the 16).
+_FORBIDDEN_RE: Final = re.compile(r"[\x00-\x1f\x7f \"&'./:<>?\\|*]")
+# Control characters forbidden in an instance name (tab, LF and CR are allowed).
+_INSTANCE_RE: Final = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+# The same characters, each searched for in a whole text (quicker than the pattern).
+_INSTANCE_FORBIDDEN: Final = "".join(map(chr, (*range(9), 11, 12, *range(14, 32), 127)))
+# Characters escaped when a name is quoted in a one-line message.
+_UNPRINTABLE_RE: Final = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+_ASCII_DIGITS: Final = frozenset("0123456789")
+_ASCII_LETTERS: Final = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz")
+
+_MAX_SHOWN_NAME = 80  # code points of a name quoted in a message
+_MAX_SHOWN_COLUMNS = 8  # columns listed per character in a message
+
+
+@dataclass(frozen=True, slots=True)
+class BadChar:
+    """One offending character of a name."""
+
+    offset: int
+    """Code-point index within the name (0-based)."""
+    char: str
+    category: str
+    """The seed table's category: ``whitespace``, ``XML special``, ``path separator``,
+    ``wildcard``, ``period`` or ``control character``."""
+    reason: str
+    """The seed table's reason, e.g. ``breaks XML element/attribute names``."""
+
+    @property
+    def shown(self) -> str:
+        """The character written visibly, e.g. ``'.' (period)`` or ``U+0009 (tab)``."""
+        return _show_char(self.char)
+
+    @property
+    def column(self) -> int:
+        """1-based column within the name."""
+        return self.offset + 1
+
+
+@dataclass(frozen=True, slots=True)
+class Violation:
+    """One broken rule of one name."""
+
+    code: str
+    """A diagnostic code from :mod:`bt_lsp.rules.codes`."""
+    message: str
+    """One line: what is wrong, which characters (shown visibly, with columns) and why."""
+    chars: tuple[BadChar, ...]
+    """Every offending character, for the ``*-forbidden-char``/``*-control-char`` codes."""
+    rule: str
+    """A short statement of the rule, for hover."""
+
+
+# --- rule texts ---------------------------------------------------------------------------
+
+_FORBIDDEN_LIST = (
+    "whitespace, XML special characters (< > & \" '), path separators (/ \\ :), "
+    "wildcards (* ? |), periods or control characters (ASCII 0-31, 127)"
+)
+_RULE_MODEL_EMPTY: Final = "A model (node type or tree ID) name cannot be empty."
+_RULE_MODEL_RESERVED: Final = "'Root' and 'root' are reserved and cannot be used as a model name."
+_RULE_MODEL_FORBIDDEN: Final = f"A model name cannot contain {_FORBIDDEN_LIST}."
+_MODEL_EMPTY_MESSAGE: Final = "Model name is empty; a node type or tree ID needs a name"
+_PORT_EMPTY_MESSAGE: Final = "Port name is empty; a port needs a name"
+_RULE_PORT_EMPTY: Final = "A port name cannot be empty."
+_RULE_PORT_LEADING_DIGIT: Final = "A port name cannot start with a digit (0-9)."
+_RULE_PORT_RESERVED: Final = (
+    "A port declared in <TreeNodesModel> cannot use a reserved attribute name: "
+    + ", ".join(_RESERVED_PORT_ORDER)
+    + "."
+)
+_RULE_PORT_FORBIDDEN: Final = f"A port name cannot contain {_FORBIDDEN_LIST}."
+_RULE_INSTANCE_CONTROL: Final = (
+    "An instance name cannot contain control characters other than tab, line feed and "
+    "carriage return (ASCII 0-8, 11, 12, 14-31, 127)."
+)
+
+#: The rule each name code stands for, as stated in hover.
+RULES: Final[dict[str, str]] = {
+    "model-name-empty": _RULE_MODEL_EMPTY,
+    "model-name-reserved": _RULE_MODEL_RESERVED,
+    "model-name-forbidden-char": _RULE_MODEL_FORBIDDEN,
+    "port-name-empty": _RULE_PORT_EMPTY,
+    "port-name-leading-digit": _RULE_PORT_LEADING_DIGIT,
+    "port-name-reserved": _RULE_PORT_RESERVED,
+    "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
+    "instance-name-control-char": _RULE_INSTANCE_CONTROL,
+}
+
+
+# --- checks -------------------------------------------------------------------------------
+
+
+def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple[Violation, ...]:
+    """Every rule ``name`` breaks as a ``kind`` of name; ``()`` when it is valid.
+
+    ``declaration`` is true for a port declared in ``<TreeNodesModel>``: only there is a
+    reserved attribute name (:data:`RESERVED_PORT_NAMES`) an error. Port violations come
+    in the order empty, leading digit, reserved, forbidden character.
+    """
+    if kind is NameKind.MODEL:
+        if not name:
+            return (Violation("model-name-empty", _MODEL_EMPTY_MESSAGE, (), _RULE_MODEL_EMPTY),)
+        if name in RESERVED_MODEL_NAMES:
+            message = (
+                f"Model name {_quote(name)} is reserved; 'Root' and 'root' cannot be used "
+                "as a node type or tree ID"
+            )
+            return (Violation("model-name-reserved", message, (), _RULE_MODEL_RESERVED),)
+        if _FORBIDDEN_RE.search(name) is None:
+            return ()
+        return (
+            _char_violation(
+                "model-name-forbidden-char",
+                "Model",
+                "forbidden",
+                name,
+                _FORBIDDEN_RE,
+                _RULE_MODEL_FORBIDDEN,
+            ),
+        )
+    if kind is NameKind.PORT:
+        if not name:
+            return (Violation("port-name-empty", _PORT_EMPTY_MESSAGE, (), _RULE_PORT_EMPTY),)
+        found: list[Violation] = []
+        if name[0] in _ASCII_DIGITS:
+            message = (
+                f"Port name {_quote(name)} starts with the digit '{name[0]}'; "
+                "a port name cannot start with a digit"
+            )
+            found.append(
+                Violation("port-name-leading-digit", message, (), _RULE_PORT_LEADING_DIGIT)
+            )
+        if declaration and name in RESERVED_PORT_NAMES:
+            message = (
+                f"Port name {_quote(name)} is a reserved attribute name and cannot be "
+                "declared as a port"
+            )
+            found.append(Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED))
+        if _FORBIDDEN_RE.search(name) is not None:
+            found.append(
+                _char_violation(
+                    "port-name-forbidden-char",
+                    "Port",
+                    "forbidden",
+                    name,
+                    _FORBIDDEN_RE,
+                    _RULE_PORT_FORBIDDEN,
+                )
+            )
+        return tuple(found)
+    if kind is NameKind.INSTANCE:
+        if _INSTANCE_RE.search(name) is None:
+            return ()
+        return (
+            _char_violation(
+                "instance-name-control-char",
+                "Instance",
+                "control",
+                name,
+                _INSTANCE_RE,
+                _RULE_INSTANCE_CONTROL,
+            ),
+        )
+    raise ValueError(f"unknown name kind {kind!r}")  # pragma: no cover
+
+
+def may_hold_bad_instance_name(text: str) -> bool:
+    """Whether an instance name within ``text`` could break its rule: false when no
+    character the rule forbids occurs in ``text``, written or as a character reference."""
+    return "&#" in text or any(c in text for c in _INSTANCE_FORBIDDEN)
+
+
+def is_allowed_port_name(name: str) -> bool:
+    """BehaviorTree.CPP's ``IsAllowedPortName``: the rule for ports usable from XML.
+
+    True iff ``name`` is non-empty, starts with an ASCII letter, has no forbidden
+    character and is not one of BT.CPP's 11 reserved attributes.
+    """
+    return (
+        bool(name)
+        and name[0] in _ASCII_LETTERS
+        and _FORBIDDEN_RE.search(name) is None
+        and name not in BTCPP_RESERVED_ATTRIBUTES
+    )
+
+
+# --- helpers ------------------------------------------------------------------------------
+
+
+def _bad_chars(name: str, pattern: re.Pattern[str]) -> tuple[BadChar, ...]:
+    result: list[BadChar] = []
+    for match in pattern.finditer(name):
+        char = match.group()
+        category = _CHAR_INFO[char][0]
+        result.append(BadChar(match.start(), char, category, _REASONS[category][0]))
+    return tuple(result)
+
+
+def _char_violation(
+    code: str, subject: str, adjective: str, name: str, pattern: re.Pattern[str], rule: str
+) -> Violation:
+    chars = _bad_chars(name, pattern)
+    columns: dict[str, list[int]] = {}
+    categories: dict[str, None] = {}
+    for bad in chars:
+        columns.setdefault(bad.char, []).append(bad.offset + 1)
+        categories.setdefault(bad.category, None)
+    listed = ", ".join(f"{_show_char(c)} at {_columns(cols)}" for c, cols in columns.items())
+    why = ", ".join(_REASONS[category][1] for category in categories)
+    if len(chars) == 1:
+        counted = f"a {adjective} character"
+    else:
+        counted = f"{len(chars)} {adjective} characters"
+    message = f"{subject} name {_quote(name)} contains {counted}: {listed}; {why}"
+    return Violation(code, message, chars, rule)
+
+
+def _columns(cols: list[int]) -> str:
+    if len(cols) == 1:
+        return f"column {cols[0]}"
+    if len(cols) > _MAX_SHOWN_COLUMNS:
+        shown = ", ".join(str(c) for c in cols[:_MAX_SHOWN_COLUMNS])
+        return f"columns {shown} and {len(cols) - _MAX_SHOWN_COLUMNS} more"
+    return "columns " + ", ".join(str(c) for c in cols[:-1]) + f" and {cols[-1]}"
+
+
+def _show_char(char: str) -> str:
+    info = _CHAR_INFO.get(char)
+    label = info[1] if info is not None else "character"
+    code = ord(char)
+    if code < 0x20 or code == 0x7F:
+        return f"U+{code:04X} ({label})"
+    if char == "'":
+        return f'"\'" ({label})'
+    if char == "\\":
+        return f"'\\\\' ({label})"
+    return f"'{char}' ({label})"
+
+
+def _escape(match: re.Match[str]) -> str:
+    char = match.group()
+    special = {"\t": "\\t", "\n": "\\n", "\r": "\\r"}.get(char)
+    if special is not None:
+        return special
+    code = ord(char)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+
+
+def _quote(name: str) -> str:
+    """``name`` in single quotes, on one line, control characters escaped, long names cut."""
+    shown = name if len(name) <= _MAX_SHOWN_NAME else name[: _MAX_SHOWN_NAME - 1] + "…"
+    if _UNPRINTABLE_RE.search(shown) is not None:
+        # Escaped, so a backslash of the name is doubled to keep it unambiguous.
+        shown = _UNPRINTABLE_RE.sub(_escape, shown.replace("\\", "\\\\"))
+    return f"'{shown}'"

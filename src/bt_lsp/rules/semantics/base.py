@@ -1,0 +1,240 @@
+"""What the rule families share: the state of one check and how a node's model is found."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any, Final, Literal
+
+from bt_lsp.rules.builtins import BUILTINS, Category, PortModel
+from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.syntax.model import EXPLICIT_TAGS, Element, Model
+
+if TYPE_CHECKING:
+    from bt_lsp.syntax.document import Document
+
+Origin = Literal["builtin", "custom", "subtree"]
+
+#: Rules about what BehaviorTree.CPP 4 defines (built-in ports, load-time checks it added)
+#: whose errors are warnings in a document without ``BTCPP_format``, which may be written
+#: for version 3.
+VERSION_4_RULES: Final[frozenset[str]] = frozenset(
+    {
+        "undeclared-port",
+        "missing-required-port",
+        "invalid-port-value",
+        "reactive-explicit-child",
+        "reactive-async-children",
+        "parallel-threshold",
+        "blackboard-type-mismatch",
+    }
+)
+
+
+@dataclass(frozen=True, slots=True)
+class Resolved:
+    """The model of a node type as the checks need it.
+
+    ``origin`` says where it comes from: a built-in of BehaviorTree.CPP (exact), a custom
+    ``<TreeNodesModel>`` entry (what the author declared; BehaviorTree.CPP itself reads the
+    C++ registration), or the ``<SubTree>`` model of a tree.
+    """
+
+    id: str
+    origin: Origin
+    category: Category
+    ports: Mapping[str, PortModel]
+    min_children: int
+    max_children: int | None
+    required: tuple[str, ...] = ()  # ports that must be given (see ports.py)
+
+    @property
+    def exact(self) -> bool:
+        """Whether BehaviorTree.CPP is known to use exactly this model."""
+        return self.origin != "custom"
+
+
+def resolve_builtin(type_id: str) -> Resolved | None:
+    m = BUILTINS.get(type_id)
+    if m is None:
+        return None
+    return Resolved(
+        m.id,
+        "builtin",
+        m.category,
+        {p.name: p for p in m.ports},
+        m.min_children,
+        m.max_children,
+        tuple(p.name for p in m.ports if p.default is None and p.direction != "output"),
+    )
+
+
+_BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
+    k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None
+}
+
+
+def is_compact(el: Element) -> bool:
+    return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
+
+
+@dataclass(slots=True)
+class State:
+    """One run of the checks over one document."""
+
+    doc: Document
+    ctx: Context
+    model: Model
+    text: str
+    out: list[Diagnostic] = field(default_factory=list)
+    v4: bool = False  # <root> declares BTCPP_format
+    _types: dict[str, Resolved | None] = field(default_factory=dict)
+    _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
+    # Models resolved from declarations, shared by the runs over the sections of one check:
+    # by ("model" | "subtree", ID), with the declaration they were made from (still looked
+    # up in each run, so that the run records what it read).
+    made: dict[tuple[str, str], tuple[object, Resolved]] = field(default_factory=dict)
+    # A run over one section of the document (see sections.py) has the section's model and
+    # text, in coordinates that start at document offset ``origin``.
+    origin: int = 0
+    uses_lines: bool = False  # whether a message names a line (see line_of)
+
+    def line_of(self, offset: int) -> int:
+        """The 0-based document line of ``offset`` (in this run's coordinates).  Messages
+        that name a line depend on where their section is: the section's results are kept
+        only as long as it starts on the same line."""
+        self.uses_lines = True
+        return self.doc.lines.line_of(self.origin + offset)
+
+    def add(
+        self,
+        start: int,
+        end: int,
+        code: str,
+        message: str,
+        severity: Severity | None = None,
+        data: Mapping[str, Any] | None = None,
+    ) -> None:
+        sev = CODES[code].severity if severity is None else severity
+        if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
+            sev = Severity.WARNING
+            message += " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
+        self.out.append(Diagnostic(start, end, code, message, sev, data))
+
+    def resolve(self, type_id: str) -> Resolved | None:
+        """The model of node type ``type_id``: built-in first, then a custom declaration."""
+        r = _BUILTIN_RESOLVED.get(type_id)
+        if r is not None:
+            return r
+        if type_id in self._types:
+            return self._types[type_id]
+        decl = self.ctx.models.get(type_id)
+        res: Resolved | None = None
+        made = self.made.get(("model", type_id))
+        if made is not None and made[0] is decl:
+            res = made[1]
+        elif decl is not None:
+            lo, hi = decl.child_range
+            required = tuple(
+                p.name for p in decl.ports if p.default is None and p.direction != "output"
+            )
+            res = Resolved(
+                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
+            )
+            self.made["model", type_id] = (decl, res)
+        self._types[type_id] = res
+        return res
+
+    def resolve_subtree(self, tree_id: str) -> Resolved | None:
+        """The ``<TreeNodesModel><SubTree>`` model of tree ``tree_id``, if declared."""
+        if tree_id in self._subtrees:
+            return self._subtrees[tree_id]
+        decl = self.ctx.subtree_models.get(tree_id)
+        res = None
+        made = self.made.get(("subtree", tree_id))
+        if made is not None and made[0] is decl:
+            res = made[1]
+        elif decl is not None:
+            # BehaviorTree.CPP treats an empty default of a SubTree model port as none.
+            required = tuple(p.name for p in decl.ports if not p.default)
+            ports = {p.name: p for p in decl.ports}
+            res = Resolved(decl.id, "subtree", "SubTree", ports, 0, 0, required)
+            self.made["subtree", tree_id] = (decl, res)
+        self._subtrees[tree_id] = res
+        return res
+
+    def node_type(self, el: Element) -> str | None:
+        """The registration ID a node element asks for (``None`` when it has none)."""
+        if is_compact(el):
+            return el.name
+        return el.value("ID")
+
+
+def quoted(text: str, limit: int = 60) -> str:
+    """``text`` in single quotes for a message, control characters shown, long text cut."""
+    shown = "".join(c if c.isprintable() else f"\\u{ord(c):04x}" for c in text)
+    if len(shown) > limit:
+        shown = shown[: limit - 1] + "…"
+    return f"'{shown}'"
+
+
+@lru_cache(maxsize=65536)  # the same names are compared again in every document
+def edit_distance(a: str, b: str, limit: int) -> int:
+    """Levenshtein distance of ``a`` and ``b``; any value above ``limit`` is ``limit + 1``.
+
+    Only the cells within ``limit`` of the diagonal are computed (the others are above the
+    limit anyway), so a check against hundreds of names stays cheap."""
+    la, lb = len(a), len(b)
+    if abs(la - lb) > limit:
+        return limit + 1
+    if a == b:
+        return 0
+    big = limit + 1
+    prev = [j if j <= limit else big for j in range(lb + 1)]
+    for i in range(1, la + 1):
+        ca = a[i - 1]
+        lo = i - limit if i > limit else 1
+        hi = i + limit if i + limit < lb else lb
+        cur = [big] * (lb + 1)
+        best = cur[0] = i if i <= limit else big
+        for j in range(lo, hi + 1):
+            v = prev[j - 1] + (ca != b[j - 1])
+            x = prev[j] + 1
+            if x < v:
+                v = x
+            x = cur[j - 1] + 1
+            if x < v:
+                v = x
+            if v > big:
+                v = big
+            cur[j] = v
+            if v < best:
+                best = v
+        if best > limit:
+            return big
+        prev = cur
+    return prev[lb] if prev[lb] < big else big
+
+
+@dataclass(slots=True)
+class BlackboardUse:
+    """The first port that used a blackboard key in a tree: its type and where."""
+
+    type: str  # canonical type name
+    shown: str  # as written
+    exact: bool  # from a built-in model
+    port: str
+    node: str
+
+
+@dataclass(slots=True)
+class TreeScope:
+    """What the checks remember while inside one ``<BehaviorTree>``."""
+
+    element: Element | None
+    subtree_names: dict[str, Element] = field(default_factory=dict)
+    depth_flagged: list[bool] = field(default_factory=lambda: [False])
+    keys: dict[str, BlackboardUse] = field(default_factory=dict)

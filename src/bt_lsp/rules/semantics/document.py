@@ -1,0 +1,140 @@
+"""Document-level rules: the ``<root>`` element, its sections, includes and nesting.
+
+* ``root-element`` (error): the top element is not ``<root>``; BehaviorTree.CPP: "The XML
+  must have a root node called <root>".  Range: the top element's name (an empty range at
+  the start when the document has no element).
+* ``missing-format`` (warning): ``<root>`` without ``BTCPP_format``; BehaviorTree.CPP only
+  prints a warning.  Range: ``root``.  Fix: add ``BTCPP_format="4"``.
+* ``duplicate-model-section`` (error): every ``<TreeNodesModel>`` after the first.
+* ``missing-id`` (error) for ``<Action|Condition|Control|Decorator|SubTree>`` written
+  directly under ``<root>`` without ``ID`` while a ``<TreeNodesModel>`` exists (a check
+  BehaviorTree.CPP makes at load time).  Range: the element name.
+* ``include-missing-path`` (error): ``<include>`` without ``path``.  Range: ``include``.
+* ``include-ros-pkg`` (warning): ``ros_pkg`` names a package the settings do not map
+  (BehaviorTree.CPP resolves it only when built with ROS support).  Range: the value.
+* ``no-main-tree`` (information): the document defines several trees and no
+  ``main_tree_to_execute``; ``createTreeFromFile`` on it fails with "[main_tree_to_execute]
+  was not specified correctly", but applications that call ``createTree("ID")`` and
+  documents included by others are fine, so it is only reported for documents no
+  workspace document includes.  Range: ``root``.
+* ``nesting-depth`` (error): an element more than 256 levels below its ``<BehaviorTree>``
+  ("Maximum XML nesting depth exceeded (limit: 256)").  Range: the first such element's
+  name in each tree.
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+from bt_lsp.rules.semantics.base import State, quoted
+from bt_lsp.syntax.model import EXPLICIT_TAGS, Element
+
+MAX_DEPTH: Final = 256
+# Element depth in the model: <root> 0, <BehaviorTree> 1, so a node at model depth d is
+# d - 1 levels below its tree.
+_MODEL_DEPTH_LIMIT: Final = MAX_DEPTH + 1
+
+_ID_TAGS: Final = EXPLICIT_TAGS | {"SubTree"}
+
+
+def check_root(st: State) -> None:
+    root = st.model.root  # the first element, when there is one
+    if root is None:
+        st.add(0, 0, "root-element", "The document has no <root> element")
+        return
+    if root.name != "root":
+        st.add(
+            root.name_start,
+            root.name_end,
+            "root-element",
+            f"The top element is <{root.name}>; BehaviorTree.CPP requires a root node "
+            "called <root>",
+        )
+    else:
+        st.v4 = root.attr("BTCPP_format") is not None
+        if not st.v4:
+            st.add(
+                root.name_start,
+                root.name_end,
+                "missing-format",
+                '<root> has no BTCPP_format attribute; add BTCPP_format="4" if the file is '
+                "written for BehaviorTree.CPP 4 (BehaviorTree.CPP warns about it)",
+            )
+    # Only the children that a rule looks at closely are made (a large document has
+    # thousands of trees).
+    model = st.model
+    models_sections = model.root_children_named(("TreeNodesModel",))
+    for extra in models_sections[1:]:
+        st.add(
+            extra.name_start,
+            extra.name_end,
+            "duplicate-model-section",
+            "Only a single <TreeNodesModel> is supported; merge this section into the first",
+        )
+    trees = model.root_child_names().count("BehaviorTree")
+    for c in model.root_children_named(("include",)):
+        _check_include(st, c)
+    for c in model.root_children_named(_ID_TAGS) if models_sections else ():
+        if c.attr("ID") is None:
+            st.add(
+                c.name_start,
+                c.name_end,
+                "missing-id",
+                f"<{c.name}> directly under <root> has no ID attribute; with a "
+                "<TreeNodesModel> present BehaviorTree.CPP requires one (model entries "
+                "belong inside <TreeNodesModel>)",
+            )
+    if (
+        root.name == "root"
+        and trees > 1
+        and root.attr("main_tree_to_execute") is None
+        and not st.ctx.included_by
+    ):
+        st.add(
+            root.name_start,
+            root.name_end,
+            "no-main-tree",
+            f"The document defines {trees} trees but no main_tree_to_execute; loading it with "
+            "createTreeFromFile/Text fails unless the application names the tree to create",
+        )
+
+
+def _check_include(st: State, el: Element) -> None:
+    if el.attr("path") is None:
+        st.add(
+            el.name_start,
+            el.name_end,
+            "include-missing-path",
+            "<include> has no path attribute (BehaviorTree.CPP: missing 'path' attribute)",
+        )
+        return
+    pkg = el.attr("ros_pkg")
+    if pkg is None or pkg.value is None:
+        return
+    path = el.value("path") or ""
+    if path.startswith("/"):
+        return  # BehaviorTree.CPP ignores ros_pkg for an absolute path
+    if pkg.value in st.ctx.ros_pkg_paths:
+        return
+    s, e = el.span_of_value(pkg)
+    st.add(
+        s,
+        e,
+        "include-ros-pkg",
+        f"ROS package {quoted(pkg.value)} is unknown to bt-lsp, so this include cannot be "
+        "followed; BehaviorTree.CPP resolves ros_pkg only when built with ROS support (map "
+        "the package to its share directory in the btLsp.rosPackages setting)",
+    )
+
+
+def check_depth(st: State, el: Element, tree_flagged: list[bool]) -> None:
+    """Report the first element of a tree that is nested too deep."""
+    if el.depth > _MODEL_DEPTH_LIMIT and not tree_flagged[0]:
+        tree_flagged[0] = True
+        st.add(
+            el.name_start,
+            el.name_end,
+            "nesting-depth",
+            f"<{el.name}> is nested {el.depth - 1} levels below its <BehaviorTree>; "
+            f"BehaviorTree.CPP rejects trees deeper than {MAX_DEPTH} levels",
+        )

@@ -1,0 +1,278 @@
+"""Nodes: is the type known, is it written right, does it have the right children.
+
+* ``missing-id`` (error): ``<Action|Condition|Control|Decorator>`` without ``ID``.  Range:
+  the element name.  (An empty ``ID=""`` is the name rule ``model-name-empty``.)
+* ``id-on-compact-node`` (error): ``ID`` on a node written in compact form
+  ("Attribute [ID] is not allowed").  Range: the attribute name.  Fix: remove it.
+* ``unknown-node``: a compact element name or explicit ``ID`` that is neither a built-in
+  nor declared in a ``<TreeNodesModel>`` of the context ("Node not recognized").  An error
+  when a catalog of the custom nodes is configured (``ctx.workspace_has_custom_models``),
+  else a hint: nodes registered only in C++ are normal.  BehaviorTree.CPP 3 names
+  (``SequenceStar``, ``SubTreePlus``), the ``RetryUntilSuccesful`` typo and tree IDs used
+  as node types are errors in a document with ``BTCPP_format`` and warnings without; a
+  case-insensitive match of a built-in is an error; the version 3 built-ins
+  ``BlackboardCheck*`` follow the general rule (version 4 still ships the class for users
+  to register).  Range: the element name (compact) or the ``ID`` value (explicit).
+  Fixes: rename to the suggested type, call a tree with ``<SubTree>``, declare the node in
+  ``<TreeNodesModel>``.  Names that break the name rules are left to those.
+* ``child-count`` (error): built-in child rules (decorators 1, controls 1 or more, leaves
+  and ``<SubTree>`` 0, ``TryCatch`` 2 or more, ``IfThenElse``/``WhileDoElse`` 2 or 3,
+  ``SwitchN`` N+1); for declared custom nodes the rule of their category.  Range: the
+  element name.
+* ``reactive-async-children`` (error): a ``ReactiveSequence`` with more than one
+  ``AsyncSequence`` child (the only registered type BehaviorTree.CPP counts).  Range: the
+  ``ReactiveSequence`` element name.
+* ``reactive-explicit-child`` (error): a child of a ``ReactiveSequence`` written in
+  explicit form: BehaviorTree.CPP looks the child's element name up as a node type and
+  fails with "Unknown node type: Action".  Range: the child's element name.
+* ``parallel-threshold`` (error): a literal ``success_count``/``failure_count`` of a
+  ``Parallel`` larger than its number of children (negative values count from the end and
+  never exceed it).  Range: the value.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Final
+
+from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES, is_blackboard_reference
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.names import NameKind, check_name
+from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
+from bt_lsp.syntax.model import EXPLICIT_TAGS, Element
+
+_BUILTIN_LOWER: Final[dict[str, str]] = {k.lower(): k for k in BUILTINS}
+_LEADING_INT: Final = re.compile(r"-?[0-9]+")
+# Entries of V3_RENAMES that are typos rather than version 3 names.
+_MISSPELLINGS: Final = frozenset({"RetryUntilSuccesful"})
+# Built-ins of BehaviorTree.CPP 3 that version 4 dropped.
+V3_ONLY: Final[dict[str, str]] = {
+    "BlackboardCheckInt": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckDouble": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckString": "ScriptCondition or a _skipIf/_successIf precondition",
+    "BlackboardCheckBool": "ScriptCondition or a _skipIf/_successIf precondition",
+}
+
+
+def check_node(st: State, el: Element) -> Resolved | None:
+    """The checks of one node element; returns its model when known."""
+    name = el.name
+    if name == "SubTree":
+        if el.children:
+            st.add(
+                el.name_start,
+                el.name_end,
+                "child-count",
+                f"<SubTree> with ID {quoted(el.value('ID') or '')} has "
+                f"{_count(len(el.children))}; it must not have any",
+            )
+        tid = el.value("ID")
+        return st.resolve_subtree(tid) if tid else None
+    if name in EXPLICIT_TAGS:
+        a = el.attr("ID")
+        if a is None:
+            st.add(
+                el.name_start,
+                el.name_end,
+                "missing-id",
+                f"<{name}> has no ID attribute naming its node type",
+            )
+            return None
+        if not a.value:
+            return None
+        type_id = a.value
+        start, end = el.span_of_value(a)
+    else:
+        type_id = name
+        start, end = el.name_start, el.name_end
+        id_attr = el.attr("ID")
+        if id_attr is not None and name not in V3_RENAMES:
+            s, e = el.span_of_name(id_attr)
+            st.add(
+                s,
+                e,
+                "id-on-compact-node",
+                f"Attribute ID is not allowed on <{name}>: the element name already is the "
+                f"node type (write <Action ID=…> for the explicit form)",
+            )
+    res = st.resolve(type_id)
+    if res is None:
+        _unknown(st, el, type_id, start, end, name in EXPLICIT_TAGS)
+        return None
+    _children(st, el, res)
+    if res.id == "ReactiveSequence":
+        _reactive(st, el)
+    elif res.id == "Parallel":
+        _parallel(st, el)
+    return res
+
+
+def _count(n: int) -> str:
+    return "1 child" if n == 1 else f"{n} children"
+
+
+def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explicit: bool) -> None:
+    if not explicit and check_name(type_id, NameKind.MODEL):
+        return  # the name rules report it (BehaviorTree.CPP checks the name first)
+    data: dict[str, object] = {"type": type_id, "explicit": explicit}
+    ctx = st.ctx
+    if type_id in V3_RENAMES:
+        new = V3_RENAMES[type_id]
+        data |= {"rename": new, "preferred": True}
+        why = (
+            "a misspelling that BehaviorTree.CPP does not register"
+            if type_id in _MISSPELLINGS
+            else "the BehaviorTree.CPP 3 name of a node"
+        )
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}",
+            Severity.ERROR if st.v4 else Severity.WARNING,
+            data,
+        )
+        return
+    if type_id in V3_ONLY:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"{quoted(type_id)} was a built-in node of BehaviorTree.CPP 3; version 4 does not "
+            f"register it by default (register it in C++, or use {V3_ONLY[type_id]})",
+            None if ctx.workspace_has_custom_models else Severity.HINT,
+            data,
+        )
+        return
+    if type_id in ctx.trees or type_id in ctx.workspace_trees:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f'{quoted(type_id)} is a tree, not a node type; call it with <SubTree ID="{type_id}"/>',
+            Severity.ERROR if st.v4 else Severity.WARNING,
+            data,
+        )
+        return
+    known = _BUILTIN_LOWER.get(type_id.lower())
+    if known is not None:
+        data |= {"rename": known, "preferred": True}
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"Node type {quoted(type_id)} is not registered; did you mean {quoted(known)}? "
+            "(names are case-sensitive)",
+            Severity.ERROR,
+            data,
+        )
+        return
+    severity = None if ctx.workspace_has_custom_models else Severity.HINT
+    suggestion = _closest(st, type_id)
+    if suggestion is not None:
+        data |= {"rename": suggestion, "preferred": False}
+    if ctx.workspace_has_custom_models:
+        message = (
+            f"Node type {quoted(type_id)} is not a built-in node and is not declared in any "
+            "<TreeNodesModel> of the workspace"
+        )
+    else:
+        message = (
+            f"Node type {quoted(type_id)} is not a built-in node; it must be registered in "
+            "C++ (declare it in a <TreeNodesModel> to have its ports checked)"
+        )
+    if suggestion is not None:
+        message += f"; did you mean {quoted(suggestion)}?"
+    st.add(start, end, "unknown-node", message, severity, data)
+
+
+def _closest(st: State, type_id: str) -> str | None:
+    """A known node type that ``type_id`` is probably a typo of (edit distance 1-2)."""
+    if len(type_id) < 5:
+        return None
+    n = len(type_id)
+    limit = 1 if n < 8 else 2
+    best: tuple[int, str] | None = None
+    for cand in (*BUILTINS, *st.ctx.models):
+        if abs(len(cand) - n) > limit:
+            continue
+        d = edit_distance(type_id, cand, limit)
+        if d <= limit and (best is None or d < best[0]):
+            best = (d, cand)
+    return best[1] if best is not None else None
+
+
+def _children(st: State, el: Element, res: Resolved) -> None:
+    n = len(el.children)
+    lo, hi = res.min_children, res.max_children
+    if lo <= n and (hi is None or n <= hi):
+        return
+    if hi == 0:
+        need = "must not have any child"
+    elif hi == lo:
+        need = f"must have exactly {_count(lo)}"
+        if res.id.startswith("Switch") and res.origin == "builtin":
+            need += f" ({lo - 1} cases + default)"
+    elif hi is None:
+        need = (
+            f"must have {lo} or more children" if lo <= 1 else f"must have at least {lo} children"
+        )
+    else:
+        need = (
+            f"must have {lo} or {hi} children" if hi == lo + 1 else f"must have {lo}-{hi} children"
+        )
+    what = {"custom": f"a {res.category} declared in <TreeNodesModel>"}.get(res.origin, "")
+    st.add(
+        el.name_start,
+        el.name_end,
+        "child-count",
+        f"The node {quoted(res.id)}{' (' + what + ')' if what else ''} {need}; it has "
+        f"{_count(n) if n else 'none'}",
+    )
+
+
+def _reactive(st: State, el: Element) -> None:
+    elements = st.model.elements
+    asyncs = 0
+    for ci in el.children:
+        child = elements[ci]
+        if child.name == "AsyncSequence":
+            asyncs += 1
+        elif child.name in EXPLICIT_TAGS:
+            st.add(
+                child.name_start,
+                child.name_end,
+                "reactive-explicit-child",
+                f"BehaviorTree.CPP looks up the element name of each ReactiveSequence child "
+                f"as a node type and fails with 'Unknown node type: {child.name}'; write this "
+                "child in compact form",
+            )
+    if asyncs > 1:
+        st.add(
+            el.name_start,
+            el.name_end,
+            "reactive-async-children",
+            f"A ReactiveSequence cannot have more than one async child; this one has {asyncs} "
+            "AsyncSequence children",
+        )
+
+
+def _parallel(st: State, el: Element) -> None:
+    n = len(el.children)
+    for port, outcome in (("success_count", "succeed"), ("failure_count", "fail")):
+        a = el.attr(port)
+        if a is None or a.value is None or is_blackboard_reference(a.value):
+            continue
+        m = _LEADING_INT.match(a.value)
+        if m is None:
+            continue  # invalid-port-value reports it
+        value = int(m.group(0))
+        if value > n:
+            s, e = el.span_of_value(a)
+            st.add(
+                s,
+                e,
+                "parallel-threshold",
+                f"{port} is {value} but the Parallel has {_count(n)}, so it can never "
+                f"{outcome} (BehaviorTree.CPP: Number of children is less than threshold)",
+            )

@@ -1,0 +1,311 @@
+"""Ports and attributes of nodes.
+
+An attribute is a port exactly when :func:`bt_lsp.rules.names.is_allowed_port_name` holds (as in
+BehaviorTree.CPP); ``ID``, ``name``, ``_autoremap`` and the pre/post-condition scripts are
+reserved; everything else is silently ignored by BehaviorTree.CPP.
+
+* ``undeclared-port``: a port attribute the node's model does not declare.  An error for
+  a built-in ("… is found in the XML but not in the providedPorts()"), a warning for a
+  node declared in ``<TreeNodesModel>`` (the C++ declaration is what counts) and for a
+  ``<SubTree>`` call whose tree has a ``<SubTree>`` model (BehaviorTree.CPP passes any
+  attribute on as a remapping, so an undeclared one is only suspicious).  Nothing is
+  reported when the model is unknown, or for a ``<SubTree>`` call without a model.
+  Range: the attribute name.
+* ``missing-required-port``: a port without a default that is not given.  Built-ins:
+  input and inout ports, an error (the node fails when it reads it).  Custom models: input
+  and inout ports without a ``default``, a warning.  ``<SubTree>`` models: every port whose
+  ``default`` is absent or empty, an error unless ``_autoremap`` is true ("is defining a
+  mandatory port … but you are not remapping it").  Range: the element name.
+* ``invalid-port-value``: a literal that does not convert to the declared type (values in
+  ``{…}`` are blackboard references and never checked); an error for built-ins, a
+  warning for custom models; ``_autoremap`` on ``<SubTree>`` must be a bool literal.
+  Range: the value.
+* ``blackboard-type-mismatch``: within one tree, a ``{key}`` used by ports of two
+  different strong types (the first use fixes the entry's type; a ``std::string`` entry
+  accepts anything).  An error when both types come from built-ins, else a warning.
+  Range: the later value.
+* ``port-name-not-remappable`` (warning): an attribute that passes the name rules but
+  not ``is_allowed_port_name`` and does not start with ``_`` (``检查``, ``-x``): never a
+  port.  Range: the attribute name.
+* ``unknown-attribute`` (warning): an attribute starting with ``_`` that is not reserved
+  (``_skipif``); ``_description``, ``_uid`` and ``_fullpath`` (written by BehaviorTree.CPP
+  itself) are allowed.  Fix: the reserved name it most likely means (``__shared_blackboard``
+  and ``__autoremap`` are version 3 spellings of ``_autoremap``).  Range: the name.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Final
+
+from bt_lsp.rules.builtins import PortModel, convert_literal, is_blackboard_reference
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.names import (
+    POSTCONDITIONS,
+    PRECONDITIONS,
+    NameKind,
+    check_name,
+    is_allowed_port_name,
+)
+from bt_lsp.rules.semantics import scripts
+from bt_lsp.rules.semantics.base import (
+    BlackboardUse,
+    Resolved,
+    State,
+    TreeScope,
+    edit_distance,
+    quoted,
+)
+from bt_lsp.syntax.model import Element
+from bt_lsp.syntax.scanner import Attr
+
+# Underscore attributes that editors and BehaviorTree.CPP itself write on purpose:
+# descriptions, WriteTreeToXML's metadata, and the editors' collapsed-node flag.
+SILENT_ATTRIBUTES: Final[frozenset[str]] = frozenset(
+    {"_description", "_uid", "_fullpath", "_collapsed"}
+)
+_UNDERSCORE_RESERVED: Final[tuple[str, ...]] = (*PRECONDITIONS, *POSTCONDITIONS, "_autoremap")
+_RESERVED_LOWER: Final[dict[str, str]] = {n.lower(): n for n in _UNDERSCORE_RESERVED}
+V3_ATTRIBUTES: Final[dict[str, str]] = {
+    "__shared_blackboard": "_autoremap",
+    "__autoremap": "_autoremap",
+}
+_BOOL_WORDS: Final = frozenset({"1", "0", "true", "false", "True", "False", "TRUE", "FALSE"})
+_TRUE_WORDS: Final = frozenset({"1", "true", "True", "TRUE"})
+
+_STRING_TYPES: Final = frozenset(
+    {
+        "std::string",
+        "string",
+        "std::__cxx11::basic_string<char, std::char_traits<char>, std::allocator<char> >",
+        "std::basic_string<char, std::char_traits<char>, std::allocator<char> >",
+    }
+)
+_WEAK_TYPES: Final = frozenset(
+    {"", "any", "Any", "BT::Any", "AnyTypeAllowed", "BT::AnyTypeAllowed"}
+)
+
+
+_allowed = lru_cache(maxsize=4096)(is_allowed_port_name)
+
+
+@lru_cache(maxsize=16384)
+def _convert(value: str, type_: str) -> str | None:
+    return convert_literal(value, type_)
+
+
+def canonical_type(type_: str) -> str | None:
+    """A port type for comparison, or ``None`` when it is not strongly typed."""
+    t = " ".join(type_.split())
+    if t in _WEAK_TYPES:
+        return None
+    if t in _STRING_TYPES:
+        return "std::string"
+    return t
+
+
+def suggest_attribute(name: str) -> tuple[str, bool] | None:
+    """The reserved attribute ``name`` probably means, and whether that is a sure match."""
+    if name in V3_ATTRIBUTES:
+        return V3_ATTRIBUTES[name], True
+    lowered = _RESERVED_LOWER.get(name.lower())
+    if lowered is not None:
+        return lowered, True
+    best: tuple[int, str] | None = None
+    for cand in _UNDERSCORE_RESERVED:
+        d = edit_distance(name, cand, 2)
+        if d <= 2 and (best is None or d < best[0]):
+            best = (d, cand)
+    return (best[1], False) if best is not None else None
+
+
+def check_attributes(
+    st: State, el: Element, res: Resolved | None, scope: TreeScope, is_subtree: bool
+) -> None:
+    """Every attribute of one node element, then the ports it leaves out."""
+    given: set[str] = set()
+    autoremap = False
+    for a in el.attrs:
+        an = a.name
+        value = a.value
+        if value is None or an == "ID" or an == "name":
+            continue
+        # Present counts as given even when the name breaks a rule: the name rules say why
+        # BehaviorTree.CPP would not read it, and saying "missing" too would mislead.
+        given.add(an)
+        if an in scripts.CONDITION_ATTRS:
+            scripts.check(st, el, a)
+            continue
+        if an == "_autoremap":
+            if is_subtree:
+                autoremap = _check_autoremap(st, el, a, value)
+            continue
+        if _allowed(an):
+            if res is not None:
+                _check_port(st, el, a, value, res, scope)
+            continue
+        if an in SILENT_ATTRIBUTES or check_name(an, NameKind.PORT):
+            continue  # allowed, or reported by the name rules
+        s, e = el.span_of_name(a)
+        if an.startswith("_"):
+            _unknown_attribute(st, an, s, e)
+        else:
+            st.add(
+                s,
+                e,
+                "port-name-not-remappable",
+                f"{quoted(an)} does not start with an ASCII letter, so BehaviorTree.CPP does not "
+                "treat it as a port and silently ignores it",
+            )
+    if res is not None:
+        _missing(st, el, res, given, autoremap)
+
+
+def _unknown_attribute(st: State, an: str, s: int, e: int) -> None:
+    message = (
+        f"BehaviorTree.CPP silently ignores the attribute {quoted(an)}: it is neither a port "
+        "(ports start with a letter) nor a reserved attribute"
+    )
+    sug = suggest_attribute(an)
+    data: dict[str, object] | None = None
+    if sug is not None:
+        message += f"; did you mean {quoted(sug[0])}?"
+        data = {"suggestion": sug[0], "preferred": sug[1]}
+    st.add(s, e, "unknown-attribute", message, None, data)
+
+
+def _check_autoremap(st: State, el: Element, a: Attr, value: str) -> bool:
+    if value not in _BOOL_WORDS:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "invalid-port-value",
+            f"_autoremap must be a bool literal (true/false, 1/0), not {quoted(value)}; "
+            "BehaviorTree.CPP fails with 'invalid bool conversion'",
+        )
+        return False
+    return value in _TRUE_WORDS
+
+
+def _owner(res: Resolved) -> str:
+    if res.origin == "subtree":
+        return f"The <SubTree> model of tree {quoted(res.id)}"
+    if res.origin == "custom":
+        return f"The <TreeNodesModel> entry of {quoted(res.id)}"
+    return f"The built-in node {quoted(res.id)}"
+
+
+def _check_port(
+    st: State, el: Element, a: Attr, value: str, res: Resolved, scope: TreeScope
+) -> None:
+    port = res.ports.get(a.name)
+    if port is None:
+        _undeclared(st, el, a, res)
+        return
+    if res.origin == "subtree":
+        return  # a literal remapping of a subtree port is stored as text, never converted
+    if (res.id, a.name) in scripts.SCRIPT_PORTS and res.origin == "builtin":
+        if not is_blackboard_reference(value):
+            scripts.check(st, el, a)
+        return
+    if is_blackboard_reference(value):
+        _blackboard_use(st, el, a, value, port, res, scope)
+        return
+    if not port.type:
+        return
+    problem = _convert(value, port.type)
+    if problem is not None:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "invalid-port-value",
+            f"The value of port {quoted(a.name)} cannot be converted to {port.type}: {problem}",
+            None if res.exact else Severity.WARNING,
+        )
+
+
+def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
+    s, e = el.span_of_name(a)
+    names = sorted(res.ports)
+    close = [n for n in names if edit_distance(a.name, n, 2) <= 2]
+    hint = f"; did you mean {quoted(close[0])}?" if close else ""
+    declared = ", ".join(names[:12]) + (" …" if len(names) > 12 else "") if names else "none"
+    if res.origin == "subtree":
+        message = (
+            f"{_owner(res)} declares no port {quoted(a.name)} (ports: {declared}){hint}; "
+            "BehaviorTree.CPP passes it on as a remapping anyway"
+        )
+        st.add(s, e, "undeclared-port", message, Severity.WARNING)
+        return
+    message = f"{_owner(res)} has no port {quoted(a.name)} (ports: {declared}){hint}"
+    if res.origin == "builtin":
+        message += "; BehaviorTree.CPP rejects attributes missing from providedPorts()"
+        st.add(s, e, "undeclared-port", message)
+    else:
+        message += "; BehaviorTree.CPP rejects it unless the C++ node declares it"
+        st.add(s, e, "undeclared-port", message, Severity.WARNING)
+
+
+def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: bool) -> None:
+    if not res.required or (autoremap and res.origin == "subtree"):
+        return
+    missing = [p for p in res.required if p not in given]
+    if not missing:
+        return
+    shown = ", ".join(quoted(m) for m in missing)
+    plural = "s" if len(missing) > 1 else ""
+    if res.origin == "subtree":
+        message = (
+            f"{_owner(res)} declares mandatory port{plural} {shown} without a default, and "
+            'this call neither remaps it nor sets _autoremap="true"'
+        )
+        severity = None
+    elif res.origin == "builtin":
+        message = (
+            f"{quoted(res.id)} needs port{plural} {shown} (no default); the node fails when "
+            "it reads a missing port"
+        )
+        severity = None
+    else:
+        message = (
+            f"{_owner(res)} declares port{plural} {shown} without a default, and it is not "
+            "given here"
+        )
+        severity = Severity.WARNING
+    st.add(
+        el.name_start, el.name_end, "missing-required-port", message, severity, {"ports": missing}
+    )
+
+
+def _blackboard_use(
+    st: State,
+    el: Element,
+    a: Attr,
+    value: str,
+    port: PortModel,
+    res: Resolved,
+    scope: TreeScope,
+) -> None:
+    canon = canonical_type(port.type)
+    if canon is None:
+        return
+    key = value.strip(" ")
+    key = a.name if key in ("=", "{=}") else key[1:-1].strip(" ")
+    first = scope.keys.get(key)
+    if first is None:
+        scope.keys[key] = BlackboardUse(canon, port.type, res.exact, a.name, res.id)
+        return
+    if first.type == canon or first.type == "std::string":
+        return
+    s, e = el.span_of_value(a)
+    st.add(
+        s,
+        e,
+        "blackboard-type-mismatch",
+        f"Blackboard key {quoted(key)} was first used as {first.shown} (port "
+        f"{quoted(first.port)} of {quoted(first.node)}) and is {port.type} here; "
+        "BehaviorTree.CPP refuses to create the tree",
+        None if (first.exact and res.exact) else Severity.WARNING,
+    )

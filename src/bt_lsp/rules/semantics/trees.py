@@ -1,0 +1,319 @@
+"""Trees and tree IDs: definitions, ``<SubTree>`` calls and the main tree.
+
+* ``missing-id`` (error): a ``<BehaviorTree>`` without ``ID`` while ``<root>`` has more
+  than one child element, or a ``<SubTree>`` without ``ID``.  Range: the element name.  (An
+  empty ``ID=""`` is reported by the name rule ``model-name-empty``.)
+* ``tree-child-count`` (error): a ``<BehaviorTree>`` without exactly one child element.
+  Range: ``BehaviorTree``.
+* ``registered-name-as-tree-id``: a ``<BehaviorTree ID>`` or ``<SubTree ID>`` that is the
+  name of a built-in node (error: BehaviorTree.CPP refuses it) or of a node declared in a
+  ``<TreeNodesModel>`` (warning: refused if that node is registered).  Range: the value.
+* ``duplicate-tree-id`` (warning): a tree ID defined again, in this document or in a
+  document of its include closure (BehaviorTree.CPP silently keeps the last one loaded).
+  Range: the ID value of every definition in this document except the first one of it.
+* ``unknown-subtree`` / ``unknown-main-tree``: a ``<SubTree ID>`` or
+  ``main_tree_to_execute`` naming no visible tree: an error ("Can't find a tree with
+  name"), or a hint when a workspace document that this one does not include defines it
+  (applications often register every file).  Range: the value.
+* ``duplicate-subtree-name`` (error): a second ``<SubTree>`` with the same ``name`` in one
+  tree ("Duplicate SubTree path detected").  Range: the second ``name`` value.
+* ``subtree-recursion`` (error): trees calling each other in a cycle ("Recursive behavior
+  tree cycle detected").  The cycle is found by a depth-first walk that starts at the main
+  tree, then this document's trees in order; the call that closes a cycle is reported
+  when it is in this document, else the last call of the cycle path that is.  Range: that
+  ``<SubTree ID>`` value.
+"""
+
+from __future__ import annotations
+
+import os
+import weakref
+from itertools import compress
+from operator import itemgetter
+from typing import TYPE_CHECKING
+
+from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.context import TreeDecl
+from bt_lsp.rules.semantics.base import State, TreeScope, quoted
+from bt_lsp.syntax.model import Element
+
+if TYPE_CHECKING:
+    from bt_lsp.syntax.document import Document
+
+
+def _where(st: State, decl: TreeDecl) -> str:
+    if st.ctx.is_own(decl):
+        return f"line {st.line_of(decl.start) + 1}"
+    return os.path.basename(decl.path) if decl.path else "another document"
+
+
+def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) -> bool:
+    """Report a tree ID that is a node type's name; whether it was one."""
+    if tree_id in BUILTINS:
+        st.add(
+            start,
+            end,
+            "registered-name-as-tree-id",
+            f"{quoted(tree_id)} is a built-in node type; the ID of <{tag}> must not use the "
+            "name of a registered node",
+        )
+        return True
+    decl = st.ctx.models.get(tree_id)
+    if decl is not None:
+        where = "" if st.ctx.is_own(decl) or not decl.path else f" in {os.path.basename(decl.path)}"
+        st.add(
+            start,
+            end,
+            "registered-name-as-tree-id",
+            f"{quoted(tree_id)} is declared as a node type (<{decl.category}> in "
+            f"<TreeNodesModel>{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
+            "registered node",
+            Severity.WARNING,
+        )
+        return True
+    return False
+
+
+def begin_tree(st: State, el: Element) -> None:
+    a = el.attr("ID")
+    if a is None:
+        root = st.model.elements[el.parent] if el.parent >= 0 else None
+        if root is not None and len(root.children) > 1:
+            st.add(
+                el.name_start,
+                el.name_end,
+                "missing-id",
+                "<BehaviorTree> has no ID attribute; it is required when <root> has more "
+                "than one child element",
+            )
+    elif a.value:
+        s, e = el.span_of_value(a)
+        _registered_name(st, "BehaviorTree", a.value, s, e)
+    n = len(el.children)
+    if n != 1:
+        tid = el.value("ID") or ""
+        what = "no child element" if n == 0 else f"{n} child elements"
+        st.add(
+            el.name_start,
+            el.name_end,
+            "tree-child-count",
+            f"The <BehaviorTree> with ID {quoted(tid)} has {what}; it must have exactly 1 "
+            "(wrap several nodes in a <Sequence> or another control node)",
+        )
+
+
+def check_duplicate_ids(st: State) -> None:
+    """``duplicate-tree-id`` for this document's trees.  A document-wide rule: it compares
+    the positions of the definitions, which every edit before them moves."""
+    trees = st.ctx.trees
+    # The IDs defined more than once, found in C: most documents have none.
+    for tree_id in compress(trees.keys(), map((1).__lt__, map(len, trees.values()))):
+        for d in trees[tree_id]:
+            if st.ctx.is_own(d):
+                _duplicate(st, tree_id, d.start, d.end)
+
+
+def _duplicate(st: State, tree_id: str, start: int, end: int) -> None:
+    decls = st.ctx.trees.get(tree_id, ())
+    if len(decls) < 2:
+        return
+    others = [d for d in decls if not (st.ctx.is_own(d) and d.start == start)]
+    earlier = [d for d in others if not st.ctx.is_own(d) or d.start < start]
+    if not earlier:
+        return
+    shown = ", ".join(_where(st, d) for d in earlier[:3])
+    if len(earlier) > 3:
+        shown += f" and {len(earlier) - 3} more"
+    st.add(
+        start,
+        end,
+        "duplicate-tree-id",
+        f"Tree ID {quoted(tree_id)} is also defined at {shown}; BehaviorTree.CPP silently "
+        "keeps the last definition it loads",
+    )
+
+
+def check_call(st: State, el: Element, scope: TreeScope) -> None:
+    """A ``<SubTree>`` element inside a tree."""
+    a = el.attr("ID")
+    if a is None:
+        st.add(
+            el.name_start,
+            el.name_end,
+            "missing-id",
+            "<SubTree> has no ID attribute naming the tree to call",
+        )
+    elif a.value:
+        s, e = el.span_of_value(a)
+        if not _registered_name(st, "SubTree", a.value, s, e):
+            _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
+    name = el.attr("name")
+    if name is not None and name.value is not None:
+        first = scope.subtree_names.get(name.value)
+        if first is None:
+            scope.subtree_names[name.value] = el
+        else:
+            s, e = el.span_of_value(name)
+            line = st.line_of(first.name_start) + 1
+            st.add(
+                s,
+                e,
+                "duplicate-subtree-name",
+                f"Another <SubTree> in this tree (line {line}) "
+                f"has the name {quoted(name.value)}; BehaviorTree.CPP rejects the duplicate "
+                "SubTree path (use unique names or omit 'name')",
+            )
+
+
+def _unknown_tree(st: State, tree_id: str, start: int, end: int, code: str, what: str) -> None:
+    if tree_id in st.ctx.trees:
+        return
+    elsewhere = st.ctx.workspace_trees.get(tree_id)
+    if elsewhere:
+        path = elsewhere[0].path
+        st.add(
+            start,
+            end,
+            code,
+            f"{what} {quoted(tree_id)}, which is defined in "
+            f"{os.path.basename(path) if path else 'another document'}; that document is "
+            "not included, so the application must register it too",
+            Severity.HINT,
+        )
+        return
+    st.add(
+        start,
+        end,
+        code,
+        f"{what} {quoted(tree_id)}, but no tree with that ID is defined in this document "
+        "or in the documents it includes",
+    )
+
+
+def check_main_tree(st: State) -> None:
+    root = st.model.root
+    if root is None:
+        return
+    a = root.attr("main_tree_to_execute")
+    if a is None or a.value is None:
+        return
+    s, e = root.span_of_value(a)
+    _unknown_tree(st, a.value, s, e, "unknown-main-tree", "main_tree_to_execute names")
+
+
+# A cycle found: the tree whose call is reported, the index of that call among its calls,
+# and the cycle as shown.
+_Cycle = tuple[str, int, str]
+# What the walk reads: the main tree, this document's path, and the visible tree IDs with
+# the calls and path of the definition kept for each.
+_Graph = tuple[
+    str | None, str | None, tuple[str, ...], tuple[tuple[str, ...], ...], tuple[str | None, ...]
+]
+# The last walk of each document, used again while its graph is the same: typing inside a
+# tree rarely changes which trees call which.
+_WALKS: weakref.WeakKeyDictionary[Document, tuple[_Graph, list[_Cycle]]] = (
+    weakref.WeakKeyDictionary()
+)
+_LAST = itemgetter(-1)
+_PATH, _CALLS = itemgetter(1), itemgetter(4)
+
+
+def check_recursion(st: State) -> None:
+    """Find SubTree cycles among the visible trees; report the closing calls that are ours."""
+    ctx = st.ctx
+    if not ctx.trees:
+        return
+    root = st.model.root
+    main = root.value("main_tree_to_execute") if root is not None else None
+    # The definition BehaviorTree.CPP uses for each ID is the last one loaded.  Made in C:
+    # an edit of a large document compares it with the last one instead of walking again.
+    kept: list[TreeDecl] = list(map(_LAST, ctx.trees.values()))
+    graph_key: _Graph = (
+        main,
+        ctx.path,
+        tuple(ctx.trees),
+        tuple(map(_CALLS, kept)),
+        tuple(map(_PATH, kept)),
+    )
+    last = _WALKS.get(st.doc)
+    if last is not None and last[0] == graph_key:
+        cycles = last[1]
+    else:
+        cycles = _walk(dict(zip(graph_key[2], kept, strict=True)), main, ctx.path)
+        _WALKS[st.doc] = (graph_key, cycles)
+    for tree_id, idx, shown in cycles:
+        decl = ctx.trees[tree_id][-1]
+        s, e = decl.call_offsets[idx]
+        st.add(
+            decl.start + s,
+            decl.start + e,
+            "subtree-recursion",
+            f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive trees",
+        )
+
+
+def _walk(kept: dict[str, TreeDecl], main: str | None, own: str | None) -> list[_Cycle]:
+    """The cycles of the calls between the trees ``kept`` (by ID), by a depth-first walk
+    from the main tree, then from this document's trees, then from the others."""
+    # A tree that calls none cannot be on a cycle.
+    graph = {tid: decl for tid, decl in kept.items() if decl.calls}
+    if not graph:
+        return []
+    order: list[str] = []
+    if main:
+        order.append(main)
+    order.extend([tid for tid, decl in graph.items() if decl.path == own])
+    order.extend(graph)
+    state: dict[str, int] = {}  # 1 on the stack, 2 done
+    found: list[_Cycle] = []
+    flagged: set[tuple[str, int]] = set()
+    for start_id in order:
+        if start_id not in graph or start_id in state:
+            continue
+        # The walk's stack: tree IDs and, for each, how many of its calls were followed.
+        ids: list[str] = [start_id]
+        done: list[int] = [0]
+        state[start_id] = 1
+        while ids:
+            decl = graph[ids[-1]]
+            i = done[-1]
+            if i >= len(decl.calls):
+                state[ids.pop()] = 2
+                done.pop()
+                continue
+            done[-1] = i + 1
+            callee = decl.calls[i]
+            if callee not in graph:
+                continue
+            cs = state.get(callee)
+            if cs is None:
+                state[callee] = 1
+                ids.append(callee)
+                done.append(0)
+            elif cs == 1:
+                cycle = _cycle(graph, ids, done, callee, own)
+                if cycle is not None and cycle[:2] not in flagged:
+                    flagged.add(cycle[:2])
+                    found.append(cycle)
+    return found
+
+
+def _cycle(
+    graph: dict[str, TreeDecl], ids: list[str], done: list[int], callee: str, own: str | None
+) -> _Cycle | None:
+    """The cycle that the call to ``callee`` closes, at the last of its calls that this
+    document makes (``None`` when it makes none)."""
+    # The cycle is the stack from `callee` to the top; each tree's last followed call
+    # (index done - 1) leads to the next one, the top's closes the cycle.
+    k = len(ids) - 1
+    while k > 0 and ids[k] != callee:
+        k -= 1
+    path = [*ids[k:], callee]
+    for j in range(len(ids) - 1, k - 1, -1):
+        decl = graph[ids[j]]
+        idx = done[j] - 1
+        if decl.path == own and 0 <= idx < len(decl.call_offsets):
+            shown = " → ".join(path) if len(path) <= 8 else " → ".join([*path[:4], "…", *path[-3:]])
+            return ids[j], idx, shown
+    return None

@@ -1,0 +1,90 @@
+"""A document: its text, line index, tokens and model, kept current by edits.
+
+An edit re-scans only the tokens around it (:func:`bt_lsp.syntax.scanner.rescan`) and updates the
+line index in place of rebuilding it; the model is derived lazily from
+the tokens when first asked for, the model from the previous one (only the sections around
+the tokens replaced since are built again, see :mod:`bt_lsp.syntax.model`).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from bt_lsp.syntax.gcpause import gc_paused, with_gc_paused
+from bt_lsp.syntax.model import Model, build
+from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
+from bt_lsp.syntax.text import LineIndex
+
+
+class Document:
+    @with_gc_paused
+    def __init__(self, text: str, path: str | None = None) -> None:
+        self.path = path
+        self.text = text
+        self.lines = LineIndex(text)
+        self.scan: Scan = scan(text)
+        self._model: Model | None = None
+        # The document's own diagnostics, kept here by bt_lsp.rules.diagnostics.own_diagnostics
+        # (this layer knows no rules); an edit clears them.
+        self.own_diagnostics: list[Any] | None = None
+        # The last model built and the tokens replaced since, for the next model.
+        self._base: Model | None = None
+        self._change: Rescan | None = None
+        self._is_bt: bool | None = None
+        self._utf8_size: int | None = None
+
+    def edit(self, start: int, end: int, new_text: str) -> None:
+        """Replace ``text[start:end]`` (code-point offsets, clamped) with ``new_text``."""
+        n = len(self.text)
+        start = min(max(start, 0), n)
+        end = min(max(end, start), n)
+        new_full = self.text[:start] + new_text + self.text[end:]
+        self.lines = self.lines.edited(start, end, new_text, new_full)
+        self.scan, change = rescan(self.scan, new_full, start, end, len(new_text))
+        self.text = new_full
+        if self._model is not None:
+            self._base, self._change = self._model, change
+        elif self._change is not None:
+            self._change = self._change.then(change)
+        self._model = None
+        self.own_diagnostics = None
+        self._is_bt = None
+        self._utf8_size = None
+
+    def replace_all(self, text: str) -> None:
+        self.__init__(text, self.path)  # type: ignore[misc]
+
+    @property
+    def model(self) -> Model:
+        if self._model is None:
+            with gc_paused():
+                self._model = build(self.scan, self.text, self._base, self._change)
+            self._base = self._change = None
+        return self._model
+
+    @property
+    def is_bt(self) -> bool:
+        """Whether the text :func:`looks_like_bt` (remembered until the next edit)."""
+        if self._is_bt is None:
+            self._is_bt = looks_like_bt(self.text)
+        return self._is_bt
+
+    @property
+    def utf8_size(self) -> int:
+        """The size of the text in UTF-8 bytes (remembered until the next edit)."""
+        if self._utf8_size is None:
+            text = self.text
+            self._utf8_size = (
+                len(text) if text.isascii() else len(text.encode("utf-8", "surrogatepass"))
+            )
+        return self._utf8_size
+
+
+_BT_MARKERS = re.compile(r"<(?:BehaviorTree|TreeNodesModel)[\s/>]|<root[\s/>]")
+
+
+def looks_like_bt(text: str) -> bool:
+    """Whether a text is BT XML (a ``<root>``, ``<BehaviorTree>`` or ``<TreeNodesModel>``
+    element), so that other XML files (launch files, package.xml) get no diagnostics."""
+    return _BT_MARKERS.search(text) is not None

@@ -1,0 +1,709 @@
+"""A tolerant, position-exact, incremental scanner for BT XML.
+
+The text is cut into a flat list of top-level tokens: text runs, start tags (with their
+attributes), end tags, comments, CDATA sections, processing instructions, DOCTYPEs and
+stray ``<``.  Between tokens the scanner has no state, and a token's result depends only
+on the text from its start up to its ``reach``.  That makes re-scanning after an edit
+cheap and exact: start again at the first token whose reach touches the edit, stop as
+soon as a new token starts where an old one (shifted by the edit) started after the
+edit, and reuse the rest.  A property test checks incremental == full scan.
+
+Offsets inside a token are relative to the token's start, so reused tokens are shared
+unchanged; the absolute starts are kept in blocks (:class:`bt_lsp.syntax.text.Offsets`), so an
+edit moves the blocks after it, not each start.
+
+The scanner never raises, never recurses, always advances and is linear: every loop
+either consumes text or stops.  It expands nothing: entity references other than XML's
+five and character references are left as written, DOCTYPEs are skipped whole.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from enum import IntEnum
+from typing import NamedTuple
+
+from bt_lsp.syntax.text import Offsets
+
+
+class Kind(IntEnum):
+    TEXT = 0
+    START = 1  # start tag or empty-element tag
+    END = 2  # end tag
+    COMMENT = 3
+    CDATA = 4
+    PI = 5  # processing instruction or XML declaration
+    DOCTYPE = 6
+    STRAY = 7  # a '<' that starts no markup
+
+
+# Read for every start tag: a module global is quicker than a member read from its enum
+# class in Python 3.11.
+_START = Kind.START
+
+XML_SYNTAX = "xml-syntax"
+UNESCAPED = "xml-unescaped-char"
+DOCTYPE_CODE = "xml-doctype"
+
+
+class Problem(NamedTuple):
+    """A lexical problem; offsets relative to the token start."""
+
+    start: int
+    end: int
+    code: str
+    message: str
+
+
+class Attr(NamedTuple):
+    """An attribute; offsets relative to the token start.
+
+    ``value_start``/``value_end`` delimit the raw value between the quotes (entity
+    references included).  ``value`` is the decoded value, ``None`` when the attribute
+    has no value at all.
+    """
+
+    name: str
+    name_start: int
+    name_end: int
+    value: str | None
+    value_start: int
+    value_end: int
+    quote: str
+
+
+class Token(NamedTuple):
+    """A token; offsets relative to its start.  Tokens, attributes and problems are named
+    tuples: immutable, small and quick to make (a document has tens of thousands).  Equal
+    tokens may be one object (whitespace runs and end tags are shared)."""
+
+    kind: Kind
+    length: int
+    reach: int  # how far (from the token start) the scan looked; >= length
+    name: str = ""
+    name_start: int = 0
+    name_end: int = 0
+    attrs: tuple[Attr, ...] = ()
+    self_closing: bool = False
+    closed: bool = True
+    problems: tuple[Problem, ...] = ()
+
+
+# Characters that end a tag or attribute name.  Anything else is part of the name, so
+# that names breaking the naming rules (``Open.Door``, ``a*b``) are still found whole.
+_NAME_STOP = " \t\r\n/>=<\"'"
+_NAME_RE = re.compile(r"[^ \t\r\n/>=<\"']+")
+_WS_RE = re.compile(r"[ \t\r\n]*")
+# Well-formed start tag, the common case, matched in one go.  Values may not hold '<'
+# (the slow path handles and reports those).
+_FAST_TAG_RE = re.compile(
+    r"<([^ \t\r\n/>=<\"']+)"
+    r"((?:[ \t\r\n]+[^ \t\r\n/>=<\"']+[ \t\r\n]*=[ \t\r\n]*(?:\"[^\"<]*\"|'[^'<]*'))*)"
+    r"[ \t\r\n]*(/?)>"
+)
+_FAST_END_RE = re.compile(r"</([^ \t\r\n/>=<\"']+)[ \t\r\n]*>")
+_FAST_ATTR_RE = re.compile(
+    r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
+)
+# An unterminated attribute value ends at its quote or before a line that starts a tag.
+_VALUE_END_RE = {
+    q: re.compile(q + r"|[\r\n][ \t\r\n]*<(?=[A-Za-z_:/!?]|[^\x00-\x7f])") for q in "\"'"
+}
+_STRAY_QUOTE_END = {q: re.compile(f"[{q}<]") for q in "\"'"}
+_UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
+_REF_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
+_PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
+
+
+def _char_ref(body: str) -> str | None:
+    try:
+        cp = int(body[2:], 16) if body[1] == "x" else int(body[1:])
+    except ValueError:
+        return None
+    if cp == 0 or cp > 0x10FFFF or 0xD800 <= cp <= 0xDFFF:
+        return None
+    return chr(cp)
+
+
+def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
+    """Decode references in an attribute value.
+
+    ``base`` is the raw value's offset (relative to its token) for problem positions.
+    BehaviorTree.CPP's tinyxml2 keeps a raw ``&`` or ``<`` as written, so they are
+    reported as warnings and kept.  Unknown entities are kept as written: bt-lsp never
+    expands DOCTYPE entities.
+    """
+    if "&" not in raw and "<" not in raw:
+        return raw
+    if problems is not None:
+        pos = raw.find("<")
+        while pos != -1:
+            problems.append(
+                Problem(
+                    base + pos,
+                    base + pos + 1,
+                    UNESCAPED,
+                    "Raw '<' in an attribute value; XML requires '&lt;'",
+                )
+            )
+            pos = raw.find("<", pos + 1)
+    if "&" not in raw:
+        return raw
+    out: list[str] = []
+    pos = 0
+    while True:
+        amp = raw.find("&", pos)
+        if amp == -1:
+            out.append(raw[pos:])
+            break
+        out.append(raw[pos:amp])
+        m = _REF_RE.match(raw, amp)
+        if m is None:
+            if problems is not None:
+                problems.append(
+                    Problem(
+                        base + amp,
+                        base + amp + 1,
+                        UNESCAPED,
+                        "Raw '&' in an attribute value; XML requires '&amp;'",
+                    )
+                )
+            out.append("&")
+            pos = amp + 1
+            continue
+        body = m.group(1)
+        if body[0] == "#":
+            ch = _char_ref(body)
+            if ch is None:
+                if problems is not None:
+                    problems.append(
+                        Problem(
+                            base + amp,
+                            base + m.end(),
+                            XML_SYNTAX,
+                            f"Invalid character reference '{m.group(0)}'",
+                        )
+                    )
+                out.append(m.group(0))
+            else:
+                out.append(ch)
+        elif body in _PREDEFINED:
+            out.append(_PREDEFINED[body])
+        else:
+            if problems is not None:
+                problems.append(
+                    Problem(
+                        base + amp,
+                        base + m.end(),
+                        XML_SYNTAX,
+                        f"Undefined entity '&{body};' (bt-lsp never expands DOCTYPE entities)",
+                    )
+                )
+            out.append(m.group(0))
+        pos = m.end()
+    return "".join(out)
+
+
+# Makes a named tuple from all its fields without the Python-level constructor (three times
+# quicker, for the hot paths).
+_new = tuple.__new__
+
+# Shared tokens: text runs by length, end tags by their text (bounded).
+_TEXT_TOKENS: dict[int, Token] = {}
+_END_TOKENS: dict[str, Token] = {}
+# Tag and attribute names, shared (bounded).
+_NAMES: dict[str, str] = {}
+_SHARED_MAX = 8192
+# Short attribute values, shared (bounded): blackboard keys, types and literals recur all
+# over a document (a megabyte of BT XML has three times as many values as distinct ones).
+_VALUES: dict[str, str] = {}
+_SHARED_VALUE_LENGTH = 16
+
+
+def _text_token(length: int) -> Token:
+    """A text run followed by '<' (its scan looked at that '<' too)."""
+    tok = _TEXT_TOKENS.get(length)
+    if tok is None:
+        if len(_TEXT_TOKENS) >= _SHARED_MAX:
+            _TEXT_TOKENS.clear()
+        tok = _TEXT_TOKENS[length] = Token(Kind.TEXT, length, length + 1)
+    return tok
+
+
+def _keep(pool: dict[str, str], s: str) -> str:
+    """Keep ``s`` in ``pool`` (emptied when full) for the next equal string to share."""
+    if len(pool) >= _SHARED_MAX:
+        pool.clear()
+    pool[s] = s
+    return s
+
+
+def _name(name: str) -> str:
+    return _NAMES.get(name) or _keep(_NAMES, name)
+
+
+def _value(raw: str) -> str:
+    if len(raw) > _SHARED_VALUE_LENGTH:
+        return raw
+    return _VALUES.get(raw) or _keep(_VALUES, raw)
+
+
+def _scan_text(text: str, pos: int, n: int) -> Token:
+    end = text.find("<", pos)
+    if end == -1:
+        return Token(Kind.TEXT, n - pos, n - pos)
+    return _text_token(end - pos)
+
+
+def _scan_delimited(
+    text: str, pos: int, n: int, kind: Kind, opener: str, closer: str, what: str
+) -> Token:
+    end = text.find(closer, pos + len(opener))
+    if end == -1:
+        return Token(
+            kind,
+            n - pos,
+            n - pos,
+            closed=False,
+            problems=(
+                Problem(0, len(opener), XML_SYNTAX, f"Unterminated {what}: missing '{closer}'"),
+            ),
+        )
+    length = end + len(closer) - pos
+    name = ""
+    if kind == Kind.PI:
+        m = _NAME_RE.match(text, pos + 2, end)
+        name = m.group(0) if m else ""
+    return Token(kind, length, length, name=name)
+
+
+def _scan_doctype(text: str, pos: int, n: int) -> Token:
+    """Skip a DOCTYPE whole (internal subset, quoted strings); never interpret it."""
+    i = pos + 9
+    depth = 0
+    quote = ""
+    while i < n:
+        c = text[i]
+        if quote:
+            j = text.find(quote, i)
+            if j == -1:
+                i = n
+                break
+            i = j + 1
+            quote = ""
+            continue
+        if c in "\"'":
+            quote = c
+        elif c == "[":
+            depth += 1
+        elif c == "]":
+            depth = max(0, depth - 1)
+        elif c == ">" and depth == 0:
+            length = i + 1 - pos
+            return Token(
+                Kind.DOCTYPE,
+                length,
+                length,
+                name="DOCTYPE",
+                problems=(
+                    Problem(
+                        0,
+                        9,
+                        DOCTYPE_CODE,
+                        "DOCTYPE ignored: its entities and external DTDs are never "
+                        "expanded or fetched",
+                    ),
+                ),
+            )
+        i += 1
+    return Token(
+        Kind.DOCTYPE,
+        n - pos,
+        n - pos,
+        name="DOCTYPE",
+        closed=False,
+        problems=(Problem(0, 9, XML_SYNTAX, "Unterminated DOCTYPE: missing '>'"),),
+    )
+
+
+def _scan_end_tag(text: str, pos: int, n: int) -> Token:
+    m = _FAST_END_RE.match(text, pos)
+    if m is not None:  # the common case: shared
+        key = m.group(0)
+        tok = _END_TOKENS.get(key)
+        if tok is None:
+            if len(_END_TOKENS) >= _SHARED_MAX:
+                _END_TOKENS.clear()
+            name = _name(m.group(1))
+            length = len(key)
+            tok = _END_TOKENS[key] = Token(Kind.END, length, length + 1, name, 2, 2 + len(name))
+        return tok
+    problems: list[Problem] = []
+    m = _NAME_RE.match(text, pos + 2)
+    if m is None:
+        name, ns, ne = "", 2, 2
+        problems.append(Problem(0, 2, XML_SYNTAX, "End tag without a name"))
+        i = pos + 2
+    else:
+        name, ns, ne = m.group(0), 2, m.end() - pos
+        i = m.end()
+    i = _WS_RE.match(text, i).end()  # type: ignore[union-attr]
+    if i < n and text[i] == ">":
+        length = i + 1 - pos
+        return Token(
+            Kind.END,
+            length,
+            length + 1,
+            name=name,
+            name_start=ns,
+            name_end=ne,
+            problems=tuple(problems),
+        )
+    length = i - pos
+    problems.append(
+        Problem(
+            ns, ne if ne > ns else 2, XML_SYNTAX, f"End tag '</{name}' is not closed: expected '>'"
+        )
+    )
+    return Token(
+        Kind.END,
+        length,
+        length + 1,
+        name=name,
+        name_start=ns,
+        name_end=ne,
+        closed=False,
+        problems=tuple(problems),
+    )
+
+
+def _scan_start_fast(text: str, pos: int) -> Token | None:
+    m = _FAST_TAG_RE.match(text, pos)
+    if m is None:
+        return None
+    name = _name(m.group(1))
+    a_start, a_end = m.span(2)
+    length = m.end() - pos
+    self_closing = m.group(3) == "/"
+    if a_start == a_end:
+        return _new(
+            Token, (_START, length, length + 1, name, 1, 1 + len(name), (), self_closing, True, ())
+        )
+    attrs: list[Attr] = []
+    problems: list[Problem] = []
+    seen: set[str] = set()
+    for am in _FAST_ATTR_RE.finditer(text, a_start, a_end):
+        aname, raw, raw2 = am.groups()
+        ns, ne = am.span(1)
+        if raw is None:
+            raw = raw2
+            vs, ve = am.span(3)
+            quote = "'"
+        else:
+            vs, ve = am.span(2)
+            quote = '"'
+        vs -= pos
+        if aname in seen:
+            problems.append(
+                Problem(ns - pos, ne - pos, XML_SYNTAX, f"Duplicate attribute '{aname}'")
+            )
+        seen.add(aname)
+        attrs.append(
+            _new(
+                Attr,
+                (
+                    _name(aname),
+                    ns - pos,
+                    ne - pos,
+                    _value(raw) if "&" not in raw else decode_value(raw, vs, problems),
+                    vs,
+                    ve - pos,
+                    quote,
+                ),
+            )
+        )
+    return _new(
+        Token,
+        (
+            _START,
+            length,
+            length + 1,
+            name,
+            1,
+            1 + len(name),
+            tuple(attrs),
+            self_closing,
+            True,
+            tuple(problems) if problems else (),
+        ),
+    )
+
+
+def _scan_start(text: str, pos: int, n: int) -> Token:
+    fast = _scan_start_fast(text, pos)
+    if fast is not None:
+        return fast
+    problems: list[Problem] = []
+    attrs: list[Attr] = []
+    seen: set[str] = set()
+    m = _NAME_RE.match(text, pos + 1)
+    assert m is not None  # the caller checked that a name character follows '<'
+    name = m.group(0)
+    i = m.end()
+    reach = i
+    self_closing = False
+    closed = False
+    while True:
+        ws_end = _WS_RE.match(text, i).end()  # type: ignore[union-attr]
+        had_ws = ws_end > i
+        i = ws_end
+        reach = max(reach, i)
+        if i >= n:
+            problems.append(
+                Problem(
+                    1,
+                    1 + len(name),
+                    XML_SYNTAX,
+                    f"Start tag '<{name}' is not closed: expected '>' or '/>'",
+                )
+            )
+            break
+        c = text[i]
+        if c == ">":
+            i += 1
+            closed = True
+            break
+        if c == "/":
+            if i + 1 < n and text[i + 1] == ">":
+                i += 2
+                closed = self_closing = True
+                break
+            reach = max(reach, i + 1)
+            problems.append(Problem(i - pos, i + 1 - pos, XML_SYNTAX, "Expected '/>' after '/'"))
+            i += 1
+            continue
+        if c == "<":
+            problems.append(
+                Problem(
+                    1,
+                    1 + len(name),
+                    XML_SYNTAX,
+                    f"Start tag '<{name}' is not closed: expected '>' or '/>'",
+                )
+            )
+            break
+        am = _NAME_RE.match(text, i)
+        if am is None:  # '=' or a quote where a name should be
+            problems.append(
+                Problem(i - pos, i + 1 - pos, XML_SYNTAX, f"Unexpected {c!r} in tag '<{name}'")
+            )
+            if c in "\"'":
+                # Skip a stray quoted chunk, but never past the start of another tag.
+                jm = _STRAY_QUOTE_END[c].search(text, i + 1)
+                reach = max(reach, jm.end() if jm is not None else n)
+                i = jm.end() if jm is not None and jm.group(0) == c else i + 1
+            else:
+                i += 1
+                reach = max(reach, i)
+            continue
+        aname = am.group(0)
+        ns, ne = am.start() - pos, am.end() - pos
+        if not had_ws and attrs:
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Missing whitespace before attribute '{aname}'")
+            )
+        if aname in seen:
+            problems.append(Problem(ns, ne, XML_SYNTAX, f"Duplicate attribute '{aname}'"))
+        seen.add(aname)
+        i = _WS_RE.match(text, am.end()).end()  # type: ignore[union-attr]
+        reach = max(reach, i + 1)
+        if i >= n or text[i] != "=":
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Attribute '{aname}' has no value: expected '=\"…\"'")
+            )
+            attrs.append(Attr(aname, ns, ne, None, -1, -1, ""))
+            continue
+        i = _WS_RE.match(text, i + 1).end()  # type: ignore[union-attr]
+        reach = max(reach, i + 1)
+        q = text[i] if i < n else ""
+        if q in ('"', "'") and q:
+            vstart = i + 1
+            vm = _VALUE_END_RE[q].search(text, vstart)
+            if vm is not None and vm.group(0) == q:
+                vend, i = vm.start(), vm.end()
+                reach = max(reach, i)
+            else:
+                vend = vm.start() if vm is not None else n
+                reach = max(reach, vm.end() if vm is not None else n)
+                i = vend
+                problems.append(
+                    Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' has no closing {q}")
+                )
+            raw = text[vstart:vend]
+            attrs.append(
+                Attr(
+                    aname,
+                    ns,
+                    ne,
+                    decode_value(raw, vstart - pos, problems),
+                    vstart - pos,
+                    vend - pos,
+                    q,
+                )
+            )
+        else:
+            # Unquoted value: XML forbids it; read up to whitespace or the tag's end.
+            vm2 = _UNQUOTED_RE.match(text, i)
+            vend = vm2.end() if vm2 else i
+            if vend > i and text[vend - 1] == "/" and vend < n and text[vend] == ">":
+                vend -= 1
+            reach = max(reach, vend + 1)
+            problems.append(
+                Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' must be quoted")
+            )
+            raw = text[i:vend]
+            attrs.append(
+                Attr(aname, ns, ne, decode_value(raw, i - pos, None), i - pos, vend - pos, "")
+            )
+            i = vend
+    length = i - pos
+    return Token(
+        Kind.START,
+        length,
+        max(reach - pos, length) + 1,
+        name=name,
+        name_start=1,
+        name_end=1 + len(name),
+        attrs=tuple(attrs),
+        self_closing=self_closing,
+        closed=closed,
+        problems=tuple(problems),
+    )
+
+
+def scan_token(text: str, pos: int) -> Token:
+    """Scan the one token that starts at ``pos`` (``pos < len(text)``)."""
+    n = len(text)
+    if text[pos] != "<":
+        return _scan_text(text, pos, n)
+    nxt = text[pos + 1] if pos + 1 < n else ""
+    if nxt == "/":
+        return _scan_end_tag(text, pos, n)
+    if nxt == "!":
+        if text.startswith("<!--", pos):
+            return _scan_delimited(text, pos, n, Kind.COMMENT, "<!--", "-->", "comment")
+        if text.startswith("<![CDATA[", pos):
+            return _scan_delimited(text, pos, n, Kind.CDATA, "<![CDATA[", "]]>", "CDATA section")
+        if text.startswith("<!DOCTYPE", pos):
+            return _scan_doctype(text, pos, n)
+        end = text.find(">", pos)
+        length = (end + 1 if end != -1 else n) - pos
+        return Token(
+            Kind.STRAY,
+            length,
+            max(length, 9) + 1,
+            closed=False,
+            problems=(Problem(0, min(2, length), XML_SYNTAX, "Unknown markup declaration"),),
+        )
+    if nxt == "?":
+        return _scan_delimited(text, pos, n, Kind.PI, "<?", "?>", "processing instruction")
+    if nxt and nxt not in _NAME_STOP:
+        return _scan_start(text, pos, n)
+    return Token(
+        Kind.STRAY,
+        1,
+        2,
+        closed=False,
+        problems=(Problem(0, 1, XML_SYNTAX, "'<' does not start a tag; write '&lt;'"),),
+    )
+
+
+# The token starts of a scan: offsets kept in blocks (see bt_lsp.syntax.text.Offsets).
+Starts = Offsets
+
+
+@dataclass(slots=True)
+class Scan:
+    """The tokens of a text and their absolute start offsets."""
+
+    tokens: list[Token]
+    starts: Starts
+
+    def index_at(self, offset: int) -> int:
+        """Index of the token containing ``offset`` (the last token for offsets past it)."""
+        return max(0, self.starts.index_at(offset))
+
+
+def scan(text: str) -> Scan:
+    tokens: list[Token] = []
+    starts: list[int] = []
+    pos, n = 0, len(text)
+    while pos < n:
+        tok = scan_token(text, pos)
+        tokens.append(tok)
+        starts.append(pos)
+        pos += tok.length
+    return Scan(tokens, Starts.of(starts))
+
+
+@dataclass(frozen=True, slots=True)
+class Rescan:
+    """What an incremental re-scan replaced: old tokens ``[first, old_stop)`` became new
+    tokens ``[first, new_stop)``; every other token is the same object as before."""
+
+    first: int
+    old_stop: int
+    new_stop: int
+
+    def then(self, later: Rescan) -> Rescan:
+        """The tokens replaced by this re-scan followed by ``later`` (a re-scan of this
+        one's result): a range that holds both, possibly with unchanged tokens too."""
+        d1 = self.new_stop - self.old_stop
+        d2 = later.new_stop - later.old_stop
+        new_stop = max(later.new_stop, self.new_stop + d2)
+        return Rescan(min(self.first, later.first), new_stop - d1 - d2, new_stop)
+
+
+def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> tuple[Scan, Rescan]:
+    """Update ``old`` for the edit that replaced old ``[start, old_end)`` with ``new_len``
+    code points, giving ``new_text``.  Re-scans only around the edit."""
+    tokens, starts = old.tokens, old.starts
+    delta = new_len - (old_end - start)
+    if not tokens:
+        full = scan(new_text)
+        return full, Rescan(0, 0, len(full.tokens))
+    # First token whose scan may have looked at the edited region.
+    first = old.index_at(start)
+    lo = max(0, first - 8)
+    for k in range(first - 1, lo - 1, -1):
+        if starts[k] + tokens[k].reach > start:
+            first = k
+    if first > 0 and starts[first] == start:
+        # An insertion at a token boundary may extend the previous token.
+        first -= 1
+    pos = starts[first]
+    new_end = start + new_len
+    n = len(new_text)
+    new_tokens: list[Token] = []
+    new_starts: list[int] = []
+    k = first  # candidate old token to resynchronise with
+    nold = len(tokens)
+    while pos < n:
+        if pos >= new_end:
+            old_pos = pos - delta
+            if old_pos >= old_end:
+                while k < nold and starts[k] < old_pos:
+                    k += 1
+                if k < nold and starts[k] == old_pos:
+                    new_list = tokens[:first]
+                    new_list.extend(new_tokens)
+                    new_list.extend(tokens[k:])
+                    result = Scan(new_list, starts.replaced(first, k, new_starts, delta))
+                    return result, Rescan(first, k, first + len(new_tokens))
+        tok = scan_token(new_text, pos)
+        new_tokens.append(tok)
+        new_starts.append(pos)
+        pos += tok.length
+    result = Scan(tokens[:first] + new_tokens, starts.replaced(first, nold, new_starts, delta))
+    return result, Rescan(first, nold, first + len(new_tokens))
