@@ -5,12 +5,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from pathlib import Path
+from typing import Any, Final
 
 from bt_lsp.rules.codes import CODES, Severity
 
 DEFAULT_MAX_DOCUMENT_BYTES = 8 * 1024 * 1024
 MAX_DEBOUNCE_MS = 60_000
+# What ``btcpp`` may be: detect the version, or BehaviorTree.CPP 3.x / 4.x.
+BTCPP_CHOICES: Final = ("auto", "3", "4")
 
 
 @dataclass(frozen=True)
@@ -21,8 +24,16 @@ class Settings:
     max_document_bytes: int = DEFAULT_MAX_DOCUMENT_BYTES
     # ROS package name -> folder, for <include ros_pkg="...">.
     ros_packages: Mapping[str, str] = field(default_factory=dict)
-    # Extra files that declare models (a generated TreeNodesModel, a Groot2 .btproj).
-    model_files: tuple[str, ...] = ()
+    # Node catalogs: generated TreeNodesModel XML files, Groot2 .btproj files (the
+    # ``modelFiles`` setting, the ``models`` key of bt-lsp.toml, ``check --models``). A
+    # relative path is relative to the first workspace folder.
+    models: tuple[Path, ...] = ()
+    # The project's BehaviorTree.CPP major version: "auto" (detected per file), "3" or "4".
+    btcpp: str = "auto"
+    # Globs (relative to the configuration file's folder) of files and folders to skip.
+    exclude: tuple[str, ...] = ()
+    # Globs of the project's C++ sources (read by the C++ catalog reader).
+    sources: tuple[str, ...] = ()
 
     @classmethod
     def parse(cls, raw: Any, problems: list[str] | None = None) -> Settings:
@@ -71,5 +82,11 @@ class Settings:
             kw["ros_packages"] = {str(k): str(v) for k, v in ros.items()}
         models = raw.get("modelFiles")
         if isinstance(models, list):
-            kw["model_files"] = tuple(str(m) for m in models)
+            kw["models"] = tuple(Path(str(m)) for m in models)
+        btcpp = raw.get("btcpp")
+        if btcpp is not None:
+            if str(btcpp) in BTCPP_CHOICES:
+                kw["btcpp"] = str(btcpp)
+            else:
+                problems.append(f"btcpp must be one of {', '.join(BTCPP_CHOICES)}, not {btcpp!r}")
         return cls(**kw)

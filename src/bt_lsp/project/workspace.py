@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from bt_lsp.ide.navigation import IncludeLink
+from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer
 from bt_lsp.project.fileio import FileError, read_text
+from bt_lsp.project.packages import Detected, Packages
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules import analysis
 from bt_lsp.rules.context import Context
@@ -91,11 +93,25 @@ def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
 
 
 class Workspace:
+    """The files of one or more folders.  ``settings`` are the editor's (or the defaults);
+    each file's settings are those with its configuration file (:mod:`bt_lsp.project.config`)
+    over them, and ``overrides`` (command-line flags) over both."""
+
     def __init__(
-        self, roots: Sequence[str | os.PathLike[str]] = (), settings: Settings | None = None
+        self,
+        roots: Sequence[str | os.PathLike[str]] = (),
+        settings: Settings | None = None,
+        *,
+        configs: Configs | None = None,
+        overrides: Layer | None = None,
     ) -> None:
         self.roots = [normalize(r) for r in roots]
         self.settings = settings or Settings()
+        self.configs = configs if configs is not None else Configs()
+        self.overrides = overrides
+        self.packages = Packages()
+        # Folder -> (the editor settings they were made from, the folder's settings).
+        self._scoped: dict[Path, tuple[Settings, Settings]] = {}
         self._open: dict[Path, Document] = {}
         self._disk: dict[Path, tuple[tuple[int, int], Document | None, str | None]] = {}
         self._files: list[Path] | None = None
@@ -159,16 +175,72 @@ class Workspace:
         p = normalize(path)
         self._disk.pop(p, None)
         self._files = None
+        if self.configs.changed(p) | self.packages.changed(p):
+            self._scoped.clear()
         self.generation += 1
 
     def refresh(self) -> None:
         """Forget everything read from disk (for clients that do not report file changes)."""
         self._disk.clear()
         self._files = None
+        self._scoped.clear()
+        self.configs.changed(Path(CONFIG_FILE))
+        self.packages.changed(Path("package.xml"))
         self.generation += 1
+
+    # -- each file's settings -------------------------------------------------------------------
+
+    def settings_for(self, path: Path) -> Settings:
+        """The settings of the file at ``path``: command-line flags over its configuration
+        file over the editor settings (the same object while none of them changes)."""
+        folder = path.parent
+        hit = self._scoped.get(folder)
+        if hit is not None and hit[0] is self.settings:
+            return hit[1]
+        scoped = self._editor_settings()
+        config = self.configs.for_path(path)
+        if config is not None and not isinstance(config, ConfigError):
+            scoped = config.over(scoped)
+        if self.overrides is not None:
+            scoped = self.overrides.over(scoped)
+        if scoped == self.settings:
+            scoped = self.settings
+        self._scoped[folder] = (self.settings, scoped)
+        return scoped
+
+    def _editor_settings(self) -> Settings:
+        """The editor settings with their relative model files resolved against the first
+        workspace folder, as they always were."""
+        models = tuple(self.model_files())
+        if models == self.settings.models:
+            return self.settings
+        return replace(self.settings, models=models)
+
+    def config_errors(self) -> list[ConfigError]:
+        """The configuration files read so far that cannot be used."""
+        return self.configs.errors()
+
+    def btcpp_for(self, path: Path, doc: Document | None = None) -> Detected:
+        """The BehaviorTree.CPP major version the file at ``path`` is built for: the
+        ``btcpp`` setting if not ``auto``, else its package's ``package.xml`` or
+        ``CMakeLists.txt``, else the document's ``BTCPP_format``."""
+        chosen = self.settings_for(path).btcpp
+        if chosen in ("3", "4"):
+            return Detected(chosen, "the btcpp setting")
+        found = self.packages.btcpp_of(path.parent)
+        if found.version is not None:
+            return found
+        doc = doc if doc is not None else self.document(path)
+        root = doc.model.root if doc is not None else None
+        if root is not None and root.name == "root":
+            written = (root.value("BTCPP_format") or "").strip()
+            if written in ("3", "4"):
+                return Detected(written, "the document's BTCPP_format=\"" + written + '"')
+        return found
 
     def set_settings(self, settings: Settings) -> None:
         self.settings = settings
+        self._scoped.clear()
         self._disk.clear()
         self.generation += 1
 
@@ -191,8 +263,7 @@ class Workspace:
     def model_files(self) -> list[Path]:
         """The model files named in the settings (relative to the first workspace folder)."""
         out = []
-        for m in self.settings.model_files:
-            mp = Path(m)
+        for mp in self.settings.models:
             out.append(normalize(mp if mp.is_absolute() or not self.roots else self.roots[0] / mp))
         return out
 
@@ -214,11 +285,12 @@ class Workspace:
         # Kept per path while the document's model and the settings are the same (every
         # document's includes are looked at for every other one).
         model = doc.model
+        settings = self.settings_for(path)
         hit = self._includes.get(path)
-        if hit is not None and hit[0] is model and hit[1] is self.settings:
+        if hit is not None and hit[0] is model and hit[1] is settings:
             return hit[2]
-        found = includes_of(path, doc, self.settings)
-        self._includes[path] = (model, self.settings, found)
+        found = includes_of(path, doc, settings)
+        self._includes[path] = (model, settings, found)
         return found
 
     def include_closure(self, path: Path, doc: Document | None = None) -> list[Path]:
@@ -316,13 +388,16 @@ class Workspace:
             if d is not None:
                 others.append((str(p), d, True))
         included_by: list[str] = []
-        model_paths = set(self.model_files())
+        settings = self.settings_for(path)
+        model_paths = self.catalog_files(path)
         model_files: list[tuple[str, Document]] = []
-        for p, d in self.bt_documents():
-            if p == path or p in in_closure:
-                continue
-            if p in model_paths:
+        for p in model_paths:
+            d = self.document(p)
+            if d is not None and p != path:
                 model_files.append((str(p), d))
+        skip = set(model_paths)
+        for p, d in self.bt_documents():
+            if p == path or p in in_closure or p in skip:
                 continue
             others.append((str(p), d, False))
             if any(inc.target == path for inc in self.includes(p, d)):
@@ -331,10 +406,21 @@ class Workspace:
             doc,
             others,
             path=str(path),
-            ros_pkg_paths=self.settings.ros_packages,
+            ros_pkg_paths=settings.ros_packages,
             model_files=model_files,
             included_by=included_by,
+            btcpp_version=self.btcpp_for(path, doc).version,
         )
+
+    def catalog_files(self, path: Path) -> list[Path]:
+        """The node catalog files in scope for the document at ``path``: the ``models``
+        of its settings (configuration file, flags, editor)."""
+        out: list[Path] = []
+        for m in self.settings_for(path).models:
+            p = normalize(m if m.is_absolute() or not self.roots else self.roots[0] / m)
+            if p not in out:
+                out.append(p)
+        return out
 
     @with_gc_paused
     def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:

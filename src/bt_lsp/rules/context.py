@@ -146,6 +146,9 @@ class Context:
     * ``ros_pkg_paths``: ROS package name -> share directory (settings).
     * ``included_by``: paths of workspace documents that include this one.
     * ``path``: this document's path; declarations with this path are its own.
+    * ``btcpp_version``: the BehaviorTree.CPP major version the document is built for,
+      ``"3"`` or ``"4"``, as the project layer detected or configured it (``None`` when
+      unknown: the document's own ``BTCPP_format`` is all there is).
     """
 
     path: str | None = None
@@ -166,6 +169,7 @@ class Context:
         default_factory=lambda: cast("Mapping[str, str]", _EMPTY)
     )
     included_by: tuple[str, ...] = ()
+    btcpp_version: str | None = None
     # What the context was combined from besides its own document's declarations (the
     # other documents' declarations, by identity, and the settings): equal sources mean
     # that only this document's own declarations can differ (see semantics/sections.py).
@@ -204,6 +208,7 @@ class Context:
         model_files: Iterable[tuple[str, Document]] = (),
         included_by: Iterable[str] = (),
         workspace_has_custom_models: bool | None = None,
+        btcpp_version: str | None = None,
     ) -> Context:
         """The context of ``own`` among ``others``: ``(path, document, included)`` triples.
 
@@ -253,7 +258,8 @@ class Context:
             workspace_has_custom_models=has_custom,
             ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
             included_by=tuple(included_by),
-            sources=(*sources, workspace_has_custom_models),
+            btcpp_version=btcpp_version,
+            sources=(*sources, workspace_has_custom_models, btcpp_version),
         )
 
 

@@ -101,7 +101,8 @@ class BtServer(LanguageServer):
                 result = self.project.diagnostics(od.path, od.doc)
             else:
                 result = analyze(od.doc)
-            result = with_severities(result, self.settings.severity)
+            settings = self.settings if od.path is None else self.project.settings_for(od.path)
+            result = with_severities(result, settings.severity)
         od.cache_key, od.cached = key, result
         return result
 

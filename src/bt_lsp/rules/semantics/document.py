@@ -4,7 +4,8 @@
   must have a root node called <root>".  Range: the top element's name (an empty range at
   the start when the document has no element).
 * ``missing-format`` (warning): ``<root>`` without ``BTCPP_format``; BehaviorTree.CPP only
-  prints a warning.  Range: ``root``.  Fix: add ``BTCPP_format="4"``.
+  prints a warning.  Range: ``root``.  Fix: add ``BTCPP_format="4"``.  Not reported when
+  the project builds against BehaviorTree.CPP 3 (``Context.btcpp_version``).
 * ``duplicate-model-section`` (error): every ``<TreeNodesModel>`` after the first.
 * ``missing-id`` (error) for ``<Action|Condition|Control|Decorator|SubTree>`` written
   directly under ``<root>`` without ``ID`` while a ``<TreeNodesModel>`` exists (a check
@@ -51,8 +52,11 @@ def check_root(st: State) -> None:
             "called <root>",
         )
     else:
-        st.v4 = root.attr("BTCPP_format") is not None
-        if not st.v4:
+        declared = root.attr("BTCPP_format") is not None
+        version = st.ctx.btcpp_version
+        st.v4 = declared or version == "4"
+        # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only.
+        if not declared and version != "3":
             st.add(
                 root.name_start,
                 root.name_end,
