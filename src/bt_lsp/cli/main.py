@@ -1,4 +1,4 @@
-"""The ``bt-lsp`` command line: ``serve``, ``check`` and ``--version``.
+"""The ``bt-lsp`` command line: ``serve``, ``check``, ``models`` and ``--version``.
 
 ``check`` never imports the language server (or pygls): the server is imported only when
 ``serve`` runs.
@@ -92,6 +92,22 @@ def build_parser() -> argparse.ArgumentParser:
         help="refuse files larger than this (e.g. 64M; default: 64M)",
     )
     check.set_defaults(subparser=check)
+
+    models = sub.add_parser(
+        "models",
+        help="print the node catalog learned from C++ sources",
+        description=(
+            "Read the C++ files under PATH (registrations and providedPorts, no build) and "
+            "print the nodes as a TreeNodesModel document (xml, BehaviorTree.CPP's "
+            "writeTreeNodesModelXML shape) or as json with source positions and flags."
+        ),
+    )
+    models.add_argument("paths", nargs="+", metavar="PATH", help="C++ files or directories")
+    models.add_argument(
+        "--format", choices=("xml", "json"), default="xml", help="output (default: %(default)s)"
+    )
+    models.add_argument("--verbose", action="store_true", help="show progress on stderr")
+    models.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     return parser
 
 
@@ -128,6 +144,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _serve(args)
         if args.command == "check":
             return _check(args.subparser, args)
+        if args.command == "models":
+            from bt_lsp.cli import models
+
+            return models.run(
+                args.paths, format=args.format, verbose=args.verbose, cache=not args.no_cache
+            )
         parser.print_help(sys.stderr)
         return 2
     except SystemExit as e:

@@ -1,0 +1,570 @@
+"""Link the facts of many C++ files into a node catalog.
+
+Each registration becomes a :class:`CppNode`: its ID, the class, the kind (from the base
+class, through project base classes in any file), and its ports, read from the class's
+``providedPorts`` (or an inherited one, ``using Base::providedPorts``, ``providedBasicPorts``
+of a base, ``Base::providedPorts()`` plus ``insert``), with port names from constants
+scoped to their class.  What cannot be known statically is said by a flag on the node
+and a note, never guessed: such a node is advisory, one without flags authoritative.
+A class that is never registered is not in the catalog.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Final, NamedTuple
+
+from bt_lsp.cpp.facts import (
+    ClassFacts,
+    FileFacts,
+    MacroTemplate,
+    Op,
+    PortFacts,
+    PortsFn,
+    Registration,
+    Span,
+)
+from bt_lsp.cpp.names import last_name, split_top, strip_args
+
+__all__ = [
+    "FLAG_DEFAULT_EXPRESSION",
+    "FLAG_DUPLICATE_ID",
+    "FLAG_KIND_UNKNOWN",
+    "FLAG_PORTS_INCOMPLETE",
+    "Catalog",
+    "CppNode",
+    "CppPort",
+    "Unresolved",
+    "link",
+]
+
+FLAG_KIND_UNKNOWN: Final = "kind-unknown"
+FLAG_PORTS_INCOMPLETE: Final = "ports-incomplete"
+FLAG_DEFAULT_EXPRESSION: Final = "default-expression"
+FLAG_DUPLICATE_ID: Final = "duplicate-id"
+# The flags that make a node advisory (a default written as an expression still is one).
+_ADVISORY: Final = frozenset({FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE, FLAG_DUPLICATE_ID})
+
+# BehaviorTree.CPP's base classes (4.x and 3.x names) and the kind each gives.
+LIBRARY_KINDS: Final[dict[str, str]] = {
+    "ActionNodeBase": "Action",
+    "SyncActionNode": "Action",
+    "SimpleActionNode": "Action",
+    "StatefulActionNode": "Action",
+    "CoroActionNode": "Action",
+    "ThreadedAction": "Action",
+    "AsyncActionNode": "Action",
+    "ConditionNode": "Condition",
+    "SimpleConditionNode": "Condition",
+    "ControlNode": "Control",
+    "DecoratorNode": "Decorator",
+    "SimpleDecoratorNode": "Decorator",
+}
+_MAX_DEPTH: Final = 16
+
+
+@dataclass(frozen=True, slots=True)
+class CppPort:
+    """A port as the C++ declares it; ``span`` is its name argument's."""
+
+    name: str
+    direction: str
+    type: str
+    default: str | None
+    description: str
+    path: str
+    span: Span
+    default_is_expr: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class CppNode:
+    """A registered node type.
+
+    ``kind`` is ``None`` when the base class could not be followed to BehaviorTree.CPP's.
+    ``flags`` say what the reading could not know (``notes`` say why, for people);
+    ``authoritative`` is true when there is no advisory flag.
+    """
+
+    id: str
+    kind: str | None
+    cls: str | None
+    ports: tuple[CppPort, ...]
+    flags: tuple[str, ...]
+    notes: tuple[str, ...]
+    form: str
+    path: str
+    id_span: Span
+    class_path: str | None = None
+    class_span: Span | None = None
+
+    @property
+    def authoritative(self) -> bool:
+        return not any(f in _ADVISORY for f in self.flags)
+
+    def port(self, name: str) -> CppPort | None:
+        for p in self.ports:
+            if p.name == name:
+                return p
+        return None
+
+
+class Unresolved(NamedTuple):
+    """A registration whose ID is not a literal or a known constant."""
+
+    path: str
+    span: Span
+    form: str
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class Catalog:
+    nodes: tuple[CppNode, ...] = ()
+    unresolved: tuple[Unresolved, ...] = ()
+    by_id: dict[str, CppNode] = field(default_factory=dict)
+    missing: frozenset[str] = frozenset()
+
+
+class _Class(NamedTuple):
+    path: str
+    facts: ClassFacts
+
+
+class _Lib(NamedTuple):
+    kind: str
+
+
+_Resolved = tuple[_Class | _Lib | None, dict[str, str]]
+
+
+class _Ports:
+    """A port list being built: first key wins, reasons for what is missing."""
+
+    def __init__(self) -> None:
+        self.ports: dict[str, CppPort] = {}
+        self.missing: list[str] = []
+
+    def add(self, p: CppPort) -> None:
+        self.ports.setdefault(p.name, p)
+
+    def merge(self, other: _Ports) -> None:
+        for p in other.ports.values():
+            self.add(p)
+        self.missing.extend(other.missing)
+
+
+def link(
+    files: Iterable[tuple[str, FileFacts]], library: Iterable[tuple[str, FileFacts]] = ()
+) -> Catalog:
+    """The catalog of the nodes registered in ``files``.
+
+    ``library`` files (known bases of libraries that are not in the sources) resolve
+    classes after the project's own and never register anything.
+    """
+    return _Linker(list(files), list(library)).run()
+
+
+class _Linker:
+    def __init__(
+        self, files: list[tuple[str, FileFacts]], library: list[tuple[str, FileFacts]]
+    ) -> None:
+        self.files = files
+        self.classes: dict[str, list[_Class]] = {}
+        self.fns: dict[tuple[str, str], list[tuple[str, PortsFn]]] = {}
+        self.file_constants: dict[str, dict[str, str]] = {}
+        self.constants: dict[str, str] = {}
+        self.macros: dict[str, MacroTemplate] = {}
+        # Class and constant names looked up and not found: the project layer reads the
+        # files that may define them (lazily: most files declare no node) and links again.
+        self.missing: set[str] = set()
+        for path, f in [*files, *library]:
+            for c in f.classes:
+                self.classes.setdefault(c.name, []).append(_Class(path, c))
+            for fn in f.fns:
+                key = (last_name(fn.owner), fn.name)
+                self.fns.setdefault(key, []).append((path, fn))
+            self.file_constants[path] = f.constants
+            for k, v in f.constants.items():
+                self.constants.setdefault(k, v)
+            for m in f.macros:
+                self.macros.setdefault(m.name, m)
+
+    # --- registrations -----------------------------------------------------------------
+
+    def run(self) -> Catalog:
+        nodes: list[CppNode] = []
+        unresolved: list[Unresolved] = []
+        by_id: dict[str, CppNode] = {}
+        for path, f in self.files:
+            for reg in self._registrations(f):
+                id_ = reg.id if reg.id is not None else self._constant(reg.id_ref or "", None, path)
+                if id_ is None:
+                    unresolved.append(Unresolved(path, reg.id_span, reg.form, reg.id_ref or ""))
+                    continue
+                node = self._node(path, reg, id_)
+                first = by_id.get(id_)
+                if first is not None:
+                    note = f"ID {id_!r} is also registered at {_where(first.path, first.id_span)}"
+                    node = _with_flag(node, FLAG_DUPLICATE_ID, note)
+                    by_id[id_] = _with_flag(
+                        first,
+                        FLAG_DUPLICATE_ID,
+                        f"ID {id_!r} is also registered at {_where(path, reg.id_span)}",
+                    )
+                    nodes[nodes.index(first)] = by_id[id_]
+                else:
+                    by_id[id_] = node
+                nodes.append(node)
+        return Catalog(tuple(nodes), tuple(unresolved), by_id, frozenset(self.missing))
+
+    def _registrations(self, f: FileFacts) -> list[Registration]:
+        regs = list(f.registrations)
+        for call in f.macro_calls:
+            m = self.macros.get(call.name)
+            if m is None or len(call.args) != len(m.params) or m.cls_param >= len(call.args):
+                continue
+            cls = call.args[m.cls_param]
+            if m.id_param >= 0:
+                arg = call.args[m.id_param]
+                span = call.arg_spans[m.id_param]
+                if m.stringify:
+                    id_, ref = arg, None
+                elif arg.startswith('"'):
+                    id_, ref = arg[1:-1], None
+                else:
+                    id_, ref = None, arg
+            else:
+                id_, ref, span = m.id_literal, None, call.span
+            regs.append(Registration(m.name, id_, ref, span, cls, None, None, call.span))
+        return regs
+
+    def _node(self, path: str, reg: Registration, id_: str) -> CppNode:
+        flags: list[str] = []
+        notes: list[str] = []
+        kind = reg.kind
+        cls_name: str | None = None
+        class_path: str | None = None
+        class_span: Span | None = None
+        ports = _Ports()
+        if reg.cls is None:
+            self._eval(reg.ops or (), None, {}, path, ports, None, 0)
+        else:
+            target, subst = self._resolve(reg.cls, None, path)
+            if isinstance(target, _Class):
+                cls_name = target.facts.qualname
+                class_path, class_span = target.path, target.facts.span
+                kind, why = self._kind(target, 0)
+                if kind is None:
+                    flags.append(FLAG_KIND_UNKNOWN)
+                    notes.append(why)
+                if reg.ops is not None:
+                    self._eval(reg.ops, target, subst, path, ports, None, 0)
+                else:
+                    ports.merge(self._ports_of(target, subst, 0))
+            elif isinstance(target, _Lib):
+                kind = target.kind
+                cls_name = reg.cls
+            else:
+                cls_name = reg.cls
+                flags += [FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE]
+                notes.append(f"class {reg.cls} is not in the sources read")
+        if ports.missing and FLAG_PORTS_INCOMPLETE not in flags:
+            flags.append(FLAG_PORTS_INCOMPLETE)
+            notes.extend(dict.fromkeys(ports.missing))
+        if any(p.default_is_expr for p in ports.ports.values()):
+            flags.append(FLAG_DEFAULT_EXPRESSION)
+            notes.append(
+                "a default is an expression: its value is known only when the program runs"
+            )
+        return CppNode(
+            id_,
+            kind,
+            cls_name,
+            tuple(ports.ports.values()),
+            tuple(flags),
+            tuple(notes),
+            reg.form,
+            path,
+            reg.id_span,
+            class_path,
+            class_span,
+        )
+
+    # --- classes -----------------------------------------------------------------------
+
+    def _resolve(self, ref: str, ctx: _Class | None, path: str, depth: int = 0) -> _Resolved:
+        """The class ``ref`` names (as written, maybe with template arguments)."""
+        ref = ref.strip().removeprefix("typename ").removeprefix("class ").strip()
+        base = strip_args(ref)
+        if ctx is not None and depth < _MAX_DEPTH:
+            first = base.split("::", 1)[0]
+            alias = ctx.facts.aliases.get(first)
+            if alias is not None and alias != ref:
+                return self._resolve(alias, None, path, depth + 1)
+        last = last_name(base)
+        cands = self.classes.get(last, [])
+        if last in LIBRARY_KINDS:  # BehaviorTree.CPP's own bases end every lineage
+            return _Lib(LIBRARY_KINDS[last]), {}
+        if not cands:
+            self.missing.add(last)
+            return None, {}
+        chosen = self._choose(cands, base, ctx, path)
+        args = _args_of_last(ref)
+        params = chosen.facts.template_params
+        subst = dict(zip(params, args, strict=False)) if args else {}
+        return chosen, subst
+
+    def _choose(self, cands: list[_Class], base: str, ctx: _Class | None, path: str) -> _Class:
+        if len(cands) == 1:
+            return cands[0]
+        if "::" in base:
+            exact = [c for c in cands if ("::" + c.facts.qualname).endswith("::" + base)]
+            if exact:
+                cands = exact
+        if ctx is not None:
+            ns = ctx.facts.qualname.rsplit("::", 1)[0] if "::" in ctx.facts.qualname else ""
+            same = [c for c in cands if c.facts.qualname.rsplit("::", 1)[0] == ns]
+            if same:
+                cands = same
+        same_file = [c for c in cands if c.path == path]
+        return (same_file or cands)[0]
+
+    def _lineage(self, cls: _Class, depth: int) -> tuple[_Class | _Lib | None, dict[str, str], str]:
+        """The base through which ``cls`` descends from a BehaviorTree.CPP node class."""
+        unknown: list[str] = []
+        for b in cls.facts.bases:
+            target, subst = self._resolve(b, cls, cls.path)
+            if isinstance(target, _Lib):
+                return target, subst, ""
+            if isinstance(target, _Class) and target.facts is not cls.facts and depth < _MAX_DEPTH:
+                k, _ = self._kind(target, depth + 1)
+                if k is not None:
+                    return target, subst, ""
+                unknown.append(b)
+            elif target is None:
+                unknown.append(b)
+        if not cls.facts.bases:
+            return None, {}, f"class {cls.facts.qualname} has no base class"
+        bases = ", ".join(unknown) or cls.facts.bases[0]
+        return None, {}, f"base class {bases} of {cls.facts.qualname} is not in the sources read"
+
+    def _kind(self, cls: _Class, depth: int) -> tuple[str | None, str]:
+        if depth > _MAX_DEPTH:
+            return None, "base classes nest too deep"
+        target, _, why = self._lineage(cls, depth)
+        if isinstance(target, _Lib):
+            return target.kind, ""
+        if isinstance(target, _Class):
+            return self._kind(target, depth + 1)
+        return None, why
+
+    def _fn(self, cls: _Class, name: str) -> tuple[str, PortsFn] | None:
+        found = self.fns.get((cls.facts.name, name), [])
+        q = cls.facts.qualname
+        for path, fn in found:
+            if fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q):
+                return path, fn
+        return None
+
+    def _ports_of(self, cls: _Class, subst: dict[str, str], depth: int) -> _Ports:
+        """What ``cls::providedPorts()`` returns."""
+        out = _Ports()
+        if depth > _MAX_DEPTH:
+            out.missing.append("base classes nest too deep")
+            return out
+        own = self._fn(cls, "providedPorts")
+        if own is not None:
+            self._eval(own[1].ops, cls, subst, own[0], out, None, depth)
+            return out
+        if cls.facts.using_ports:
+            target, s2 = self._resolve(cls.facts.using_ports, cls, cls.path)
+            self._ports_from(target, _compose(s2, subst), out, cls.facts.using_ports, depth)
+            return out
+        target, s2, why = self._lineage(cls, depth)
+        if target is None:
+            out.missing.append(why)
+            return out
+        self._ports_from(target, _compose(s2, subst), out, "", depth)
+        return out
+
+    def _ports_from(
+        self, target: _Class | _Lib | None, subst: dict[str, str], out: _Ports, ref: str, depth: int
+    ) -> None:
+        if isinstance(target, _Class):
+            out.merge(self._ports_of(target, subst, depth + 1))
+        elif target is None:
+            out.missing.append(f"{ref}::providedPorts() is not in the sources read")
+
+    def _basic(
+        self, cls: _Class | None, ref: str, depth: int
+    ) -> tuple[_Class, tuple[str, PortsFn], dict[str, str]] | None:
+        """The ``providedBasicPorts`` that a call in ``cls`` reaches, with its substitution."""
+        start: _Class | None = cls
+        subst: dict[str, str] = {}
+        if ref and cls is not None:
+            t, subst = self._resolve(ref, cls, cls.path)
+            start = t if isinstance(t, _Class) else None
+        cur = start
+        for _ in range(_MAX_DEPTH):
+            if cur is None:
+                return None
+            fn = self._fn(cur, "providedBasicPorts")
+            if fn is not None:
+                return cur, fn, subst
+            target, s2, _ = self._lineage(cur, depth)
+            if not isinstance(target, _Class):
+                return None
+            subst = _compose(s2, subst)
+            cur = target
+        return None
+
+    # --- port lists --------------------------------------------------------------------
+
+    def _eval(
+        self,
+        ops: Sequence[Op],
+        cls: _Class | None,
+        subst: dict[str, str],
+        path: str,
+        out: _Ports,
+        arg: _Ports | None,
+        depth: int,
+    ) -> None:
+        for op in ops:
+            if op.kind == "port" and op.port is not None:
+                p = self._port(op.port, cls, subst, path)
+                if p is None:
+                    out.missing.append(f"port name {op.port.name_ref} is not a known constant")
+                else:
+                    out.add(p)
+            elif op.kind == "ref":
+                if cls is None:
+                    out.missing.append(f"{op.ref}::providedPorts() is not in the sources read")
+                elif not op.ref:
+                    target, s2, why = self._lineage(cls, depth)
+                    if target is None:
+                        out.missing.append(why)
+                    self._ports_from(target, _compose(s2, subst), out, cls.facts.qualname, depth)
+                else:
+                    target, s2 = self._resolve(op.ref, cls, path)
+                    if isinstance(target, _Class) and target.facts is cls.facts:
+                        target, s2, _ = self._lineage(cls, depth)
+                    self._ports_from(target, _compose(s2, subst), out, op.ref, depth)
+            elif op.kind == "basic":
+                inner = _Ports()
+                self._eval(op.ops, cls, subst, path, inner, arg, depth)
+                found = self._basic(cls, op.ref, depth) if depth < _MAX_DEPTH else None
+                if found is None:
+                    out.merge(inner)
+                    owner = op.ref or (cls.facts.qualname if cls else "")
+                    out.missing.append(
+                        f"providedBasicPorts() of a base of {owner} is not in the sources read"
+                    )
+                else:
+                    bcls, (bpath, fn), s2 = found
+                    self._eval(fn.ops, bcls, _compose(s2, subst), bpath, out, inner, depth + 1)
+            elif op.kind == "param":
+                if arg is not None:
+                    out.merge(arg)
+            else:
+                out.missing.append(f"cannot read {op.ref!r} statically")
+
+    def _port(
+        self, p: PortFacts, cls: _Class | None, subst: dict[str, str], path: str
+    ) -> CppPort | None:
+        name = p.name if p.name is not None else self._constant(p.name_ref or "", cls, path)
+        if name is None:
+            return None
+        type_ = _substitute(p.type, subst) if p.type is not None else "AnyTypeAllowed"
+        return CppPort(
+            name, p.direction, type_, p.default, p.description, path, p.name_span, p.default_is_expr
+        )
+
+    def _constant(self, ref: str, cls: _Class | None, path: str) -> str | None:
+        """The value of the string constant ``ref`` as seen from ``cls`` in ``path``."""
+        if not ref or not re.fullmatch(r"[A-Za-z_][\w:]*", ref):
+            return None
+        if "::" in ref:
+            scope, name = ref.rsplit("::", 1)
+            target, _ = self._resolve(scope, cls, path)
+            if isinstance(target, _Class) and name in target.facts.constants:
+                return target.facts.constants[name]
+            return self.constants.get(name)
+        seen = 0
+        cur: _Class | None = cls
+        while cur is not None and seen < _MAX_DEPTH:
+            if ref in cur.facts.constants:
+                return cur.facts.constants[ref]
+            nxt: _Class | None = None
+            for b in cur.facts.bases:
+                t, _ = self._resolve(b, cur, cur.path)
+                if isinstance(t, _Class) and t.facts is not cur.facts:
+                    nxt = t
+                    break
+            cur = nxt
+            seen += 1
+        own = self.file_constants.get(path, {})
+        if ref in own:
+            return own[ref]
+        if ref not in self.constants:
+            self.missing.add(ref)
+        return self.constants.get(ref)
+
+
+def _args_of_last(ref: str) -> list[str]:
+    """The template arguments of the last component of ``ref``: ``a::B<int, X>`` -> [int, X]."""
+    ref = ref.strip()
+    if not ref.endswith(">"):
+        return []
+    depth = 0
+    for i in range(len(ref) - 1, -1, -1):
+        ch = ref[i]
+        if ch == ">":
+            depth += 1
+        elif ch == "<":
+            depth -= 1
+            if depth == 0:
+                return [a.strip() for a in split_top(ref[i + 1 : -1])]
+    return []
+
+
+def _substitute(text: str, subst: dict[str, str]) -> str:
+    if not subst:
+        return text
+    pattern = re.compile(r"\b(" + "|".join(map(re.escape, subst)) + r")\b")
+    return pattern.sub(lambda m: subst[m.group(1)], text)
+
+
+def _compose(inner: dict[str, str], outer: dict[str, str]) -> dict[str, str]:
+    """Substitution ``inner`` (a base's parameters) with ``outer`` applied to its values.
+
+    An empty ``inner`` is the same class (or a base without parameters): ``outer`` stays.
+    """
+    if not inner:
+        return dict(outer)
+    return {k: _substitute(v, outer) for k, v in inner.items()} if outer else dict(inner)
+
+
+def _where(path: str, span: Span) -> str:
+    return f"{path}:{span[0] + 1}"
+
+
+def _with_flag(node: CppNode, flag: str, note: str) -> CppNode:
+    if flag in node.flags:
+        return node
+    return CppNode(
+        node.id,
+        node.kind,
+        node.cls,
+        node.ports,
+        (*node.flags, flag),
+        (*node.notes, note),
+        node.form,
+        node.path,
+        node.id_span,
+        node.class_path,
+        node.class_span,
+    )

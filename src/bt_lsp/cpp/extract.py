@@ -1,0 +1,664 @@
+"""One C++ file's node facts, read from its tree-sitter syntax tree.
+
+No preprocessor and nothing compiled: a query finds the few places that matter (the
+registering calls, ``providedPorts``/``providedBasicPorts`` definitions, classes, string
+constants, registering macros), and only those are walked in Python, which keeps the cost
+close to tree-sitter's own parse.  Whatever a form does not match is kept as an
+``unknown`` step, so the catalog can say that a port list is incomplete instead of
+guessing.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from functools import cache
+from typing import Final
+
+import tree_sitter
+import tree_sitter_cpp
+
+from bt_lsp.cpp.facts import (
+    ClassFacts,
+    FileFacts,
+    MacroCall,
+    MacroTemplate,
+    Op,
+    PortFacts,
+    PortsFn,
+    Registration,
+    Span,
+)
+from bt_lsp.cpp.names import last_name, split_top, squash, strip_args, unescape
+
+Node = tree_sitter.Node
+
+_PORT_FUNCTIONS: Final = {
+    "InputPort": "input",
+    "OutputPort": "output",
+    "BidirectionalPort": "inout",
+}
+_TEMPLATE_REGISTRARS: Final = frozenset({"registerNodeType", "registerBuilder"})
+_SIMPLE_REGISTRARS: Final = {
+    "registerSimpleAction": "Action",
+    "registerSimpleCondition": "Condition",
+    "registerSimpleDecorator": "Decorator",
+}
+_KEYWORDS: Final = (
+    b"providedPorts",
+    b"providedBasicPorts",
+    b"register",
+    b"BT_REGISTER",
+    b"CreateRosNodePlugin",
+    b"CreateManifest",
+)
+
+_QUERY_SOURCE: Final = """
+((field_identifier) @callee
+  (#any-of? @callee "registerNodeType" "registerBuilder" "registerSimpleAction"
+     "registerSimpleCondition" "registerSimpleDecorator" "providedPorts" "providedBasicPorts"))
+((identifier) @callee
+  (#any-of? @callee "registerNodeType" "registerBuilder" "registerSimpleAction"
+     "registerSimpleCondition" "registerSimpleDecorator" "providedPorts" "providedBasicPorts"
+     "CreateManifest" "registerBehavior"))
+(class_specifier name: (_) body: (field_declaration_list)) @class
+(struct_specifier name: (_) body: (field_declaration_list)) @class
+(preproc_function_def) @macro
+(preproc_def name: (identifier) value: (preproc_arg)) @define
+(translation_unit (declaration) @const)
+(namespace_definition body: (declaration_list (declaration) @const))
+"""
+
+# Invocations of macros that may register nodes (ALL_CAPS names, or names that say so),
+# with one or two arguments: a type and maybe a string.  Found in the text, because a
+# macro invoked without a trailing semicolon parses as anything.
+_MACRO_CALL: Final = re.compile(
+    rb"\b([A-Z][A-Z0-9_]{2,}|\w*(?:[Rr]egist|Plugin)\w*)[ \t]*\([ \t\r\n]*"
+    rb"([A-Za-z_][\w:]*(?:<[^()<>;\n]*>)?)[ \t]*"
+    rb"(?:,[ \t\r\n]*(\"(?:[^\"\\\n]|\\.)*\"|[A-Za-z_][\w:]*))?[ \t\r\n]*\)"
+)
+_MACRO_BODY: Final = re.compile(
+    r"(registerNodeType|registerBuilder)\s*<\s*([A-Za-z_]\w*)\s*>\s*\(\s*"
+    r"(?:#\s*([A-Za-z_]\w*)|([A-Za-z_]\w*)|\"((?:[^\"\\]|\\.)*)\")"
+)
+
+
+@cache
+def _language() -> tree_sitter.Language:
+    return tree_sitter.Language(tree_sitter_cpp.language())
+
+
+@cache
+def _query() -> tree_sitter.Query:
+    return tree_sitter.Query(_language(), _QUERY_SOURCE)
+
+
+def parser() -> tree_sitter.Parser:
+    """A C++ parser (one per caller: tree-sitter parsers are not shared across threads)."""
+    return tree_sitter.Parser(_language())
+
+
+def may_declare_nodes(source: bytes) -> bool:
+    """Whether ``source`` can hold a registration or a port list (a cheap text test)."""
+    return any(k in source for k in _KEYWORDS)
+
+
+def extract(source: bytes, parser_: tree_sitter.Parser | None = None) -> FileFacts:
+    """The node facts of one C++ file's text."""
+    tree = (parser_ or parser()).parse(source)
+    return _Reader(source).read(tree.root_node)
+
+
+class _Reader:
+    def __init__(self, source: bytes) -> None:
+        self.src = source
+        self.ascii = source.isascii()
+        self.classes: list[ClassFacts] = []
+        self.fns: list[PortsFn] = []
+        self.regs: list[Registration] = []
+        self.macros: list[MacroTemplate] = []
+        self.constants: dict[str, str] = {}
+        self._seen_calls: set[int] = set()
+
+    # --- text and positions ------------------------------------------------------------
+
+    def text(self, n: Node) -> str:
+        return self.src[n.start_byte : n.end_byte].decode("utf-8", "replace")
+
+    def _col(self, byte: int, point_col: int) -> int:
+        if self.ascii:
+            return point_col
+        line_start = byte - point_col
+        return len(self.src[line_start:byte].decode("utf-8", "replace"))
+
+    def span(self, n: Node) -> Span:
+        s, e = n.start_point, n.end_point
+        return (s[0], self._col(n.start_byte, s[1]), e[0], self._col(n.end_byte, e[1]))
+
+    def _span_of_bytes(self, start: int, end: int) -> Span:
+        def point(b: int) -> tuple[int, int]:
+            line = self.src.count(b"\n", 0, b)
+            ls = self.src.rfind(b"\n", 0, b) + 1
+            return line, len(self.src[ls:b].decode("utf-8", "replace"))
+
+        return (*point(start), *point(end))
+
+    # --- the file ----------------------------------------------------------------------
+
+    def read(self, root: Node) -> FileFacts:
+        cursor = tree_sitter.QueryCursor(_query())
+        caps = cursor.captures(root)
+        for n in caps.get("define", ()):
+            self._define(n)
+        for n in caps.get("macro", ()):
+            self._macro(n)
+        for n in caps.get("const", ()):
+            self._file_constant(n)
+        for n in caps.get("class", ()):
+            self._class(n)
+        for n in caps.get("callee", ()):
+            self._callee(n)
+        calls = tuple(self._macro_calls(root)) if self.src.find(b"(") >= 0 else ()
+        return FileFacts(
+            tuple(self.classes),
+            tuple(self.fns),
+            tuple(sorted(self.regs, key=lambda r: r.span)),
+            tuple(self.macros),
+            calls,
+            self.constants,
+        )
+
+    # --- constants ---------------------------------------------------------------------
+
+    def _define(self, n: Node) -> None:
+        name, value = n.child_by_field_name("name"), n.child_by_field_name("value")
+        if name is None or value is None:
+            return
+        v = self.text(value).strip()
+        if len(v) >= 2 and v[0] == '"' and v[-1] == '"':
+            self.constants[self.text(name)] = unescape(v[1:-1])
+
+    def _string_constant(self, decl: Node) -> tuple[str, str] | None:
+        """``name, value`` of a declaration of one string constant, else ``None``."""
+        if "const" not in self.text(decl).split("=", 1)[0] and decl.type != "preproc_def":
+            return None
+        for d in decl.children_by_field_name("declarator"):
+            value = d.child_by_field_name("value") if d.type == "init_declarator" else None
+            target = d.child_by_field_name("declarator") if d.type == "init_declarator" else d
+            if value is None:
+                value = decl.child_by_field_name("default_value")
+            if value is not None and value.type in ("initializer_list", "argument_list"):
+                inner = value.named_children
+                value = inner[0] if len(inner) == 1 else None
+            if value is None or target is None:
+                continue
+            s = self.string(value)
+            name = _declared_name(target)
+            if s is not None and name is not None:
+                return self.text(name), s
+        return None
+
+    def _file_constant(self, n: Node) -> None:
+        c = self._string_constant(n)
+        if c is not None:
+            self.constants.setdefault(c[0], c[1])
+
+    # --- strings -----------------------------------------------------------------------
+
+    def string(self, n: Node) -> str | None:
+        """The value of a string literal (or concatenation of them), else ``None``."""
+        if n.type == "string_literal":
+            out: list[str] = []
+            for c in n.named_children:
+                if c.type == "string_content":
+                    out.append(self.text(c))
+                elif c.type == "escape_sequence":
+                    out.append(unescape(self.text(c)))
+            return "".join(out)
+        if n.type == "raw_string_literal":
+            for c in n.named_children:
+                if c.type == "raw_string_content":
+                    return self.text(c)
+            return ""
+        if n.type == "concatenated_string":
+            parts = [self.string(c) for c in n.named_children]
+            if any(p is None for p in parts):
+                return None
+            return "".join(p for p in parts if p is not None)
+        if n.type == "call_expression":  # std::string("x"), BT::StringView{"x"}
+            fn = n.child_by_field_name("function")
+            args = n.child_by_field_name("arguments")
+            if fn is not None and args is not None and self.text(fn) in _STRING_TYPES:
+                a = args.named_children
+                if len(a) == 1:
+                    return self.string(a[0])
+        return None
+
+    # --- classes -----------------------------------------------------------------------
+
+    def _class(self, n: Node) -> None:
+        name_node = n.child_by_field_name("name")
+        body = n.child_by_field_name("body")
+        if name_node is None or body is None:
+            return
+        name = strip_args(self.text(name_node))
+        qual = "::".join([*self._scopes(n), name])
+        bases: list[str] = []
+        for c in n.named_children:
+            if c.type == "base_class_clause":
+                bases.extend(
+                    squash(self.text(b))
+                    for b in c.named_children
+                    if b.type not in ("access_specifier", "comment", "virtual")
+                )
+        params: tuple[str, ...] = ()
+        parent = n.parent
+        if parent is not None and parent.type == "template_declaration":
+            plist = parent.child_by_field_name("parameters")
+            if plist is not None:
+                params = tuple(p for p in map(self._template_param, plist.named_children) if p)
+        using_ports: str | None = None
+        aliases: dict[str, str] = {}
+        constants: dict[str, str] = {}
+        for m in body.named_children:
+            if m.type == "using_declaration":
+                t = self.text(m)
+                if "providedPorts" in t:
+                    target = t.removeprefix("using").strip().rstrip(";").strip()
+                    using_ports = squash(target.rsplit("::", 1)[0])
+            elif m.type == "alias_declaration":
+                an, at = m.child_by_field_name("name"), m.child_by_field_name("type")
+                if an is not None and at is not None:
+                    aliases[self.text(an)] = squash(self.text(at))
+            elif m.type in ("field_declaration", "declaration"):
+                kv = self._string_constant(m)
+                if kv is not None:
+                    constants[kv[0]] = kv[1]
+        self.classes.append(
+            ClassFacts(
+                name,
+                qual,
+                self.span(name_node),
+                tuple(bases),
+                params,
+                using_ports,
+                aliases,
+                constants,
+            )
+        )
+
+    def _template_param(self, p: Node) -> str | None:
+        for c in p.named_children:
+            if c.type in ("type_identifier", "identifier"):
+                return self.text(c)
+        return None
+
+    def _scopes(self, n: Node) -> list[str]:
+        """The namespaces and classes enclosing ``n``, outermost first."""
+        out: list[str] = []
+        p = n.parent
+        while p is not None:
+            if p.type in ("namespace_definition", "class_specifier", "struct_specifier"):
+                nm = p.child_by_field_name("name")
+                if nm is not None:
+                    out.append(strip_args(self.text(nm)))
+            p = p.parent
+        out.reverse()
+        return out
+
+    # --- calls and definitions ---------------------------------------------------------
+
+    def _callee(self, ident: Node) -> None:
+        name = self.text(ident)
+        if name in ("providedPorts", "providedBasicPorts"):
+            self._ports_fn(ident, name)
+            return
+        call = _enclosing_call(ident)
+        if call is None or call.id in self._seen_calls:
+            return
+        self._seen_calls.add(call.id)
+        args_node = call.child_by_field_name("arguments")
+        if args_node is None:
+            return
+        args = [a for a in args_node.named_children if a.type != "comment"]
+        targs = _template_args(call.child_by_field_name("function"))
+        if name in _TEMPLATE_REGISTRARS and targs:
+            if args:
+                self._registration(name, args[0], targs[0], None, None, call)
+        elif name == "registerBuilder" and args and args[0].type == "call_expression":
+            manifest = args[0]
+            mf = manifest.child_by_field_name("function")
+            margs_node = manifest.child_by_field_name("arguments")
+            mt = _template_args(mf)
+            if mf is None or margs_node is None or not mt or "CreateManifest" not in self.text(mf):
+                return
+            margs = margs_node.named_children
+            if margs:
+                ops = self.ports_expr(margs[1], {}) if len(margs) > 1 else None
+                self._registration("CreateManifest", margs[0], mt[0], None, ops, call)
+        elif name in _SIMPLE_REGISTRARS and args:
+            ops = self.ports_expr(args[2], {}) if len(args) > 2 else ()
+            self._registration(name, args[0], None, _SIMPLE_REGISTRARS[name], ops, call)
+        elif name == "registerBehavior" and targs and len(args) >= 2:
+            self._registration(name, args[1], targs[0], None, None, call)
+
+    def _registration(
+        self,
+        form: str,
+        id_node: Node,
+        cls: str | None,
+        kind: str | None,
+        ops: tuple[Op, ...] | None,
+        call: Node,
+    ) -> None:
+        value = self.string(id_node)
+        ref = None if value is not None else squash(self.text(id_node))
+        self.regs.append(
+            Registration(form, value, ref, self.span(id_node), cls, kind, ops, self.span(call))
+        )
+
+    def _ports_fn(self, ident: Node, name: str) -> None:
+        decl = ident.parent
+        owner_parts: list[str] = []
+        if decl is not None and decl.type == "qualified_identifier":
+            scope = decl.child_by_field_name("scope")
+            if scope is not None:
+                owner_parts.append(strip_args(self.text(scope)))
+            while decl is not None and decl.type == "qualified_identifier":
+                decl = decl.parent
+        if decl is None or decl.type != "function_declarator":
+            return
+        fn = decl.parent
+        while fn is not None and fn.type in ("pointer_declarator", "reference_declarator"):
+            fn = fn.parent
+        if fn is None or fn.type != "function_definition":
+            return
+        body = fn.child_by_field_name("body")
+        if body is None:
+            return
+        scopes = self._scopes(fn)
+        owner = "::".join([*scopes, *owner_parts]) if owner_parts or scopes else ""
+        if not owner:
+            return
+        param: str | None = None
+        params = decl.child_by_field_name("parameters")
+        if params is not None:
+            for p in params.named_children:
+                d = p.child_by_field_name("declarator")
+                if d is not None:
+                    nm = _declared_name(d)
+                    param = self.text(nm) if nm is not None else None
+        self.fns.append(PortsFn(owner, name, param, self.ports_body(body, param), self.span(fn)))
+
+    # --- port lists --------------------------------------------------------------------
+
+    def ports_body(self, body: Node, param: str | None) -> tuple[Op, ...]:
+        """The steps of a ``providedPorts`` body: locals, ``insert``/``emplace``, ``return``."""
+        local: dict[str, list[Op]] = {}
+        if param:
+            local[param] = [Op("param")]
+        result: tuple[Op, ...] | None = None
+        extra: list[Op] = []
+        for st in body.named_children:
+            t = st.type
+            if t == "comment":
+                continue
+            if t == "declaration":
+                for d in st.children_by_field_name("declarator"):
+                    if d.type == "init_declarator":
+                        target = d.child_by_field_name("declarator")
+                        value = d.child_by_field_name("value")
+                        if target is not None and value is not None:
+                            if value.type == "argument_list":
+                                inner = value.named_children
+                                ops = (
+                                    self.ports_expr(inner[0], local)
+                                    if len(inner) == 1
+                                    else ((Op("unknown", ref=self.text(value)),) if inner else ())
+                                )
+                            else:
+                                ops = self.ports_expr(value, local)
+                            local[self.text(target)] = list(ops)
+                    elif d.type == "identifier":
+                        local[self.text(d)] = []
+                continue
+            if t == "expression_statement" and st.named_children:
+                e = st.named_children[0]
+                if e.type == "call_expression" and self._insert(e, local):
+                    continue
+                extra.append(Op("unknown", ref=squash(self.text(st))))
+                continue
+            if t == "return_statement":
+                vals = st.named_children
+                result = self.ports_expr(vals[0], local) if vals else ()
+                break
+            extra.append(Op("unknown", ref=squash(self.text(st))[:80]))
+        if result is None:
+            return (*extra, Op("unknown", ref="no return of a port list"))
+        return (*extra, *result)
+
+    def _insert(self, call: Node, local: dict[str, list[Op]]) -> bool:
+        fn = call.child_by_field_name("function")
+        args_node = call.child_by_field_name("arguments")
+        if fn is None or args_node is None or fn.type != "field_expression":
+            return False
+        obj, field = fn.child_by_field_name("argument"), fn.child_by_field_name("field")
+        if obj is None or field is None or self.text(field) not in ("insert", "emplace"):
+            return False
+        target = local.get(self.text(obj))
+        if target is None:
+            return False
+        args = args_node.named_children
+        if len(args) == 2 and self.text(args[0]).endswith(".begin()"):
+            src = self.text(args[0])[: -len(".begin()")]
+            target.extend(
+                local.get(src, [Op("unknown", ref=src)]) if src in local else self._range(src)
+            )
+        elif len(args) == 1:
+            a = args[0]
+            if a.type == "initializer_list" and not self._is_port_call(a):
+                target.extend(self.ports_expr(a, local))
+            else:
+                target.append(self.port_item(a))
+        else:
+            target.append(Op("unknown", ref=squash(self.text(call))))
+        return True
+
+    def _range(self, src: str) -> list[Op]:
+        if src.endswith("providedPorts()"):
+            return [Op("ref", ref=strip_args(src.rsplit("::", 1)[0]) if "::" in src else "")]
+        return [Op("unknown", ref=src)]
+
+    def _is_port_call(self, n: Node) -> bool:
+        return n.type == "call_expression" and self._port_direction(n) is not None
+
+    def ports_expr(self, n: Node, local: dict[str, list[Op]]) -> tuple[Op, ...]:
+        """The steps of an expression that yields a port list."""
+        t = n.type
+        if t == "initializer_list":
+            return tuple(self.port_item(c) for c in n.named_children if c.type != "comment")
+        if t == "identifier" and self.text(n) in local:
+            return tuple(local[self.text(n)])
+        if t == "compound_literal_expression":
+            value = n.child_by_field_name("value")
+            if value is not None and last_name(self.text(n.child_by_field_name("type") or n)) == (
+                "PortsList"
+            ):
+                return self.ports_expr(value, local)
+        if t == "call_expression":
+            fn = n.child_by_field_name("function")
+            args_node = n.child_by_field_name("arguments")
+            if fn is not None and args_node is not None:
+                fname = strip_args(self.text(fn))
+                last = last_name(fname)
+                args = args_node.named_children
+                if last == "PortsList":
+                    return self.ports_expr(args[0], local) if len(args) == 1 else ()
+                scope = fname.rsplit("::", 1)[0] if "::" in fname else ""
+                if last == "providedPorts" and not args:
+                    return (Op("ref", ref=scope),)
+                if last == "providedBasicPorts" and len(args) <= 1:
+                    inner = self.ports_expr(args[0], local) if args else ()
+                    return (Op("basic", ref=scope, ops=inner),)
+        if t == "parenthesized_expression" and n.named_children:
+            return self.ports_expr(n.named_children[0], local)
+        return (Op("unknown", ref=squash(self.text(n))[:80]),)
+
+    def _port_direction(self, call: Node) -> str | None:
+        fn = call.child_by_field_name("function")
+        if fn is None:
+            return None
+        return _PORT_FUNCTIONS.get(last_name(strip_args(self.text(fn))))
+
+    def port_item(self, n: Node) -> Op:
+        """One element of a port list: a port call, else an unknown step."""
+        if n.type == "call_expression":
+            direction = self._port_direction(n)
+            args_node = n.child_by_field_name("arguments")
+            if direction is not None and args_node is not None:
+                args = [a for a in args_node.named_children if a.type != "comment"]
+                if args:
+                    return Op("port", self._port(n, direction, args))
+        return Op("unknown", ref=squash(self.text(n))[:80])
+
+    def _port(self, call: Node, direction: str, args: list[Node]) -> PortFacts:
+        targs = _template_args(call.child_by_field_name("function"))
+        type_ = targs[0] if targs else None
+        name_node = args[0]
+        name = self.string(name_node)
+        name_ref = None if name is not None else squash(self.text(name_node))
+        default: str | None = None
+        is_expr = False
+        desc_node: Node | None = None
+        if len(args) == 2:
+            desc_node = args[1]
+        elif len(args) >= 3:
+            default, is_expr = self._default(args[1])
+            desc_node = args[2]
+        desc = (self.string(desc_node) if desc_node is not None else "") or ""
+        return PortFacts(
+            direction,
+            type_,
+            name,
+            name_ref,
+            self.span(name_node),
+            default,
+            is_expr,
+            desc,
+            self.span(call),
+        )
+
+    def _default(self, n: Node) -> tuple[str, bool]:
+        s = self.string(n)
+        if s is not None:
+            return s, False
+        text = squash(self.text(n))
+        if n.type in ("number_literal", "true", "false") or (
+            n.type == "unary_expression" and re.fullmatch(r"[-+]\s*[\d.][\w.]*", text)
+        ):
+            return text.replace(" ", ""), False
+        return text, True
+
+    # --- macros ------------------------------------------------------------------------
+
+    def _macro(self, n: Node) -> None:
+        name, params, value = (
+            n.child_by_field_name("name"),
+            n.child_by_field_name("parameters"),
+            n.child_by_field_name("value"),
+        )
+        if name is None or params is None or value is None:
+            return
+        body = self.text(value)
+        m = _MACRO_BODY.search(body)
+        if m is None:
+            return
+        plist = tuple(self.text(p) for p in params.named_children)
+        form, cls_p, str_p, id_p, lit = m.groups()
+        if cls_p not in plist:
+            return
+        id_name = str_p or id_p
+        if id_name is not None and id_name not in plist:
+            return
+        self.macros.append(
+            MacroTemplate(
+                self.text(name),
+                plist,
+                form,
+                plist.index(cls_p),
+                plist.index(id_name) if id_name is not None else -1,
+                str_p is not None,
+                None if lit is None else unescape(lit),
+            )
+        )
+
+    def _macro_calls(self, root: Node) -> Iterator[MacroCall]:
+        for m in _MACRO_CALL.finditer(self.src):
+            name = m.group(1).decode()
+            if name in _SIMPLE_REGISTRARS or name in _TEMPLATE_REGISTRARS:
+                continue
+            at = root.descendant_for_byte_range(m.start(1), m.end(1))
+            if at is None or at.type in ("comment", "string_content", "preproc_arg"):
+                continue
+            p = at.parent
+            if p is not None and p.type in ("preproc_function_def", "preproc_def"):
+                continue
+            groups = [g for g in (2, 3) if m.group(g) is not None]
+            yield MacroCall(
+                name,
+                tuple(m.group(g).decode("utf-8", "replace") for g in groups),
+                tuple(self._span_of_bytes(m.start(g), m.end(g)) for g in groups),
+                self._span_of_bytes(m.start(), m.end()),
+            )
+
+
+_STRING_TYPES: Final = frozenset(
+    {"std::string", "string", "BT::StringView", "StringView", "std::string_view"}
+)
+
+
+def _enclosing_call(ident: Node) -> Node | None:
+    """The call whose function ``ident`` names (through templates, fields, scopes)."""
+    n = ident
+    for _ in range(4):
+        p = n.parent
+        if p is None:
+            return None
+        if p.type == "call_expression":
+            return p if p.child_by_field_name("function") == n else None
+        if p.type not in (
+            "template_method",
+            "template_function",
+            "field_expression",
+            "qualified_identifier",
+        ):
+            return None
+        n = p
+    return None
+
+
+def _template_args(fn: Node | None) -> list[str]:
+    """The template arguments of a called function, as written (squashed)."""
+    if fn is None:
+        return []
+    stack = [fn]
+    while stack:
+        n = stack.pop()
+        if n.type == "template_argument_list":
+            src = n.text or b""
+            inner = src.decode("utf-8", "replace")[1:-1]
+            return [squash(a) for a in split_top(inner)]
+        stack.extend(reversed(n.named_children))
+    return []
+
+
+def _declared_name(d: Node) -> Node | None:
+    """The identifier a declarator declares (through pointers, arrays, references)."""
+    n: Node | None = d
+    while n is not None and n.type not in ("identifier", "field_identifier"):
+        inner = n.child_by_field_name("declarator")
+        if inner is None:
+            named = [c for c in n.named_children if c.type in ("identifier", "field_identifier")]
+            return named[0] if named else None
+        n = inner
+    return n

@@ -1,0 +1,188 @@
+"""Find the project's C++ files, read their node facts (with an on-disk cache) and link them.
+
+The cache holds one JSON file per file content (``sha256`` of the bytes and of the reader's
+version), in ``$XDG_CACHE_HOME/bt-lsp/cpp`` (``~/.cache/bt-lsp/cpp``): written to a
+temporary file and renamed into place, so concurrent processes never see half an entry;
+an entry that does not load is ignored and written again.
+
+Only files that can declare nodes are parsed first (a text test for ``providedPorts``,
+``register`` ...); a base class or constant that the link could not find is then looked
+for in the other files, which are read only when their text names it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import tempfile
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Final
+
+import tree_sitter
+
+from bt_lsp import __version__
+from bt_lsp.cpp.catalog import Catalog, link
+from bt_lsp.cpp.extract import extract, may_declare_nodes, parser
+from bt_lsp.cpp.facts import FileFacts, from_json, to_json
+from bt_lsp.cpp.library import library_facts
+
+CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp"})
+SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules", "__pycache__"})
+# Bumped whenever the facts' shape or meaning changes, so old cache entries are not read.
+_FORMAT: Final = "1"
+_LAZY_ROUNDS: Final = 3
+
+
+def default_cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "bt-lsp" / "cpp"
+
+
+def find_cpp_files(paths: Iterable[str | Path], exclude: Sequence[str] = ()) -> list[Path]:
+    """The C++ files among ``paths`` and under the directories among them, sorted.
+
+    Build, install and log folders (and hidden ones) are skipped, and so is any path that
+    matches one of the ``exclude`` globs (relative to the directory given).
+    """
+    out: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_file():
+            out.append(p)
+            continue
+        for root, dirs, files in os.walk(p):
+            dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.startswith("."))
+            for name in sorted(files):
+                f = Path(root) / name
+                if f.suffix in CPP_SUFFIXES and not _excluded(f, p, exclude):
+                    out.append(f)
+    return sorted(dict.fromkeys(out))
+
+
+def _excluded(f: Path, base: Path, exclude: Sequence[str]) -> bool:
+    if not exclude:
+        return False
+    rel = f.relative_to(base)
+    return any(rel.match(g) or f.match(g) for g in exclude)
+
+
+@dataclass
+class Scanner:
+    """Reads C++ files into facts, keeping each file's facts while its content is the same.
+
+    One per process (the server keeps one for its workspace); ``cache_dir`` ``None``
+    keeps facts in memory only.
+    """
+
+    cache_dir: Path | None = field(default_factory=default_cache_dir)
+    _parser: tree_sitter.Parser = field(default_factory=parser, repr=False)
+    _facts: dict[str, tuple[bytes, FileFacts]] = field(default_factory=dict, repr=False)
+    parsed: int = 0  # files parsed (not found in memory or on disk), for benchmarks and tests
+
+    def facts(self, path: str, data: bytes) -> FileFacts:
+        """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse."""
+        key = hashlib.sha256(_FORMAT.encode() + __version__.encode() + b"\0" + data).digest()
+        kept = self._facts.get(path)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        f = self._load(key)
+        if f is None:
+            f = extract(data, self._parser)
+            self.parsed += 1
+            self._store(key, f)
+        self._facts[path] = (key, f)
+        return f
+
+    def _entry(self, key: bytes) -> Path | None:
+        if self.cache_dir is None:
+            return None
+        h = key.hex()
+        return self.cache_dir / h[:2] / f"{h[2:40]}.json"
+
+    def _load(self, key: bytes) -> FileFacts | None:
+        entry = self._entry(key)
+        if entry is None:
+            return None
+        try:
+            with open(entry, "rb") as fh:
+                return from_json(json.loads(fh.read()))
+        except (OSError, ValueError, TypeError, KeyError, IndexError):
+            return None  # absent or corrupt: read the file again and rewrite it
+
+    def _store(self, key: bytes, f: FileFacts) -> None:
+        entry = self._entry(key)
+        if entry is None:
+            return
+        try:
+            entry.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=entry.parent, prefix=".tmp-", suffix=".json")
+            try:
+                with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                    json.dump(to_json(f), fh, separators=(",", ":"))
+                os.replace(tmp, entry)
+            except BaseException:
+                os.unlink(tmp)
+                raise
+        except OSError:
+            pass  # a cache that cannot be written only costs time
+
+    def forget(self, path: str) -> None:
+        self._facts.pop(path, None)
+
+
+ReadFile = Callable[[Path], bytes | None]
+
+
+def _read(path: Path) -> bytes | None:
+    try:
+        return path.read_bytes()
+    except OSError:
+        return None
+
+
+def scan(
+    files: Sequence[Path],
+    scanner: Scanner | None = None,
+    *,
+    read: ReadFile = _read,
+    progress: Callable[[int, int], None] | None = None,
+) -> Catalog:
+    """The catalog of the nodes registered in ``files``.
+
+    ``read`` gives a file's bytes (the server passes open documents' text); ``progress``
+    is called with (files done, files in all).
+    """
+    sc = scanner or Scanner()
+    texts: dict[str, bytes] = {}
+    for f in files:
+        data = read(f)
+        if data is not None:
+            texts[str(f)] = data
+    eager = [p for p, d in texts.items() if may_declare_nodes(d)]
+    rest = [p for p in texts if p not in set(eager)]
+    read_facts: dict[str, FileFacts] = {}
+    total = len(eager)
+    for i, p in enumerate(eager):
+        read_facts[p] = sc.facts(p, texts[p])
+        if progress is not None:
+            progress(i + 1, total)
+    catalog = link(sorted(read_facts.items()), library_facts())
+    for _ in range(_LAZY_ROUNDS):
+        names = set(catalog.missing)
+        names.update(m.name for f in read_facts.values() for m in f.macros)
+        if not names or not rest:
+            break
+        wanted = re.compile(
+            rb"\b(?:" + b"|".join(re.escape(m.encode()) for m in sorted(names)) + rb")\b"
+        )
+        more = [p for p in rest if wanted.search(texts[p])]
+        if not more:
+            break
+        for p in more:
+            read_facts[p] = sc.facts(p, texts[p])
+        rest = [p for p in rest if p not in set(more)]
+        catalog = link(sorted(read_facts.items()), library_facts())
+    return catalog
