@@ -1,0 +1,349 @@
+"""The tree renderer: what a picture holds, its layout's geometry, and the three outputs."""
+
+from __future__ import annotations
+
+import re
+from xml.sax.saxutils import quoteattr
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from lxml import etree
+
+from bt_lsp.render import (
+    build_picture,
+    find_tree,
+    layout,
+    main_tree,
+    render,
+    to_dot,
+    to_mermaid,
+    to_svg,
+    tree_at,
+    workspace_resolver,
+)
+from bt_lsp.render.picture import MAX_NODES
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
+
+SVG_NS = "{http://www.w3.org/2000/svg}"
+
+SAMPLE = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence name="root seq">
+      <CheckBattery/>
+      <Fallback>
+        <Condition ID="IsDoorOpen" door="{door}"/>
+        <RetryUntilSuccessful num_attempts="3">
+          <Action ID="OpenDoor" name="open &amp; &quot;push&quot;"/>
+        </RetryUntilSuccessful>
+      </Fallback>
+      <SubTree ID="Walk" goal="{goal}"/>
+      <Foo bar="1"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Walk">
+    <Sequence><Action ID="Move" to="{goal}"/><SubTree ID="Walk"/></Sequence>
+  </BehaviorTree>
+  <TreeNodesModel><Condition ID="CheckBattery"/></TreeNodesModel>
+</root>
+"""
+
+
+def _picture(text: str = SAMPLE, **kw: object):  # type: ignore[no-untyped-def]
+    doc = Document(text)
+    tree = main_tree(doc.model)
+    assert tree is not None
+    return doc, build_picture(
+        doc.model, tree, ctx=Context.from_document(doc), diagnostics=analyze(doc), **kw
+    )
+
+
+# -- what is drawn ---------------------------------------------------------------------------
+
+
+def test_nodes_kinds_names_and_spans() -> None:
+    doc, pic = _picture()
+    got = [(n.kind, n.type, n.name) for n in pic.nodes]
+    assert got == [
+        ("tree", "Main", None),
+        ("control", "Sequence", "root seq"),
+        ("condition", "CheckBattery", None),  # declared in the TreeNodesModel
+        ("control", "Fallback", None),
+        ("condition", "IsDoorOpen", None),
+        ("decorator", "RetryUntilSuccessful", None),
+        ("action", "OpenDoor", 'open & "push"'),
+        ("subtree", "Walk", None),
+        ("unknown", "Foo", None),  # neither built in nor declared: drawn neutrally
+    ]
+    seq = pic.nodes[1]
+    assert doc.text[seq.start : seq.end].startswith("<Sequence name=")
+    assert doc.text[seq.start : seq.end].endswith("</Sequence>")
+    assert pic.nodes[7].subtree == "Walk" and not pic.nodes[7].expanded
+
+
+def test_children_in_xml_order_and_parents() -> None:
+    _, pic = _picture()
+    assert pic.nodes[1].children == [2, 3, 7, 8]
+    assert all(pic.nodes[c].parent == n.index for n in pic.nodes for c in n.children)
+
+
+def test_problems_go_to_the_innermost_node() -> None:
+    _doc, pic = _picture()
+    by_type = {n.type: n for n in pic.nodes}
+    assert by_type["Foo"].severity is not None
+    assert any("Foo" in p for p in by_type["Foo"].problems)
+    # The unknown-node hint of OpenDoor is OpenDoor's, not its decorator's or Sequence's.
+    assert any("OpenDoor" in p for p in by_type["OpenDoor"].problems)
+    assert not any("OpenDoor" in p for p in by_type["RetryUntilSuccessful"].problems)
+    assert by_type["Sequence"].severity is None
+
+
+def test_severity_is_the_worst() -> None:
+    text = '<root BTCPP_format="4"><BehaviorTree ID="T"><Inverter><AlwaysSuccess/>'
+    text += "<AlwaysFailure/></Inverter></BehaviorTree></root>"
+    _doc, pic = _picture(text)
+    inv = pic.nodes[1]
+    assert inv.type == "Inverter" and inv.severity == Severity.ERROR
+
+
+def test_expanded_subtree_inlines_and_stops_at_recursion() -> None:
+    _, pic = _picture(expand_subtrees=True)
+    walk = pic.nodes[7]
+    assert walk.expanded
+    inner = [pic.nodes[c] for c in walk.children]
+    assert [n.type for n in inner] == ["Sequence"]
+    calls = [pic.nodes[c] for c in inner[0].children]
+    assert [(n.type, n.recursive, n.expanded) for n in calls] == [
+        ("Move", False, False),
+        ("Walk", True, False),
+    ]
+    # The recursion error of the inner call is on the drawn call.
+    assert calls[1].severity == Severity.ERROR
+
+
+def test_expansion_across_documents() -> None:
+    main = Document(
+        '<root BTCPP_format="4"><include path="b.xml"/><BehaviorTree ID="A">'
+        '<SubTree ID="B"/></BehaviorTree></root>',
+        "/ws/a.xml",
+    )
+    other = Document(
+        '<root BTCPP_format="4"><BehaviorTree ID="B"><AlwaysSuccess/></BehaviorTree></root>',
+        "/ws/b.xml",
+    )
+    ctx = Context.combine(main, [("/ws/b.xml", other, True)], path="/ws/a.xml")
+    resolve = workspace_resolver(main.model, ctx, {"/ws/b.xml": other.model})
+    tree = find_tree(main.model, "A")
+    assert tree is not None
+    pic = build_picture(main.model, tree, ctx=ctx, resolve=resolve, expand_subtrees=True)
+    leaf = pic.nodes[-1]
+    assert (leaf.type, leaf.source) == ("AlwaysSuccess", "/ws/b.xml")
+    assert other.text[leaf.start : leaf.end] == "<AlwaysSuccess/>"
+
+
+def test_expansion_is_bounded() -> None:
+    # Each tree calls the next one twice: 2**20 nodes if inlined in full.
+    trees = [
+        f'<BehaviorTree ID="T{i}"><Sequence><SubTree ID="T{i + 1}"/><SubTree ID="T{i + 1}"/>'
+        "</Sequence></BehaviorTree>"
+        for i in range(20)
+    ]
+    text = f'<root BTCPP_format="4" main_tree_to_execute="T0">{"".join(trees)}</root>'
+    _, pic = _picture(text, expand_subtrees=True)
+    assert pic.truncated and len(pic.nodes) == MAX_NODES
+
+
+def test_ports_on_request() -> None:
+    _, plain = _picture()
+    assert all(not n.ports for n in plain.nodes)
+    _, pic = _picture(ports=True)
+    door = next(n for n in pic.nodes if n.type == "IsDoorOpen")
+    assert [(p.name, p.value, p.is_key) for p in door.ports] == [("door", "{door}", True)]
+    retry = next(n for n in pic.nodes if n.type == "RetryUntilSuccessful")
+    assert [(p.name, p.is_key) for p in retry.ports] == [("num_attempts", False)]
+
+
+def test_tree_at_and_main_tree() -> None:
+    doc = Document(SAMPLE)
+    walk_at = SAMPLE.index('<Action ID="Move"')
+    t = tree_at(doc.model, walk_at)
+    assert t is not None and t.value("ID") == "Walk"
+    t = tree_at(doc.model, SAMPLE.index("<TreeNodesModel>"))
+    assert t is not None and t.value("ID") == "Main"  # outside every tree: the main one
+
+
+# -- layout geometry -------------------------------------------------------------------------
+
+TYPES = [
+    "Sequence",
+    "Fallback",
+    "Parallel",
+    "Inverter",
+    "Repeat",
+    "AlwaysSuccess",
+    "ScriptCondition",
+    "X",
+    "AVeryLongCustomActionNameThatIsWide",
+]
+
+
+@st.composite
+def random_trees(draw: st.DrawFn) -> str:
+    """A random tree (any shape, node widths varying) as BT XML."""
+    n = draw(st.integers(1, 60))
+    parents = [draw(st.integers(0, i)) for i in range(n)]  # node i+1's parent is <= i
+    kids: list[list[int]] = [[] for _ in range(n + 1)]
+    for i, p in enumerate(parents, 1):
+        kids[p].append(i)
+    names = draw(st.lists(st.sampled_from(TYPES), min_size=n + 1, max_size=n + 1))
+    inst = draw(st.lists(st.text("ab <&\"'é😀", max_size=12), min_size=n + 1, max_size=n + 1))
+    out: list[str] = []
+    stack: list[tuple[int, bool]] = [(0, False)]
+    while stack:
+        i, closing = stack.pop()
+        tag = names[i]
+        if closing:
+            out.append(f"</{tag}>")
+            continue
+        attr = f" name={quoteattr(inst[i])}" if inst[i] else ""
+        if not kids[i]:
+            out.append(f"<{tag}{attr}/>")
+            continue
+        out.append(f"<{tag}{attr}>")
+        stack.append((i, True))
+        stack.extend((k, False) for k in reversed(kids[i]))
+    return f'<root BTCPP_format="4"><BehaviorTree ID="T">{"".join(out)}</BehaviorTree></root>'
+
+
+def _overlap(a, b) -> bool:  # type: ignore[no-untyped-def]
+    return a.x < b.x + b.w and b.x < a.x + a.w and a.y < b.y + b.h and b.y < a.y + a.h
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_trees(), st.booleans())
+def test_layout_is_tidy(text: str, ports: bool) -> None:
+    _, pic = _picture(text, ports=ports)
+    laid = layout(pic)
+    boxes = laid.boxes
+    assert len(boxes) == len(pic.nodes)
+    for i, a in enumerate(boxes):  # no two boxes intersect
+        for b in boxes[i + 1 :]:
+            assert not _overlap(a, b)
+    for node in pic.nodes:
+        box = boxes[node.index]
+        assert box.x >= 0 and box.y >= 0
+        assert box.x + box.w <= laid.width + 1e-6 and box.bottom <= laid.height + 1e-6
+        if node.children:
+            first, last = boxes[node.children[0]], boxes[node.children[-1]]
+            assert box.cx == pytest.approx((first.cx + last.cx) / 2)  # centred above
+            xs = [boxes[c].cx for c in node.children]
+            assert xs == sorted(xs) and len(set(xs)) == len(xs)  # in XML order
+            assert all(boxes[c].y > box.bottom for c in node.children)  # below
+
+
+def test_deep_tree_has_no_recursion_limit() -> None:
+    depth = 1000
+    body = "<Inverter>" * depth + "<AlwaysSuccess/>" + "</Inverter>" * depth
+    text = f'<root BTCPP_format="4"><BehaviorTree ID="T">{body}</BehaviorTree></root>'
+    _, pic = _picture(text)
+    assert len(pic.nodes) == depth + 2
+    laid = layout(pic)
+    assert laid.boxes[-1].y > laid.boxes[-2].bottom
+    assert etree.fromstring(to_svg(pic, laid).encode()) is not None
+
+
+# -- outputs ---------------------------------------------------------------------------------
+
+
+@settings(max_examples=30, deadline=None)
+@given(random_trees())
+def test_svg_parses_and_holds_every_node(text: str) -> None:
+    _doc, pic = _picture(text, ports=True)
+    svg = etree.fromstring(to_svg(pic).encode())
+    assert svg.tag == f"{SVG_NS}svg"
+    groups = {
+        g.get("id"): g for g in svg.iter(f"{SVG_NS}g") if "node" in g.get("class", "").split()
+    }
+    assert set(groups) == {n.id for n in pic.nodes}
+    for n in pic.nodes:
+        g = groups[n.id]
+        assert (int(g.get("data-start")), int(g.get("data-end"))) == (n.start, n.end)
+        label = "".join(g.find(f"{SVG_NS}text").itertext())
+        assert label.startswith(n.type[:10])
+    assert len(svg.findall(f".//{SVG_NS}path[@class='edge']")) == len(pic.nodes) - 1
+
+
+def test_svg_is_standalone_and_themed() -> None:
+    out, _ = render(Document(SAMPLE).model, main_tree(Document(SAMPLE).model), "svg")
+    svg = etree.fromstring(out.encode())
+    style = svg.find(f"{SVG_NS}style").text
+    assert "prefers-color-scheme: dark" in style
+    assert "--bt-action:var(--vscode-" in style
+    assert "href" not in out and "url(" not in out and "<image" not in out and "<script" not in out
+    texts = ["".join(t.itertext()) for t in svg.iter(f"{SVG_NS}text")]
+    assert "Sequence" in texts and '"root seq"' in texts
+
+
+def test_svg_marks_keys_and_badges() -> None:
+    _, pic = _picture(ports=True)
+    svg = etree.fromstring(to_svg(pic).encode())
+    keys = [t.text for t in svg.iter(f"{SVG_NS}tspan") if t.get("class") == "key"]
+    assert keys == ["{door}", "{goal}"]
+    badged = {g.get("data-type") for g in svg.iter(f"{SVG_NS}g") if "sev-" in g.get("class", "")}
+    assert "Foo" in badged and "Sequence" not in badged
+
+
+def test_svg_escapes_what_xml_cannot_hold() -> None:
+    text = '<root BTCPP_format="4"><BehaviorTree ID="T"><AlwaysSuccess name="a&#7;b]]&gt;"/>'
+    text += "</BehaviorTree></root>"
+    _, pic = _picture(text)
+    svg = etree.fromstring(to_svg(pic).encode())
+    assert '"aU+0007b]]>"' in ["".join(t.itertext()) for t in svg.iter(f"{SVG_NS}text")]
+
+
+_MERMAID_NODE = re.compile(r'  n\d+(>|\[|\{\{|\(|\(\[|\[\[|\[/)"[^"]*"(\]|\}\}|\)|\]\)|\]\]|/\])')
+
+
+@settings(max_examples=30, deadline=None)
+@given(random_trees())
+def test_mermaid_syntax(text: str) -> None:
+    _, pic = _picture(text, ports=True)
+    lines = to_mermaid(pic).splitlines()
+    assert lines[0] == "flowchart TD"
+    nodes = [ln for ln in lines if _MERMAID_NODE.fullmatch(ln)]
+    edges = [ln for ln in lines if re.fullmatch(r"  n\d+ -(->|\.->) n\d+", ln)]
+    styles = [
+        ln for ln in lines if re.fullmatch(r"  (classDef \w+ [\w#:,.\- ]+|class [n\d,]+ \w+)", ln)
+    ]
+    assert len(nodes) == len(pic.nodes) and len(edges) == len(pic.nodes) - 1
+    assert len(nodes) + len(edges) + len(styles) == len(lines) - 1
+
+
+def test_mermaid_escapes_labels() -> None:
+    _, pic = _picture(ports=True)
+    out = to_mermaid(pic)
+    assert 'n6("OpenDoor<br>#quot;open #amp; #quot;push#quot;#quot;<br>' in out
+    assert "n5{{" in out and "n2([" in out and "n7[[" in out and "n8[/" in out
+
+
+@settings(max_examples=30, deadline=None)
+@given(random_trees())
+def test_dot_syntax(text: str) -> None:
+    _, pic = _picture(text, ports=True)
+    out = to_dot(pic)
+    lines = out.splitlines()
+    assert lines[0].startswith("digraph ") and lines[-1] == "}"
+    strings = re.compile(r'"(?:[^"\\]|\\.)*"')
+    for line in lines[1:-1]:
+        bare = strings.sub('""', line)
+        assert '"' not in bare.replace('""', "")  # every quote is inside a closed string
+        assert re.fullmatch(r"  (node|edge|n\d+)( -> n\d+)?( \[.*\])?;", bare), line
+    assert sum(" -> " in ln for ln in lines) == len(pic.nodes) - 1
+
+
+def test_dot_escapes_labels() -> None:
+    _, pic = _picture()
+    assert 'n6 [label="OpenDoor\\n\\"open & \\"push\\"\\"' in to_dot(pic)
