@@ -108,6 +108,37 @@ def build_parser() -> argparse.ArgumentParser:
     )
     models.add_argument("--verbose", action="store_true", help="show progress on stderr")
     models.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
+
+    render = sub.add_parser(
+        "render",
+        help="draw one tree of a file as SVG, Mermaid or DOT",
+        description=(
+            "Draw a tree of a BehaviorTree.CPP XML file (the main tree unless --tree names "
+            "another): node kinds, instance names and problems as 'check' finds them, with "
+            "the file's folder as the workspace. Exit status: 0, or 2 for an unreadable "
+            "file, an unknown tree or an output that cannot be written."
+        ),
+    )
+    render.add_argument("file", metavar="FILE", help="the XML file")
+    render.add_argument("--tree", metavar="ID", help="the tree to draw (default: the main tree)")
+    render.add_argument(
+        "--format",
+        choices=("svg", "mermaid", "dot"),
+        default="svg",
+        help="output format (default: %(default)s)",
+    )
+    render.add_argument("--ports", action="store_true", help="show each node's ports")
+    render.add_argument(
+        "--expand-subtrees",
+        action="store_true",
+        help="draw each called tree below its SubTree node (recursive calls stay collapsed)",
+    )
+    render.add_argument("-o", "--output", metavar="OUT", help="write here instead of stdout")
+    render.add_argument(
+        "--workspace",
+        metavar="DIR",
+        help="the folder whose files count as the workspace (default: the file's folder)",
+    )
     return parser
 
 
@@ -135,6 +166,20 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     return check.run(args.paths, options)
 
 
+def _render(args: argparse.Namespace) -> int:
+    from bt_lsp.cli import render
+
+    options = render.Options(
+        format=args.format,
+        tree=args.tree,
+        ports=args.ports,
+        expand_subtrees=args.expand_subtrees,
+        output=args.output,
+        workspace=args.workspace,
+    )
+    return render.run(args.file, options)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (2 for a usage error)."""
     parser = build_parser()
@@ -150,6 +195,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return models.run(
                 args.paths, format=args.format, verbose=args.verbose, cache=not args.no_cache
             )
+        if args.command == "render":
+            return _render(args)
         parser.print_help(sys.stderr)
         return 2
     except SystemExit as e:
