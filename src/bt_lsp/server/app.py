@@ -283,6 +283,7 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 def create_server() -> BtServer:
     from bt_lsp.server import actions, completion, documents, hover, navigation
+    from bt_lsp.server import render as render_command
 
     server = BtServer()
 
@@ -362,6 +363,7 @@ def create_server() -> BtServer:
     hover.register(server)
     navigation.register(server)
     completion.register(server)
+    render_command.register(server)
     return server
 
 
