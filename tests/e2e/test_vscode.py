@@ -136,11 +136,13 @@ class CodeServer:
 
 
 @contextmanager
-def _code_server(tmp_path: Path) -> Iterator[CodeServer]:
-    """code-server on 127.0.0.1 with the extension, an isolated user-data dir and a workspace."""
+def _code_server(tmp_path: Path, files: dict[str, str] | None = None) -> Iterator[CodeServer]:
+    """code-server on 127.0.0.1 with the extension, an isolated user-data dir and a workspace
+    holding ``files`` (name -> text; by default tree.xml)."""
     workspace = tmp_path / "ws"
     workspace.mkdir()
-    (workspace / "tree.xml").write_text(TREE, encoding="utf-8", newline="\n")
+    for name, text in (files or {"tree.xml": TREE}).items():
+        (workspace / name).write_text(text, encoding="utf-8", newline="\n")
     user_data = tmp_path / "user-data"
     (user_data / "User").mkdir(parents=True)
     extensions = tmp_path / "extensions"

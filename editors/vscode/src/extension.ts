@@ -11,6 +11,7 @@ import {
   ServerOptions,
 } from 'vscode-languageclient/node';
 import { resolveServerCommand } from './serverCommand';
+import { registerTreeView } from './treeView';
 
 const CLIENT_ID = 'btLsp'; // also the settings section; vscode-languageclient reads `btLsp.trace.server`
 const CLIENT_NAME = 'bt-lsp';
@@ -50,6 +51,7 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
       }
     }),
   );
+  registerTreeView(context, () => client, log);
   return enqueue(startClient);
 }
 

@@ -100,7 +100,7 @@ STYLE = (
     f"@media (prefers-color-scheme: dark){{.bt-tree{{{_vars(True)}}}}}"
     ".bt-tree{background:var(--bt-bg);font:12px ui-monospace,SFMono-Regular,Menlo,Consolas,"
     "'DejaVu Sans Mono',monospace}"
-    ".bt-tree text{fill:var(--bt-fg);white-space:pre}"
+    ".bt-tree text{fill:var(--bt-fg);white-space:pre;pointer-events:none}"
     ".bt-tree .edge{fill:none;stroke:var(--bt-edge);stroke-width:1.5}"
     ".bt-tree .edge.inlined{stroke-dasharray:4 3}"
     ".bt-tree .shape{fill:var(--bt-box);stroke-width:2}"

@@ -1,0 +1,249 @@
+#!/usr/bin/env node
+// Drives "bt-lsp: Show Tree" in a running code-server (with the bt-lsp extension installed) from
+// headless Chromium and prints what a user would see as one JSON object on the last line of stdout.
+//
+//   node tree.js '{"url": "http://127.0.0.1:PORT/?folder=/ws", "file": "mission.xml",
+//                  "insertAt": [5, 7], "insert": "<AlwaysFailure/>", "expectType": "AlwaysFailure",
+//                  "clickType": "Fallback", "cursorAt": [4, 10], "cursorType": "Charge",
+//                  "subtreeType": "Dock", "subtreeTree": "Dock", "shotDir": "/tmp/shots"}'
+//
+// Steps: open the file, wait for the server (its first squiggle), run "bt-lsp: Show Tree" from the
+// Command Palette, read the picture's nodes in the webview; type `insert` at line:column insertAt
+// and wait for the picture to show a node of type expectType; click the node of type clickType
+// and read the editor's selection from the status bar; zoom with the keyboard; move the cursor to
+// cursorAt and read which node the webview highlights; check that an update keeps the zoom;
+// double-click the SubTree node of type subtreeType and wait for the picture of subtreeTree.
+// Screenshots: tree.png (after the click), tree-failure.png on failure, in shotDir.
+// Exit status: 0 when every step ran (the caller judges the result), 1 when one failed.
+
+'use strict';
+
+const path = require('node:path');
+const { chromium } = require('playwright-core');
+
+const config = JSON.parse(process.argv[2] || '{}');
+const STEP_TIMEOUT = config.stepTimeoutMs || 20000;
+const SERVER_TIMEOUT = config.serverTimeoutMs || 60000;
+
+const result = { steps: [], consoleErrors: [] };
+let step = 'start';
+const started = Date.now();
+
+function mark(name) {
+  step = name;
+  result.steps.push({ step: name, atMs: Date.now() - started });
+  process.stderr.write(`[tree] ${name}\n`);
+}
+
+async function until(fn, timeoutMs, intervalMs = 250) {
+  const deadline = Date.now() + timeoutMs;
+  let value;
+  for (;;) {
+    value = await fn();
+    if (value || Date.now() > deadline) {
+      return value;
+    }
+    await new Promise((resolve) => setTimeout(resolve, intervalMs));
+  }
+}
+
+async function gotoPosition(page, line, column) {
+  await page.keyboard.press('Control+G');
+  await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: STEP_TIMEOUT });
+  await page.keyboard.type(`${line}:${column}`);
+  await page.keyboard.press('Enter');
+  await page.waitForSelector('.quick-input-widget', { state: 'hidden', timeout: STEP_TIMEOUT });
+}
+
+/** The frame of the tree webview (nested iframes in the workbench), once its script has run. */
+async function treeFrame(page) {
+  for (const frame of page.frames()) {
+    const found = await frame.$('#canvas').catch(() => null);
+    if (found) {
+      return frame;
+    }
+  }
+  return null;
+}
+
+/** What the webview shows: its tree, node types in order, the highlighted one, the zoom. */
+async function picture(frame) {
+  return frame.evaluate(() => {
+    const nodes = [...document.querySelectorAll('#canvas g.node')];
+    const selected = document.querySelector('#canvas g.node.selected');
+    return {
+      tree: document.body.dataset.tree || null,
+      renders: parseInt(document.body.dataset.renders || '0', 10),
+      types: nodes.map((g) => g.dataset.type),
+      kinds: nodes.map((g) => g.dataset.kind),
+      badges: nodes.filter((g) => /\bsev-/.test(g.getAttribute('class'))).map((g) => g.dataset.type),
+      selected: selected ? selected.dataset.type : null,
+      transform: document.getElementById('canvas').style.transform,
+      // The SVG's style sheet applied (the CSP let it in): a node outline has its kind's colour.
+      stroke: nodes.length ? getComputedStyle(nodes[1].querySelector('.shape')).stroke : null,
+      status: document.getElementById('status').textContent,
+    };
+  });
+}
+
+async function selectionStatus(page) {
+  return page
+    .$eval('.statusbar-item[id="status.editor.selection"]', (el) => el.innerText.trim())
+    .catch(() => '');
+}
+
+async function main(page) {
+  mark('load workbench');
+  await page.goto(config.url);
+  await page.waitForSelector('.monaco-workbench', { timeout: SERVER_TIMEOUT });
+  await page.waitForSelector(`.explorer-folders-view .monaco-list-row[aria-label*="${config.file}"]`, {
+    timeout: SERVER_TIMEOUT,
+  });
+
+  mark('open file');
+  const opened = await until(async () => {
+    await page.keyboard.press('Escape');
+    await page.keyboard.press('Control+P');
+    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
+    if (!input) {
+      return false;
+    }
+    await page.keyboard.type(config.file);
+    const row = await page
+      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${config.file}"]`, { timeout: 5000 })
+      .catch(() => null);
+    if (!row) {
+      return false;
+    }
+    await page.keyboard.press('Enter');
+    return page
+      .waitForSelector(`.tabs-container .tab[aria-label*="${config.file}"]`, { timeout: 5000 })
+      .then(() => true, () => false);
+  }, STEP_TIMEOUT, 500);
+  if (!opened) {
+    throw new Error(`could not open ${config.file} with Quick Open`);
+  }
+
+  await page.keyboard.press('Control+B'); // the side bar away: room for the editor and the tree
+
+  mark('wait for the server');
+  result.squiggle = await page
+    .waitForSelector('.editor-instance .squiggly-error', { timeout: SERVER_TIMEOUT })
+    .then(() => true, () => false);
+  if (!result.squiggle) {
+    throw new Error(`no error squiggle within ${SERVER_TIMEOUT} ms (is the server running?)`);
+  }
+  result.titleButton = await page
+    .$$eval('.editor-actions .action-label', (els) => els.map((e) => e.getAttribute('aria-label') || ''))
+    .then((labels) => labels.some((l) => l.includes('Show Tree')))
+    .catch(() => false);
+
+  mark('show tree');
+  await page.click('.editor-instance .monaco-editor .view-lines');
+  await page.keyboard.press('F1');
+  await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: STEP_TIMEOUT });
+  await page.keyboard.type('bt-lsp: Show Tree');
+  await page.waitForSelector('.quick-input-list .monaco-list-row[aria-label*="Show Tree"]', { timeout: STEP_TIMEOUT });
+  await page.keyboard.press('Enter');
+  const frame = await until(() => treeFrame(page), STEP_TIMEOUT, 300);
+  if (!frame) {
+    throw new Error('no tree webview appeared');
+  }
+  result.first = await until(async () => {
+    const p = await picture(frame);
+    return p.types.length > 0 ? p : null;
+  }, SERVER_TIMEOUT);
+  if (!result.first) {
+    throw new Error('the webview shows no tree');
+  }
+
+  mark('edit');
+  await page.click('.editor-instance .monaco-editor .view-lines');
+  await gotoPosition(page, config.insertAt[0], config.insertAt[1]);
+  await page.keyboard.type(config.insert);
+  result.afterEdit = await until(async () => {
+    const p = await picture(frame);
+    return p.types.includes(config.expectType) ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+
+  mark('click a node');
+  await frame.click(`#canvas g.node[data-type="${config.clickType}"]`);
+  result.selection = await until(async () => {
+    const s = await selectionStatus(page);
+    return /selected/.test(s) ? s : null;
+  }, STEP_TIMEOUT) || (await selectionStatus(page));
+  await new Promise((resolve) => setTimeout(resolve, 500));
+  await page.screenshot({ path: path.join(config.shotDir, 'tree.png') });
+
+  mark('zoom');
+  const before = (await picture(frame)).transform;
+  await frame.focus('#view');
+  await page.keyboard.press('-');
+  await page.keyboard.press('-');
+  result.zoomBefore = before;
+  result.zoomed = (await picture(frame)).transform;
+
+  mark('move the cursor');
+  await page.click('.editor-instance .monaco-editor .view-lines');
+  await gotoPosition(page, config.cursorAt[0], config.cursorAt[1]);
+  result.highlighted = await until(async () => {
+    const p = await picture(frame);
+    return p.selected === config.cursorType ? p.selected : null;
+  }, STEP_TIMEOUT) || (await picture(frame)).selected;
+
+  mark('update keeps the zoom');
+  const beforeSecond = await picture(frame);
+  const renders = beforeSecond.renders;
+  result.transformBeforeSecondEdit = beforeSecond.transform;
+  await page.keyboard.press('End');
+  await page.keyboard.type(' ');
+  result.afterSecondEdit = await until(async () => {
+    const p = await picture(frame);
+    return p.renders > renders ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+
+  mark('open a subtree');
+  await frame.dblclick(`#canvas g.node[data-type="${config.subtreeType}"]`);
+  result.subtree = await until(async () => {
+    const p = await picture(frame);
+    return p.tree === config.subtreeTree ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+  result.subtreeSelection = await selectionStatus(page);
+  mark('done');
+}
+
+(async () => {
+  let exitCode = 0;
+  const browser = await chromium.launch({
+    executablePath: config.chromium || '/usr/bin/chromium',
+    headless: true,
+    args: [
+      '--no-sandbox',
+      '--disable-gpu',
+      '--disable-dev-shm-usage',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+      '--no-first-run',
+    ],
+  });
+  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
+  page.on('console', (message) => {
+    if (message.type() === 'error') {
+      result.consoleErrors.push(message.text().slice(0, 300));
+    }
+  });
+  try {
+    await main(page);
+  } catch (error) {
+    exitCode = 1;
+    result.failedStep = step;
+    result.error = String(error && error.stack ? error.stack : error);
+    await page.screenshot({ path: path.join(config.shotDir, 'tree-failure.png') }).catch(() => {});
+  } finally {
+    result.elapsedMs = Date.now() - started;
+    await browser.close().catch(() => {});
+  }
+  process.stdout.write(JSON.stringify(result) + '\n');
+  process.exit(exitCode);
+})();

@@ -1,0 +1,304 @@
+// "bt-lsp: Show Tree": a webview beside the editor with the picture of the behavior tree under
+// the cursor, drawn by the server (`bt-lsp.renderTree`). It follows the text as the user types
+// (after the diagnostics' debounce), highlights the node under the cursor, and a click on a node
+// selects its element in the XML; a double click on a SubTree node opens the tree it calls.
+
+import * as vscode from 'vscode';
+import type { LanguageClient } from 'vscode-languageclient/node';
+
+const COMMAND = 'bt-lsp.renderTree';
+const VIEW_TYPE = 'btLsp.tree';
+
+interface LspPosition {
+  line: number;
+  character: number;
+}
+interface LspRange {
+  start: LspPosition;
+  end: LspPosition;
+}
+interface TreeNode {
+  id: string;
+  kind: string;
+  type: string;
+  name: string | null;
+  range?: LspRange;
+  uri?: string;
+  subtree?: string;
+  target?: { uri: string; range: LspRange };
+}
+interface Rendered {
+  tree: string;
+  svg: string;
+  trees: string[];
+  nodes: TreeNode[];
+}
+
+type FromWebview = { type: 'ready' } | { type: 'reveal'; id: string } | { type: 'open'; id: string };
+
+function toRange(r: LspRange): vscode.Range {
+  return new vscode.Range(r.start.line, r.start.character, r.end.line, r.end.character);
+}
+
+function nonce(): string {
+  const chars = 'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789';
+  let out = '';
+  for (let i = 0; i < 32; i++) {
+    out += chars.charAt(Math.floor(Math.random() * chars.length));
+  }
+  return out;
+}
+
+function isXml(doc: vscode.TextDocument | undefined): doc is vscode.TextDocument {
+  return doc !== undefined && doc.languageId === 'xml' && (doc.uri.scheme === 'file' || doc.uri.scheme === 'untitled');
+}
+
+class TreePanel {
+  private readonly panel: vscode.WebviewPanel;
+  private readonly nonce = nonce();
+  private readonly disposables: vscode.Disposable[] = [];
+  private document: vscode.TextDocument | undefined;
+  private position: vscode.Position | undefined;
+  private rendered: Rendered | undefined;
+  private timer: ReturnType<typeof setTimeout> | undefined;
+  private generation = 0;
+  private ready = false;
+
+  constructor(
+    private readonly extensionUri: vscode.Uri,
+    private readonly getClient: () => LanguageClient | undefined,
+    private readonly log: vscode.LogOutputChannel,
+    private readonly onDispose: () => void,
+  ) {
+    this.panel = vscode.window.createWebviewPanel(
+      VIEW_TYPE,
+      'Behavior tree',
+      { viewColumn: vscode.ViewColumn.Beside, preserveFocus: true },
+      {
+        enableScripts: true,
+        retainContextWhenHidden: true,
+        localResourceRoots: [vscode.Uri.joinPath(extensionUri, 'media')],
+      },
+    );
+    this.panel.webview.html = this.html();
+    this.disposables.push(
+      this.panel.onDidDispose(() => this.dispose()),
+      this.panel.webview.onDidReceiveMessage((m: FromWebview) => void this.onMessage(m)),
+      vscode.workspace.onDidChangeTextDocument((e) => {
+        if (e.document === this.document && e.contentChanges.length > 0) {
+          this.schedule();
+        }
+      }),
+      vscode.window.onDidChangeActiveTextEditor((editor) => {
+        if (editor && isXml(editor.document) && editor.document !== this.document) {
+          this.follow(editor);
+        }
+      }),
+      vscode.window.onDidChangeTextEditorSelection((e) => {
+        if (e.textEditor.document === this.document) {
+          this.cursorMoved(e.selections[0].active);
+        }
+      }),
+    );
+  }
+
+  reveal(): void {
+    this.panel.reveal(vscode.ViewColumn.Beside, true);
+  }
+
+  follow(editor: vscode.TextEditor): void {
+    this.document = editor.document;
+    this.position = editor.selection.active;
+    this.panel.title = `Tree: ${editor.document.uri.path.split('/').pop() ?? ''}`;
+    void this.refresh();
+  }
+
+  private html(): string {
+    const webview = this.panel.webview;
+    const media = (name: string) => webview.asWebviewUri(vscode.Uri.joinPath(this.extensionUri, 'media', name));
+    const csp = [
+      "default-src 'none'",
+      `style-src ${webview.cspSource} 'nonce-${this.nonce}'`,
+      `script-src 'nonce-${this.nonce}'`,
+      `img-src ${webview.cspSource} data:`,
+    ].join('; ');
+    return `<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="UTF-8">
+<meta http-equiv="Content-Security-Policy" content="${csp}">
+<meta name="viewport" content="width=device-width, initial-scale=1.0">
+<link rel="stylesheet" href="${media('treeView.css')}">
+<title>Behavior tree</title>
+</head>
+<body>
+<div id="bar"><span id="title"></span><span id="status"></span>
+<span id="help">drag: pan · wheel or +/−: zoom · 0: fit · click: select in the XML · double click a SubTree: open its tree</span></div>
+<div id="view" tabindex="0" aria-label="Behavior tree"><div id="canvas" data-nonce="${this.nonce}"></div></div>
+<script nonce="${this.nonce}" src="${media('treeView.js')}"></script>
+</body>
+</html>`;
+  }
+
+  /** Re-render after the same delay the server waits before recomputing diagnostics. */
+  private schedule(): void {
+    if (this.timer) {
+      clearTimeout(this.timer);
+    }
+    const delay = Math.max(0, vscode.workspace.getConfiguration('btLsp').get<number>('debounceMs') ?? 200);
+    this.timer = setTimeout(() => void this.refresh(), delay);
+  }
+
+  private async refresh(): Promise<void> {
+    this.timer = undefined;
+    const client = this.getClient();
+    const doc = this.document;
+    if (!doc) {
+      return;
+    }
+    if (!client) {
+      this.post({ type: 'message', text: 'The bt-lsp server is not running (see the bt-lsp output).' });
+      return;
+    }
+    const generation = ++this.generation;
+    const position = this.position ?? new vscode.Position(0, 0);
+    try {
+      const result = (await client.sendRequest('workspace/executeCommand', {
+        command: COMMAND,
+        arguments: [
+          {
+            uri: client.code2ProtocolConverter.asUri(doc.uri),
+            position: { line: position.line, character: position.character },
+          },
+        ],
+      })) as Rendered | null;
+      if (generation !== this.generation) {
+        return; // a newer request is on its way
+      }
+      this.rendered = result ?? undefined;
+      if (!result) {
+        this.post({ type: 'message', text: 'No <BehaviorTree> in this document.' });
+        return;
+      }
+      this.post({
+        type: 'render',
+        svg: result.svg,
+        tree: result.tree,
+        trees: result.trees,
+        nodes: result.nodes.map((n) => ({ id: n.id, kind: n.kind, subtree: n.subtree ?? null })),
+        selected: this.nodeAt(position)?.id ?? null,
+      });
+    } catch (error) {
+      this.log.warn(`bt-lsp: drawing the tree: ${error instanceof Error ? error.message : String(error)}`);
+      this.post({ type: 'message', text: 'The tree could not be drawn (see the bt-lsp output).' });
+    }
+  }
+
+  private post(message: unknown): void {
+    if (this.ready) {
+      void this.panel.webview.postMessage(message);
+    } else {
+      this.pending = message;
+    }
+  }
+  private pending: unknown;
+
+  /** The innermost node of the picture whose element holds ``pos`` (nodes of this document). */
+  private nodeAt(pos: vscode.Position): TreeNode | undefined {
+    let best: TreeNode | undefined;
+    for (const node of this.rendered?.nodes ?? []) {
+      if (node.uri || !node.range) {
+        continue;
+      }
+      const r = toRange(node.range);
+      if (r.contains(pos) && (!best || (best.range && toRange(best.range).contains(r)))) {
+        best = node;
+      }
+    }
+    return best;
+  }
+
+  private cursorMoved(pos: vscode.Position): void {
+    this.position = pos;
+    const root = this.rendered?.nodes[0];
+    const inTree = root?.range ? toRange(root.range).contains(pos) : false;
+    if (!inTree) {
+      // Perhaps another tree of the document: draw the one under the cursor.
+      if (this.rendered && !this.timer) {
+        this.schedule();
+      }
+      return;
+    }
+    this.post({ type: 'highlight', id: this.nodeAt(pos)?.id ?? null });
+  }
+
+  private async onMessage(message: FromWebview): Promise<void> {
+    if (message.type === 'ready') {
+      this.ready = true;
+      if (this.pending !== undefined) {
+        void this.panel.webview.postMessage(this.pending);
+        this.pending = undefined;
+      }
+      return;
+    }
+    const node = this.rendered?.nodes.find((n) => n.id === message.id);
+    if (!node) {
+      return;
+    }
+    if (message.type === 'open' && node.target) {
+      await this.show(vscode.Uri.parse(node.target.uri), toRange(node.target.range));
+      return;
+    }
+    if (node.range) {
+      const uri = node.uri ? vscode.Uri.parse(node.uri) : this.document?.uri;
+      if (uri) {
+        await this.show(uri, toRange(node.range));
+      }
+    }
+  }
+
+  /** Opens ``uri`` in the editor column of the document shown and selects ``range``. */
+  private async show(uri: vscode.Uri, range: vscode.Range): Promise<void> {
+    const column =
+      vscode.window.visibleTextEditors.find((e) => e.document === this.document)?.viewColumn ?? vscode.ViewColumn.One;
+    const editor = await vscode.window.showTextDocument(uri, { viewColumn: column, preserveFocus: false });
+    // The cursor at the element's start (its tag in view), the element selected.
+    editor.selection = new vscode.Selection(range.end, range.start);
+    editor.revealRange(range, vscode.TextEditorRevealType.InCenterIfOutsideViewport);
+  }
+
+  dispose(): void {
+    if (this.timer) {
+      clearTimeout(this.timer);
+    }
+    this.disposables.forEach((d) => d.dispose());
+    this.disposables.length = 0;
+    this.panel.dispose();
+    this.onDispose();
+  }
+}
+
+/** Registers "bt-lsp: Show Tree". ``getClient`` gives the running language client, if any. */
+export function registerTreeView(
+  context: vscode.ExtensionContext,
+  getClient: () => LanguageClient | undefined,
+  log: vscode.LogOutputChannel,
+): void {
+  let panel: TreePanel | undefined;
+  context.subscriptions.push(
+    vscode.commands.registerCommand('btLsp.showTree', () => {
+      const editor = vscode.window.activeTextEditor;
+      if (!editor || !isXml(editor.document)) {
+        void vscode.window.showInformationMessage('bt-lsp: open a BehaviorTree.CPP XML file to show its tree.');
+        return;
+      }
+      if (!panel) {
+        panel = new TreePanel(context.extensionUri, getClient, log, () => (panel = undefined));
+      } else {
+        panel.reveal();
+      }
+      panel.follow(editor);
+    }),
+    { dispose: () => panel?.dispose() },
+  );
+}

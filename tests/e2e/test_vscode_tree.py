@@ -1,0 +1,164 @@
+""" "bt-lsp: Show Tree" in a real VS Code (code-server driven by headless Chromium): the picture
+appears beside the XML, follows an edit, a click on a node selects its element, the cursor
+highlights its node, an update keeps the zoom, and a SubTree opens its tree.
+
+Needs what tests/e2e/test_vscode.py needs (`editors/vscode/e2e/setup.sh`). Its screenshot goes
+to `.e2e-artifacts/vscode/tree.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
+`editors/vscode/images/tree.png` for the READMEs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tests.e2e.test_vscode import (
+    ARTIFACTS,
+    EXT_DIR,
+    README_IMAGES,
+    SETUP,
+    CodeServer,
+    _code_server,
+    _logs,
+    _missing_setup,
+)
+
+pytestmark = pytest.mark.e2e
+
+DRIVER = EXT_DIR / "e2e" / "tree.js"
+DRIVER_TIMEOUT_S = 180
+
+MISSION = """\
+<root BTCPP_format="4" main_tree_to_execute="Mission">
+  <BehaviorTree ID="Mission">
+    <Sequence name="mission">
+      <Charge level="{battery}"/>
+      <Fallback name="dock if needed">
+        <IsDocked/>
+        <SubTree ID="Dock"/>
+      </Fallback>
+      <Inverter><AlwaysSuccess/><AlwaysFailure/></Inverter>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Dock">
+    <Sequence><Align/><Stop/></Sequence>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <Action ID="Charge"><input_port name="level"/></Action>
+    <Condition ID="IsDocked"/>
+    <Action ID="Align"/>
+    <Action ID="Stop"/>
+  </TreeNodesModel>
+</root>
+"""
+LINES = MISSION.splitlines()
+
+
+def test_vscode_tree_view(tmp_path: Path) -> None:
+    missing = _missing_setup()
+    if missing:
+        pytest.fail(
+            f"the VS Code e2e setup is missing: {', '.join(missing)}. Run `bash {SETUP}` first.",
+            pytrace=False,
+        )
+    missing_driver = [p for p in (EXT_DIR / "media" / "treeView.js", DRIVER) if not p.exists()]
+    assert not missing_driver, missing_driver
+    with _code_server(tmp_path, {"mission.xml": MISSION}) as code_server:
+        _drive_and_check(code_server, tmp_path)
+
+
+def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
+    shots = tmp_path / "shots"
+    shots.mkdir()
+    charge_line = 4
+    insert_col = len(LINES[charge_line - 1]) + 1  # after <Charge .../>
+    fallback_line = 5
+    fallback_col = LINES[fallback_line - 1].index("<Fallback") + 1
+    config = {
+        "url": code_server.url,
+        "file": "mission.xml",
+        "insertAt": [charge_line, insert_col],
+        "insert": "<Stop/>",
+        "expectType": "Stop",
+        "clickType": "Fallback",
+        "cursorAt": [charge_line, LINES[charge_line - 1].index("Charge") + 3],
+        "cursorType": "Charge",
+        "subtreeType": "Dock",
+        "subtreeTree": "Dock",
+        "shotDir": str(shots),
+        "chromium": shutil.which("chromium"),
+    }
+    try:
+        run = subprocess.run(
+            ["node", str(DRIVER), json.dumps(config)],
+            env=code_server.env,
+            capture_output=True,
+            text=True,
+            timeout=DRIVER_TIMEOUT_S,
+        )
+    except subprocess.TimeoutExpired as e:
+        logs = _logs(code_server.user_data, code_server.log)
+        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr!r}\n{logs}")
+    finally:
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        for shot in shots.glob("*.png"):
+            shutil.copy(shot, ARTIFACTS / shot.name)
+
+    lines = run.stdout.strip().splitlines()
+    logs = _logs(code_server.user_data, code_server.log)
+    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
+    result = json.loads(lines[-1])
+    (ARTIFACTS / "tree-result.json").write_text(json.dumps(result, indent=1))
+    context = (
+        f"\ndriver result: {json.dumps(result, indent=1)}\ndriver stderr:\n{run.stderr[-2000:]}\n"
+        f"{logs}\nscreenshots: {ARTIFACTS}"
+    )
+    assert run.returncode == 0 and "error" not in result, context
+
+    # The picture appears, with the kinds the models give and the Inverter's error as a badge.
+    first = result["first"]
+    assert first["tree"] == "Mission", context
+    assert first["types"] == [
+        "Mission",
+        "Sequence",
+        "Charge",
+        "Fallback",
+        "IsDocked",
+        "Dock",
+        "Inverter",
+        "AlwaysSuccess",
+        "AlwaysFailure",
+    ], context
+    assert first["kinds"][2:6] == ["action", "control", "condition", "subtree"], context
+    assert first["badges"] == ["Inverter"], context
+    assert first["stroke"] not in (None, "", "none"), context  # the SVG's styles ran under the CSP
+    assert result["titleButton"], context  # the editor-title button on an XML file
+
+    # It follows an edit (after the debounce), in XML order.
+    after = result["afterEdit"]["types"]
+    assert after[:4] == ["Mission", "Sequence", "Charge", "Stop"], context
+
+    # A click on a node selects its element in the XML.
+    assert f"Ln {fallback_line}, Col {fallback_col}" in result["selection"], context
+    assert "selected" in result["selection"], context
+
+    # Moving the cursor highlights its node.
+    assert result["highlighted"] == "Charge", context
+
+    # The keyboard zoomed, and the next update kept the zoom and scroll.
+    assert result["zoomed"] != result["zoomBefore"], context
+    assert result["afterSecondEdit"]["transform"] == result["transformBeforeSecondEdit"], context
+
+    # A double click on a SubTree node opens its tree, which the view then draws.
+    assert result["subtree"]["tree"] == "Dock", context
+    assert result["subtree"]["types"] == ["Dock", "Sequence", "Align", "Stop"], context
+    assert "Ln 12," in result["subtreeSelection"], context
+
+    assert (ARTIFACTS / "tree.png").stat().st_size > 10_000
+    if os.environ.get("BT_LSP_E2E_UPDATE_IMAGES") == "1":
+        shutil.copy(ARTIFACTS / "tree.png", README_IMAGES / "tree.png")
