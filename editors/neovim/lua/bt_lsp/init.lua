@@ -351,10 +351,124 @@ function M.restart()
   end))
 end
 
+-- Requests on a client: client:request() from 0.11 on (the dot form is deprecated there).
+local function client_request(client, method, params, handler, bufnr)
+  if vim.fn.has("nvim-0.11") == 1 then
+    return client:request(method, params, handler, bufnr)
+  end
+  return client.request(method, params, handler, bufnr)
+end
+
+-- The viewer for a file: vim.ui.open() on 0.10+, else xdg-open (or open on macOS), else nil.
+local function open_file(path)
+  if vim.ui.open then
+    local _, err = vim.ui.open(path)
+    return err == nil, err
+  end
+  for _, opener in ipairs({ "xdg-open", "open" }) do
+    if vim.fn.executable(opener) == 1 then
+      local job = vim.fn.jobstart({ opener, path }, { detach = true })
+      return job > 0, job > 0 and nil or ("could not run " .. opener)
+    end
+  end
+  return false, "no viewer found (xdg-open)"
+end
+
+--- Where :BtLspTree writes the picture of `tree` of buffer `bufnr`: `<file>-<tree>.svg` in
+--- stdpath("cache")/bt_lsp/trees (kept after Neovim exits, for the viewer; rewritten each time).
+function M.tree_path(tree, bufnr)
+  local function safe(text)
+    local out = tostring(text):gsub("[^%w_.-]", "_")
+    return out ~= "" and out or "tree"
+  end
+  local dir = vim.fn.stdpath("cache") .. "/bt_lsp/trees"
+  vim.fn.mkdir(dir, "p")
+  local stem = vim.fn.fnamemodify(api.nvim_buf_get_name(bufnr or 0), ":t:r")
+  return ("%s/%s-%s.svg"):format(dir, safe(stem), safe(tree))
+end
+
+--- Renders the behavior tree under the cursor to an SVG file (the server's bt-lsp.renderTree
+--- command) and opens it with the system viewer, or only prints its path. Options:
+---   ports            show each node's ports
+---   expand_subtrees  draw called trees below their SubTree nodes
+---   open             open the file (default true); the path is printed either way
+---   path             where to write (default: M.tree_path(tree ID, buffer))
+---   on_done          function(path or nil, error message or nil), called when done
+function M.tree(opts)
+  opts = opts or {}
+  local bufnr = api.nvim_get_current_buf()
+  local done = opts.on_done or function() end
+  local client = nil
+  for _, c in ipairs(M.clients()) do
+    if vim.lsp.buf_is_attached(bufnr, c.id) then
+      client = c
+    end
+  end
+  local function fail(message)
+    vim.notify("bt-lsp: " .. message, vim.log.levels.ERROR)
+    done(nil, message)
+  end
+  if client == nil then
+    return fail("no bt-lsp server is running for this buffer")
+  end
+  local position = vim.lsp.util.make_position_params(0, client.offset_encoding).position
+  local params = {
+    command = "bt-lsp.renderTree",
+    arguments = {
+      {
+        uri = vim.uri_from_bufnr(bufnr),
+        position = position,
+        format = "svg",
+        ports = opts.ports == true,
+        expandSubtrees = opts.expand_subtrees == true,
+      },
+    },
+  }
+  client_request(client, "workspace/executeCommand", params, function(err, result)
+    if err then
+      return fail("drawing the tree: " .. (err.message or vim.inspect(err)))
+    end
+    if result == nil or result == vim.NIL then
+      return fail("no <BehaviorTree> in this buffer")
+    end
+    local path = opts.path or M.tree_path(result.tree, bufnr)
+    local file, why = io.open(path, "wb")
+    if file == nil then
+      return fail("cannot write " .. path .. ": " .. tostring(why))
+    end
+    file:write(result.svg)
+    file:close()
+    M.last_tree = path
+    local message = ("bt-lsp: tree '%s' written to %s"):format(result.tree, path)
+    if opts.open ~= false then
+      local ok, open_err = open_file(path)
+      if not ok then
+        message = message .. " (not opened: " .. tostring(open_err) .. ")"
+      end
+    end
+    vim.notify(message, vim.log.levels.INFO)
+    done(path, nil)
+  end, bufnr)
+end
+
 local function create_commands()
   api.nvim_create_user_command("BtLspRestart", function()
     M.restart()
   end, { desc = "Restart the bt-lsp language server" })
+  api.nvim_create_user_command("BtLspTree", function(args)
+    local words = {}
+    for _, w in ipairs(args.fargs) do
+      words[w] = true
+    end
+    M.tree({ ports = words.ports, expand_subtrees = words.expand, open = not args.bang })
+  end, {
+    nargs = "*",
+    bang = true,
+    complete = function()
+      return { "ports", "expand" }
+    end,
+    desc = "Draw the behavior tree under the cursor as SVG and open it (! only prints its path)",
+  })
 end
 
 local function check(name, value, kind, optional)
