@@ -166,3 +166,21 @@ def test_installed_command(ws: Path) -> None:
     )
     assert r.returncode == 0, r.stderr
     assert r.stdout.startswith("flowchart TD\n")
+
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "docs" / "tree" / "mission.xml"
+
+
+def test_readme_pictures_are_current(capsys: pytest.CaptureFixture[str]) -> None:
+    """The README's Mermaid block is what `render --format mermaid` prints for it, and the
+    SVG it shows has the nodes `render` draws now."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert main(["render", str(EXAMPLE), "--tree", "Dock", "--format", "mermaid"]) == 0
+    mermaid = capsys.readouterr().out
+    assert f"```mermaid\n{mermaid}```\n" in readme
+    assert main(["render", str(EXAMPLE), "--ports", "--expand-subtrees"]) == 0
+    now = _nodes(_svg(capsys.readouterr().out))
+    shown = _nodes(etree.parse(str(EXAMPLE.with_suffix(".svg"))).getroot())
+    assert shown == now and ("subtree", "Dock") in now and ("action", "Align") in now
+    assert "](docs/tree/mission.svg)" in readme and "](editors/vscode/images/tree.png)" in readme

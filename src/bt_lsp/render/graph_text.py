@@ -69,12 +69,11 @@ def to_mermaid(picture: Picture) -> str:
     for node in picture.nodes[1:]:
         arrow = "-.->" if picture.nodes[node.parent].expanded else "-->"
         out.append(f"  n{node.parent} {arrow} {node.id}")
-    for kind, style in _MERMAID_STYLE.items():
-        out.append(f"  classDef {kind} {style}")
     by_kind: dict[str, list[str]] = {}
     for node in picture.nodes:
         by_kind.setdefault(node.kind, []).append(node.id)
     for kind, ids in by_kind.items():
+        out.append(f"  classDef {kind} {_MERMAID_STYLE[kind]}")
         out.append(f"  class {','.join(ids)} {kind}")
     flagged = [n.id for n in picture.nodes if n.severity is not None and n.severity <= 2]
     if flagged:
