@@ -9,11 +9,13 @@ to `.e2e-artifacts/vscode/tree.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import shutil
 import subprocess
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -57,6 +59,18 @@ MISSION = """\
 </root>
 """
 LINES = MISSION.splitlines()
+BIG_NODES = 1000
+
+
+def _big_tree() -> str:
+    """A tree of BIG_NODES nodes, from the renderer's benchmark."""
+    path = EXT_DIR.parents[1] / "benchmarks" / "render.py"
+    spec = importlib.util.spec_from_file_location("bench_render_e2e", path)
+    assert spec is not None and spec.loader is not None
+    module: ModuleType = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    text: str = module.big_tree(BIG_NODES)
+    return text
 
 
 def test_vscode_tree_view(tmp_path: Path) -> None:
@@ -68,7 +82,8 @@ def test_vscode_tree_view(tmp_path: Path) -> None:
         )
     missing_driver = [p for p in (EXT_DIR / "media" / "treeView.js", DRIVER) if not p.exists()]
     assert not missing_driver, missing_driver
-    with _code_server(tmp_path, {"mission.xml": MISSION}) as code_server:
+    files = {"mission.xml": MISSION, "big.xml": _big_tree()}
+    with _code_server(tmp_path, files) as code_server:
         _drive_and_check(code_server, tmp_path)
 
 
@@ -90,6 +105,7 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
         "cursorType": "Charge",
         "subtreeType": "Dock",
         "subtreeTree": "Dock",
+        "big": {"file": "big.xml", "nodes": BIG_NODES},
         "shotDir": str(shots),
         "chromium": shutil.which("chromium"),
     }
@@ -158,6 +174,15 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     assert result["subtree"]["tree"] == "Dock", context
     assert result["subtree"]["types"] == ["Dock", "Sequence", "Align", "Stop"], context
     assert "Ln 12," in result["subtreeSelection"], context
+
+    # A tree of 1,000 nodes: the view follows the newly active editor and draws every node,
+    # fits it with the keyboard, and a click on one of them still selects its element.
+    big = result["big"]
+    assert big["nodes"] == BIG_NODES + 1, context
+    assert big["initialTransform"].endswith("scale(0.5)"), context  # readable, not fitted
+    assert big["fittedTransform"] != big["initialTransform"], context
+    assert big["zoomedTransform"] != big["fittedTransform"], context
+    assert "selected" in big["selection"], context
 
     assert (ARTIFACTS / "tree.png").stat().st_size > 10_000
     if os.environ.get("BT_LSP_E2E_UPDATE_IMAGES") == "1":

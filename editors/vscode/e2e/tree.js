@@ -92,6 +92,31 @@ async function selectionStatus(page) {
     .catch(() => '');
 }
 
+async function openFile(page, file) {
+  const opened = await until(async () => {
+    await page.keyboard.press('Escape');
+    await page.keyboard.press('Control+P');
+    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
+    if (!input) {
+      return false;
+    }
+    await page.keyboard.type(file);
+    const row = await page
+      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${file}"]`, { timeout: 5000 })
+      .catch(() => null);
+    if (!row) {
+      return false;
+    }
+    await page.keyboard.press('Enter');
+    return page
+      .waitForSelector(`.tabs-container .tab[aria-label*="${file}"]`, { timeout: 5000 })
+      .then(() => true, () => false);
+  }, STEP_TIMEOUT, 500);
+  if (!opened) {
+    throw new Error(`could not open ${file} with Quick Open`);
+  }
+}
+
 async function main(page) {
   mark('load workbench');
   await page.goto(config.url);
@@ -101,29 +126,7 @@ async function main(page) {
   });
 
   mark('open file');
-  const opened = await until(async () => {
-    await page.keyboard.press('Escape');
-    await page.keyboard.press('Control+P');
-    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
-    if (!input) {
-      return false;
-    }
-    await page.keyboard.type(config.file);
-    const row = await page
-      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .catch(() => null);
-    if (!row) {
-      return false;
-    }
-    await page.keyboard.press('Enter');
-    return page
-      .waitForSelector(`.tabs-container .tab[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .then(() => true, () => false);
-  }, STEP_TIMEOUT, 500);
-  if (!opened) {
-    throw new Error(`could not open ${config.file} with Quick Open`);
-  }
-
+  await openFile(page, config.file);
   await page.keyboard.press('Control+B'); // the side bar away: room for the editor and the tree
 
   mark('wait for the server');
@@ -209,6 +212,48 @@ async function main(page) {
     return p.tree === config.subtreeTree ? p : null;
   }, STEP_TIMEOUT) || (await picture(frame));
   result.subtreeSelection = await selectionStatus(page);
+  if (config.big) {
+    // A large tree: the view follows the newly active editor and draws every node.
+    mark('big tree');
+    await page.click('.editor-instance .monaco-editor .view-lines');
+    const t0 = Date.now();
+    await openFile(page, config.big.file);
+    const big = await until(async () => {
+      const p = await picture(frame);
+      return p.types.length === config.big.nodes + 1 ? p : null;
+    }, SERVER_TIMEOUT, 100);
+    result.big = { nodes: big ? big.types.length : (await picture(frame)).types.length, shownMs: Date.now() - t0 };
+    await frame.focus('#view');
+    // Drawn at a readable zoom (too large to fit); '0' fits all of it, '+' zooms in again.
+    result.big.initialTransform = (await picture(frame)).transform;
+    const z0 = Date.now();
+    await page.keyboard.press('0');
+    result.big.fittedTransform = (await picture(frame)).transform;
+    result.big.fitMs = Date.now() - z0;
+    await page.keyboard.press('+');
+    result.big.zoomedTransform = (await picture(frame)).transform;
+    await page.keyboard.press('0');
+    // The last node in view (drawn in pre-order: the deepest visible one on the right).
+    const target = await frame.$$eval('#canvas g.node', (gs) => {
+      const view = document.getElementById('view').getBoundingClientRect();
+      const inside = gs.filter((g) => {
+        const r = g.getBoundingClientRect();
+        return r.left >= view.left && r.right <= view.right && r.top >= view.top && r.bottom <= view.bottom;
+      });
+      return inside.length ? inside[inside.length - 1].id : null;
+    });
+    if (!target) {
+      throw new Error('no node of the large tree in view after fitting it');
+    }
+    result.big.clicked = target;
+    const c0 = Date.now();
+    await frame.click(`#canvas g[id="${target}"]`);
+    result.big.selection = await until(async () => {
+      const s = await selectionStatus(page);
+      return /selected/.test(s) ? s : null;
+    }, STEP_TIMEOUT, 50) || (await selectionStatus(page));
+    result.big.clickToSelectionMs = Date.now() - c0;
+  }
   mark('done');
 }
 

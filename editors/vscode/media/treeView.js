@@ -35,6 +35,23 @@
     apply();
   }
 
+  /** A new tree: all of it when it fits at a readable size, else its top, root centred. */
+  function initial() {
+    const w = view.clientWidth;
+    if (!size.w || !w) {
+      return;
+    }
+    const k = Math.min(1, (w - 32) / size.w, Math.max((view.clientHeight - 32) / size.h, 0.5));
+    if (k >= 0.5) {
+      fit();
+      return;
+    }
+    state.k = 0.5;
+    state.x = w / 2 - (size.w / 2) * state.k;
+    state.y = 16;
+    apply();
+  }
+
   function zoomAt(factor, mx, my) {
     const k = Math.min(MAX_ZOOM, Math.max(MIN_ZOOM, state.k * factor));
     state.x = mx - ((mx - state.x) * k) / state.k;
@@ -73,7 +90,7 @@
     selected = null;
     if (state.tree !== message.tree) {
       state.tree = message.tree;
-      fit();
+      initial();
     } else {
       apply();
     }
