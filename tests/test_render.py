@@ -22,6 +22,7 @@ from bt_lsp.render import (
     tree_at,
     workspace_resolver,
 )
+from bt_lsp.render.layout import SIBLING_GAP
 from bt_lsp.render.picture import MAX_NODES
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.codes import Severity
@@ -242,6 +243,37 @@ def test_layout_is_tidy(text: str, ports: bool) -> None:
             xs = [boxes[c].cx for c in node.children]
             assert xs == sorted(xs) and len(set(xs)) == len(xs)  # in XML order
             assert all(boxes[c].y > box.bottom for c in node.children)  # below
+
+
+def _extents(pic, boxes, root: int) -> dict[float, tuple[float, float]]:  # type: ignore[no-untyped-def]
+    """Row top -> (leftmost, rightmost) x of the boxes of ``root``'s subtree."""
+    out: dict[float, tuple[float, float]] = {}
+    stack = [root]
+    while stack:
+        i = stack.pop()
+        b = boxes[i]
+        lo, hi = out.get(b.y, (b.x, b.x + b.w))
+        out[b.y] = (min(lo, b.x), max(hi, b.x + b.w))
+        stack.extend(pic.nodes[i].children)
+    return out
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_trees())
+def test_layout_is_compact(text: str) -> None:
+    """Each subtree sits as close to its left siblings' subtrees as the gap allows: at some
+    row exactly the gap apart, nowhere closer."""
+    _, pic = _picture(text)
+    boxes = layout(pic).boxes
+    for node in pic.nodes:
+        for k in range(1, len(node.children)):
+            here = _extents(pic, boxes, node.children[k])
+            before: dict[float, float] = {}
+            for c in node.children[:k]:
+                for y, (_, hi) in _extents(pic, boxes, c).items():
+                    before[y] = max(before.get(y, hi), hi)
+            gaps = [here[y][0] - before[y] for y in here if y in before]
+            assert min(gaps) == pytest.approx(SIBLING_GAP)
 
 
 def test_deep_tree_has_no_recursion_limit() -> None:
