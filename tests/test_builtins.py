@@ -16,10 +16,9 @@ from bt_lsp.rules.builtins import (
     V3_RENAMES,
     NodeModel,
     PortModel,
-    convert_literal,
-    is_blackboard_reference,
     is_builtin,
 )
+from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
 
 _SPEC = Path(__file__).resolve().parents[2] / "shared" / "spec" / "bt-xml.md"
 

@@ -9,7 +9,7 @@ from lxml import etree
 
 from bt_lsp.ide.hover import hover_at
 from bt_lsp.ide.name_fixes import Fix, escape_value, fix_all, fixes_for
-from bt_lsp.ide.navigation import RenamePlan, RenameRefused, rename
+from bt_lsp.ide.rename import RenamePlan, RenameRefused, rename
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
 from bt_lsp.syntax.document import Document

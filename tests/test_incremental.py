@@ -1,7 +1,7 @@
 """What an edit reuses gives what a fresh analysis gives.
 
 An edit re-scans the tokens around it, rebuilds the model's sections around them, and
-re-checks only the sections whose inputs changed (see ``bt_lsp.syntax.model`` and
+re-checks only the sections whose inputs changed (see ``bt_lsp.syntax.builder`` and
 ``bt_lsp.rules.semantics.sections``).  These tests edit documents at random places, with text
 that changes the structure, names and declarations, and compare every step with a fresh
 document: tokens, the model (elements, name tokens, problems, lookups), the document's own

@@ -7,7 +7,7 @@ import pytest
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.rules.names import NameKind
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import Role, Zone
+from bt_lsp.syntax.elements import Role, Zone
 from tests.marks import unmark
 
 # Every checked name position of the contract is marked; nothing else may be a checked name.

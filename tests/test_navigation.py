@@ -9,25 +9,14 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from bt_lsp.ide.navigation import (
-    BUILTIN_CATALOG,
-    DocSymbol,
-    Fold,
-    Place,
-    RenameRefused,
-    SymbolKind,
-    builtin_catalog,
-    definition,
-    document_symbols,
-    folding_ranges,
-    highlights,
-    key_at,
-    linked_editing_ranges,
-    prepare_rename,
-    references,
-    rename,
-    workspace_symbols,
-)
+from bt_lsp.ide.blackboard import key_at
+from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
+from bt_lsp.ide.definition import definition
+from bt_lsp.ide.folding import Fold, folding_ranges, linked_editing_ranges
+from bt_lsp.ide.places import Place
+from bt_lsp.ide.references import highlights, references
+from bt_lsp.ide.rename import RenameRefused, prepare_rename, rename
+from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
 from bt_lsp.project.workspace import Workspace, links, normalize
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.builtins import BUILTINS

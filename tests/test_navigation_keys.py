@@ -6,17 +6,10 @@ from __future__ import annotations
 import pytest
 from lxml import etree
 
-from bt_lsp.ide.blackboard import KeyForm, blackboard_keys, key_uses
-from bt_lsp.ide.navigation import (
-    Place,
-    RenamePlan,
-    RenameRefused,
-    highlights,
-    key_at,
-    prepare_rename,
-    references,
-    rename,
-)
+from bt_lsp.ide.blackboard import KeyForm, blackboard_keys, key_at, key_uses
+from bt_lsp.ide.places import Place
+from bt_lsp.ide.references import highlights, references
+from bt_lsp.ide.rename import RenamePlan, RenameRefused, prepare_rename, rename
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
 from tests.test_navigation import at, parse

@@ -13,10 +13,10 @@ from bt_lsp.rules import semantics
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
-from bt_lsp.rules.semantics.scripts import raw_offsets, raw_span
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
 from bt_lsp.syntax.scanner import decode_value
+from bt_lsp.syntax.values import raw_offsets, raw_span
 from tests.marks import unmark
 from tests.test_semantics import CASES, R, T
 

@@ -32,13 +32,15 @@ from bisect import bisect_right
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from bt_lsp.rules.builtins import BUILTINS, is_blackboard_reference
+from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
-from bt_lsp.rules.script import identifiers
-from bt_lsp.rules.semantics.scripts import CONDITION_ATTRS, SCRIPT_PORTS, raw_offsets
+from bt_lsp.rules.script import CONDITION_ATTRS, SCRIPT_PORTS, identifiers
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import Element, Model, Zone
+from bt_lsp.syntax.elements import Element, Zone
+from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.values import raw_offsets
 
 __all__ = [
     "KeyForm",

@@ -19,13 +19,14 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from bt_lsp.ide.blackboard import KeyForm, key_uses
-from bt_lsp.ide.navigation import enclosing_tree, ports_of
+from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_uses
+from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element, Model, Zone
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
+from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Attr, Kind, Token
 
 __all__ = ["Completions", "Item", "ItemKind", "complete", "ports_markdown"]

@@ -12,7 +12,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import name_violations
 from bt_lsp.rules.names import RULES
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import DECLARING_ROLES, NameRef, Role
+from bt_lsp.syntax.elements import DECLARING_ROLES, NameRef, Role
 
 
 @dataclass(frozen=True, slots=True)

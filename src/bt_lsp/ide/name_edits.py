@@ -1,7 +1,7 @@
 """Renaming a name token: where its symbol occurs, the edits that write a new name there,
 and the names a new one must avoid.
 
-Pure, and blind to blackboard keys: :mod:`bt_lsp.ide.navigation` builds renames (keys
+Pure, and blind to blackboard keys: :mod:`bt_lsp.ide.rename` builds renames (keys
 included) on top of these, and :mod:`bt_lsp.ide.name_fixes` uses those renames.
 """
 
@@ -10,7 +10,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.model import Model, NameRef, Symbol
+from bt_lsp.syntax.elements import NameRef, Symbol
+from bt_lsp.syntax.model import Model
 
 __all__ = [
     "namespace",

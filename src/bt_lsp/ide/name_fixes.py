@@ -1,7 +1,7 @@
 """Fixes for name diagnostics: sanitized, unique replacements, renamed as a rename would.
 
-A fix renames a bad name exactly as :func:`bt_lsp.ide.navigation.rename` renames it to the same
-new name, through the same :class:`~bt_lsp.ide.navigation.Renamer`: every reference in the
+A fix renames a bad name exactly as :func:`bt_lsp.ide.rename.rename` renames it to the same
+new name, through the same :class:`~bt_lsp.ide.rename.Renamer`: every reference in the
 document and in the other workspace documents, a tree's port together with its uses as a
 blackboard key inside the tree, and the ``{=}`` of a renamed port attribute written out.
 Where the rename refuses:
@@ -30,12 +30,12 @@ from bt_lsp.ide.name_edits import (
     shown,
     taken_names,
 )
-from bt_lsp.ide.navigation import RenamePlan, Renamer, RenameRefused, combined
+from bt_lsp.ide.rename import RenamePlan, Renamer, RenameRefused, combined
 from bt_lsp.ide.sanitize import candidates, sanitize
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.model import NameRef, Symbol
+from bt_lsp.syntax.elements import NameRef, Symbol
 
 __all__ = [
     "Fix",

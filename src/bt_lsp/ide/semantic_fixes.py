@@ -23,7 +23,8 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.names import is_allowed_port_name
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element, Model, Zone
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
+from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import UNESCAPED
 
 if TYPE_CHECKING:

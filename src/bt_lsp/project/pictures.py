@@ -10,7 +10,8 @@ from bt_lsp.project.workspace import Workspace
 from bt_lsp.render import Format, Picture, render, workspace_resolver
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import Element, Model
+from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.model import Model
 
 
 def draw(

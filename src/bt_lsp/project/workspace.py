@@ -15,7 +15,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from bt_lsp.ide.navigation import IncludeLink
+from bt_lsp.ide.places import IncludeLink
 from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer
 from bt_lsp.project.fileio import FileError, read_text
 from bt_lsp.project.packages import Detected, Packages

@@ -30,7 +30,8 @@ from bt_lsp.render.picture import (
 from bt_lsp.render.svg import to_svg
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
-from bt_lsp.syntax.model import Element, Model
+from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.model import Model
 
 Format = Literal["svg", "mermaid", "dot"]
 FORMATS: tuple[Format, ...] = ("svg", "mermaid", "dot")

@@ -17,11 +17,13 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
-from bt_lsp.rules.builtins import BUILTINS, is_blackboard_reference
+from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context
+from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.diagnostics import Diagnostic
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element, Model, Zone
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
+from bt_lsp.syntax.model import Model
 
 Kind = Literal["tree", "control", "decorator", "action", "condition", "subtree", "unknown"]
 

@@ -24,7 +24,9 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Final, NamedTuple, TypeVar, cast
 
 from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
-from bt_lsp.syntax.model import Element, Model, Section, Zone
+from bt_lsp.syntax.elements import Element, Zone
+from bt_lsp.syntax.model import Model
+from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
@@ -421,7 +423,7 @@ def _extract_all(
         subs_at.append(len(subtree_models))
         local: DocumentFacts | None = section.cache.get("facts")
         if local is None:
-            local = section.cache["facts"] = extract(section.local_model(root), None)
+            local = section.cache["facts"] = extract(Model.of_section(section, root), None)
         if not local.models and not local.subtree_models and len(local.trees) == 1:
             t = local.trees[0]  # the usual section: one tree
             # Made without the named tuple's constructor, as every tree of a first analysis.

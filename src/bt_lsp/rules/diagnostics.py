@@ -12,8 +12,10 @@ from typing import TYPE_CHECKING, Any
 
 from bt_lsp.rules.codes import CODES, Severity
 from bt_lsp.rules.names import NameKind, Violation, check_name
-from bt_lsp.syntax.model import Model, NameRef, Role, Section
+from bt_lsp.syntax.elements import NameRef, Role
+from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Scan
+from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document

@@ -7,7 +7,8 @@ breaks a name rule needs neither positions nor a model, only its tag, its attrib
 where it sits, which lxml's parse gives in document order.  So this pass checks the names
 of every element as lxml reads them (the checks are cached by text), and places only the
 elements with a suspect name: their start tags are found by counting start tags, scanned by
-the real scanner and named by the model's own code (:func:`bt_lsp.syntax.model.start_tag_refs`).
+the real scanner and named by the model's own code
+(:func:`bt_lsp.syntax.nametokens.start_tag_refs`).
 Every diagnostic found is therefore one the full analysis makes too, with the same range,
 code and message; the server publishes them first and the complete set when it is ready.
 
@@ -26,15 +27,8 @@ from lxml import etree
 
 from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, ref_diagnostics, violations
 from bt_lsp.rules.names import RESERVED_PORT_NAMES, NameKind, may_hold_bad_instance_name
-from bt_lsp.syntax.model import (
-    EXPLICIT_TAGS,
-    Element,
-    Role,
-    Zone,
-    start_tag_element,
-    start_tag_refs,
-    zone_in,
-)
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Role, Zone, zone_in
+from bt_lsp.syntax.nametokens import start_tag_element, start_tag_refs
 
 __all__ = ["early_name_diagnostics"]
 

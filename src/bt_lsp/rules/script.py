@@ -42,7 +42,16 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Final
 
-__all__ = ["ScriptError", "check_script", "identifiers"]
+from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
+
+__all__ = ["CONDITION_ATTRS", "SCRIPT_PORTS", "ScriptError", "check_script", "identifiers"]
+
+#: Attributes whose value is a script on every node.
+CONDITION_ATTRS: Final[frozenset[str]] = frozenset((*PRECONDITIONS, *POSTCONDITIONS))
+#: Built-in (node type, port) pairs whose value is a script.
+SCRIPT_PORTS: Final[frozenset[tuple[str, str]]] = frozenset(
+    {("Script", "code"), ("ScriptCondition", "code"), ("Precondition", "if")}
+)
 
 
 @dataclass(frozen=True, slots=True)

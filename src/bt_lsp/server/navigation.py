@@ -1,6 +1,6 @@
 """Navigation features: definition, references, highlights, rename, document and workspace
 symbols, folding ranges and linked editing.  Each handler converts positions with the
-document's own line index in the negotiated encoding and calls :mod:`bt_lsp.ide.navigation`.
+document's own line index in the negotiated encoding and calls the features of :mod:`bt_lsp.ide`.
 """
 
 from __future__ import annotations
@@ -16,14 +16,16 @@ from pygls.exceptions import JsonRpcException
 from pygls.uris import from_fs_path
 
 from bt_lsp import __version__
-from bt_lsp.ide import navigation
-from bt_lsp.ide.navigation import (
-    BUILTIN_CATALOG,
-    DocSymbol,
-    Place,
-    RenameRefused,
-    SymbolKind,
-)
+from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
+from bt_lsp.ide.definition import definition as find_definition
+from bt_lsp.ide.folding import folding_ranges, linked_editing_ranges
+from bt_lsp.ide.places import Place
+from bt_lsp.ide.references import highlights
+from bt_lsp.ide.references import references as find_references
+from bt_lsp.ide.rename import RenameRefused
+from bt_lsp.ide.rename import prepare_rename as rename_target
+from bt_lsp.ide.rename import rename as plan_rename
+from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
 from bt_lsp.project.workspace import links
 from bt_lsp.server.convert import to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
@@ -75,7 +77,7 @@ def catalog_file() -> tuple[str, LineIndex] | None:
     global _catalog
     if _catalog is not None:
         return _catalog
-    text = navigation.builtin_catalog().text
+    text = builtin_catalog().text
     for folder in _catalog_dirs():
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -167,7 +169,7 @@ def register(server: BtServer) -> None:
         if od is None or not od.is_bt:
             return None
         sources = workspace_sources(ls, od)
-        places = navigation.definition(
+        places = find_definition(
             od.doc,
             offset_of(ls, od, params.position),
             {k: s.doc for k, s in sources.items()},
@@ -182,7 +184,7 @@ def register(server: BtServer) -> None:
         if od is None or not od.is_bt:
             return None
         sources = workspace_sources(ls, od)
-        places = navigation.references(
+        places = find_references(
             od.doc,
             offset_of(ls, od, params.position),
             {k: s.doc for k, s in sources.items()},
@@ -208,7 +210,7 @@ def register(server: BtServer) -> None:
                 if h.write
                 else types.DocumentHighlightKind.Read,
             )
-            for h in navigation.highlights(od.doc, offset_of(ls, od, params.position))
+            for h in highlights(od.doc, offset_of(ls, od, params.position))
         ]
 
     @server.feature(types.TEXT_DOCUMENT_PREPARE_RENAME)
@@ -219,7 +221,7 @@ def register(server: BtServer) -> None:
         if od is None or not od.is_bt:
             return None
         try:
-            target = navigation.prepare_rename(od.doc, offset_of(ls, od, params.position))
+            target = rename_target(od.doc, offset_of(ls, od, params.position))
         except RenameRefused as e:
             raise RequestFailed(e.message) from None
         if target is None:
@@ -236,7 +238,7 @@ def register(server: BtServer) -> None:
             return None
         sources = workspace_sources(ls, od)
         try:
-            plan = navigation.rename(
+            plan = plan_rename(
                 od.doc,
                 offset_of(ls, od, params.position),
                 params.new_name,
@@ -256,7 +258,7 @@ def register(server: BtServer) -> None:
         if od is None or not od.is_bt:
             return None
         enc = ls.encoding
-        symbols = navigation.document_symbols(od.doc, context_of(ls, od))
+        symbols = document_symbols(od.doc, context_of(ls, od))
         return [_document_symbol(od.doc.lines, s, enc) for s in symbols]
 
     @server.feature(types.WORKSPACE_SYMBOL)
@@ -265,7 +267,7 @@ def register(server: BtServer) -> None:
     ) -> list[types.WorkspaceSymbol]:
         enc = ls.encoding
         sources = workspace_sources(ls)
-        found = navigation.workspace_symbols(((k, s.doc) for k, s in sources.items()), params.query)
+        found = workspace_symbols(((k, s.doc) for k, s in sources.items()), params.query)
         out: list[types.WorkspaceSymbol] = []
         for s in found:
             src = sources[s.path]
@@ -294,7 +296,7 @@ def register(server: BtServer) -> None:
                 end_line=f.end_line,
                 kind=types.FoldingRangeKind.Comment if f.comment else types.FoldingRangeKind.Region,
             )
-            for f in navigation.folding_ranges(od.doc)
+            for f in folding_ranges(od.doc)
         ]
 
     @server.feature(types.TEXT_DOCUMENT_LINKED_EDITING_RANGE)
@@ -304,7 +306,7 @@ def register(server: BtServer) -> None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
-        spans = navigation.linked_editing_ranges(od.doc, offset_of(ls, od, params.position))
+        spans = linked_editing_ranges(od.doc, offset_of(ls, od, params.position))
         if spans is None:
             return None
         enc = ls.encoding

@@ -36,7 +36,7 @@ from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, path_of
 from bt_lsp.server.navigation import RequestFailed
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import Element
+from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.text import Encoding
 
 COMMAND = "bt-lsp.renderTree"

@@ -3,7 +3,7 @@
 An edit re-scans only the tokens around it (:func:`bt_lsp.syntax.scanner.rescan`) and updates the
 line index in place of rebuilding it; the model is derived lazily from
 the tokens when first asked for, the model from the previous one (only the sections around
-the tokens replaced since are built again, see :mod:`bt_lsp.syntax.model`).
+the tokens replaced since are built again, see :mod:`bt_lsp.syntax.builder`).
 """
 
 from __future__ import annotations
@@ -11,8 +11,9 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from bt_lsp.syntax.builder import build
 from bt_lsp.syntax.gcpause import gc_paused, with_gc_paused
-from bt_lsp.syntax.model import Model, build
+from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
 from bt_lsp.syntax.text import LineIndex
 

@@ -112,7 +112,8 @@ _VALUE_END_RE = {
 }
 _STRAY_QUOTE_END = {q: re.compile(f"[{q}<]") for q in "\"'"}
 _UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
-_REF_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
+# An entity or character reference (the one definition: the value offsets follow it too).
+REFERENCE_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
 _PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
 
 
@@ -158,7 +159,7 @@ def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
             out.append(raw[pos:])
             break
         out.append(raw[pos:amp])
-        m = _REF_RE.match(raw, amp)
+        m = REFERENCE_RE.match(raw, amp)
         if m is None:
             if problems is not None:
                 problems.append(

@@ -25,7 +25,7 @@ from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.semantics import document, models, nodes, ports, trees
 from bt_lsp.rules.semantics.base import State, TreeScope
 from bt_lsp.rules.semantics.sections import check_sections
-from bt_lsp.syntax.model import Element, Zone
+from bt_lsp.syntax.elements import Element, Zone
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document

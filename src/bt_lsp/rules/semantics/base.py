@@ -11,7 +11,8 @@ from bt_lsp.rules.builtins import BUILTINS, Category, PortModel
 from bt_lsp.rules.codes import CODES, Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element, Model
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
+from bt_lsp.syntax.model import Model
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document

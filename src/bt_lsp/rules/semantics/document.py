@@ -28,7 +28,7 @@ from __future__ import annotations
 from typing import Final
 
 from bt_lsp.rules.semantics.base import State, quoted
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
 MAX_DEPTH: Final = 256
 # Element depth in the model: <root> 0, <BehaviorTree> 1, so a node at model depth d is

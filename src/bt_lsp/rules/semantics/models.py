@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.rules.semantics.base import State, quoted
-from bt_lsp.syntax.model import Element
+from bt_lsp.syntax.elements import Element
 
 
 def check_entry(st: State, el: Element) -> None:

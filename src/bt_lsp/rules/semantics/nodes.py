@@ -35,11 +35,12 @@ from __future__ import annotations
 import re
 from typing import Final
 
-from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES, is_blackboard_reference
+from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
 from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
-from bt_lsp.syntax.model import EXPLICIT_TAGS, Element
+from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
 _BUILTIN_LOWER: Final[dict[str, str]] = {k.lower(): k for k in BUILTINS}
 _LEADING_INT: Final = re.compile(r"-?[0-9]+")

@@ -38,8 +38,9 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Final
 
-from bt_lsp.rules.builtins import PortModel, convert_literal, is_blackboard_reference
+from bt_lsp.rules.builtins import PortModel
 from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
 from bt_lsp.rules.names import (
     POSTCONDITIONS,
     PRECONDITIONS,
@@ -47,6 +48,7 @@ from bt_lsp.rules.names import (
     check_name,
     is_allowed_port_name,
 )
+from bt_lsp.rules.script import CONDITION_ATTRS, SCRIPT_PORTS
 from bt_lsp.rules.semantics import scripts
 from bt_lsp.rules.semantics.base import (
     BlackboardUse,
@@ -56,7 +58,7 @@ from bt_lsp.rules.semantics.base import (
     edit_distance,
     quoted,
 )
-from bt_lsp.syntax.model import Element
+from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.scanner import Attr
 
 # Underscore attributes that editors and BehaviorTree.CPP itself write on purpose:
@@ -133,7 +135,7 @@ def check_attributes(
         # Present counts as given even when the name breaks a rule: the name rules say why
         # BehaviorTree.CPP would not read it, and saying "missing" too would mislead.
         given.add(an)
-        if an in scripts.CONDITION_ATTRS:
+        if an in CONDITION_ATTRS:
             scripts.check(st, el, a)
             continue
         if an == "_autoremap":
@@ -205,7 +207,7 @@ def _check_port(
         return
     if res.origin == "subtree":
         return  # a literal remapping of a subtree port is stored as text, never converted
-    if (res.id, a.name) in scripts.SCRIPT_PORTS and res.origin == "builtin":
+    if (res.id, a.name) in SCRIPT_PORTS and res.origin == "builtin":
         if not is_blackboard_reference(value):
             scripts.check(st, el, a)
         return

@@ -13,66 +13,14 @@ post-condition attributes (``_skipIf`` … ``_post``) on any node.
 
 from __future__ import annotations
 
-import re
 from functools import lru_cache
-from typing import Final
 
 from bt_lsp.rules.codes import Severity
-from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.rules.script import ScriptError, check_script
 from bt_lsp.rules.semantics.base import State
-from bt_lsp.syntax.model import Element
-from bt_lsp.syntax.scanner import Attr, decode_value
-
-#: Attributes whose value is a script on every node.
-CONDITION_ATTRS: Final[frozenset[str]] = frozenset((*PRECONDITIONS, *POSTCONDITIONS))
-#: Built-in (node type, port) pairs whose value is a script.
-SCRIPT_PORTS: Final[frozenset[tuple[str, str]]] = frozenset(
-    {("Script", "code"), ("ScriptCondition", "code"), ("Precondition", "if")}
-)
-
-# An entity or character reference, exactly as the scanner recognises one.
-_REF: Final = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
-
-
-def raw_offsets(raw: str) -> list[int]:
-    """Where each code point of the decoded value starts in ``raw``, plus ``len(raw)``.
-
-    ``raw`` is an attribute value as written; decoding follows
-    :func:`bt_lsp.syntax.scanner.decode_value`: a reference it replaces becomes one code point,
-    anything it keeps as written (a raw ``&``, an unknown entity, an invalid character
-    reference) stays one code point per character.
-    """
-    out: list[int] = []
-    n = len(raw)
-    pos = 0
-    while pos < n:
-        amp = raw.find("&", pos)
-        if amp == -1:
-            out.extend(range(pos, n))
-            break
-        out.extend(range(pos, amp))
-        m = _REF.match(raw, amp)
-        if m is None:
-            out.append(amp)
-            pos = amp + 1
-            continue
-        if len(decode_value(m.group(0), 0, None)) == 1:
-            out.append(amp)
-        else:
-            out.extend(range(amp, m.end()))
-        pos = m.end()
-    out.append(n)
-    return out
-
-
-def raw_span(raw: str, start: int, end: int) -> tuple[int, int]:
-    """The span of ``raw`` (relative to it) that decodes to ``decoded[start:end]``."""
-    if "&" not in raw:
-        return start, end
-    offs = raw_offsets(raw)
-    last = len(offs) - 1
-    return offs[min(start, last)], offs[min(end, last)]
+from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.values import raw_span
 
 
 @lru_cache(maxsize=16384)

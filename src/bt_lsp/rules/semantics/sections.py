@@ -3,7 +3,7 @@
 :func:`bt_lsp.rules.semantics.check` runs the document-wide rules (the root and its sections,
 tree IDs across the document, the main tree, recursion) over the whole model, and the
 rules that look at one element and at what the context says about the names it uses over
-each section of the model (:class:`bt_lsp.syntax.model.Section`: one child of ``<root>``), in
+each section of the model (:class:`bt_lsp.syntax.sections.Section`: one child of ``<root>``), in
 the section's coordinates.  A section's results are kept on it with everything they read
 besides the section: the context entries looked up (through mappings that record every
 lookup, compared by their position-free content), the context's settings, the root's
@@ -27,7 +27,9 @@ from typing import TYPE_CHECKING, Final, TypeVar
 from bt_lsp.rules.context import Context, DocumentFacts, ModelDecl, TreeDecl
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.semantics.base import State
-from bt_lsp.syntax.model import Element, Section
+from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.model import Model
+from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
@@ -295,7 +297,7 @@ def _run(
 ) -> _Entry:
     deps = recording.deps
     deps.clear()
-    local = sec.local_model(root)
+    local = Model.of_section(sec, root)
     run = State(
         st.doc,
         recording.ctx,

@@ -36,7 +36,7 @@ from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import TreeDecl
 from bt_lsp.rules.semantics.base import State, TreeScope, quoted
-from bt_lsp.syntax.model import Element
+from bt_lsp.syntax.elements import Element
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document

@@ -1,0 +1,118 @@
+"""What checking a file gives: its diagnostics as findings with their positions
+converted, the result of the file, the summary line and the exit status."""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Final
+
+from bt_lsp.project.fileio import FileError
+from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.rules import analysis
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.syntax.document import Document
+
+FILE_ERROR: Final = "file-error"
+
+
+@dataclass(frozen=True, slots=True)
+class Finding:
+    """One diagnostic of one file, with its positions already converted.
+
+    ``line``/``column`` are 1-based, columns in code points; ``end_column`` is the column
+    after the last character. ``utf16_*`` are the same columns in UTF-16 code units.
+    ``token`` is the text the diagnostic covers (for stable fingerprints).
+    """
+
+    path: str
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+    utf16_column: int
+    utf16_end_column: int
+    severity: Severity
+    code: str
+    message: str
+    token: str = ""
+
+
+@dataclass(slots=True)
+class FileResult:
+    path: str
+    findings: list[Finding] = field(default_factory=list)
+    error: FileError | None = None
+    fixed: int = 0
+    not_fixed: str | None = None  # why a file with fixes was left unchanged
+    notes: list[str] = field(default_factory=list)  # what the applied fixes left as it was
+    detail: str = ""  # the traceback of an internal error
+
+
+def analyze(doc: Document, workspace: Workspace | None = None) -> list[Diagnostic]:
+    """Every diagnostic of ``doc``, before severity settings; with a workspace, its
+    includes, models and trees count too."""
+    if workspace is None or doc.path is None:
+        return analysis.analyze(doc)
+    return workspace.diagnostics(normalize(doc.path), doc)
+
+
+def findings_of(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[Finding]:
+    lines = doc.lines
+    out: list[Finding] = []
+    for d in diags:
+        sl, sc = lines.position(d.start, "utf-32")
+        el, ec = lines.position(d.end, "utf-32")
+        _, sc16 = lines.position(d.start, "utf-16")
+        _, ec16 = lines.position(d.end, "utf-16")
+        out.append(
+            Finding(
+                path,
+                sl + 1,
+                sc + 1,
+                el + 1,
+                ec + 1,
+                sc16 + 1,
+                ec16 + 1,
+                d.severity,
+                d.code,
+                d.message,
+                doc.text[d.start : min(d.end, d.start + 200)],
+            )
+        )
+    return out
+
+
+def plural(n: int, word: str, plural: str | None = None) -> str:
+    return f"{n} {word if n == 1 else (plural or word + 's')}"
+
+
+def summary(results: Sequence[FileResult]) -> str:
+    """E.g. ``3 errors, 1 warning in 2 files``."""
+    counts = Counter(f.severity for r in results for f in r.findings)
+    parts = [
+        plural(counts[Severity.ERROR], "error"),
+        plural(counts[Severity.WARNING], "warning"),
+    ]
+    if counts[Severity.INFORMATION]:
+        parts.append(plural(counts[Severity.INFORMATION], "information", "information"))
+    if counts[Severity.HINT]:
+        parts.append(plural(counts[Severity.HINT], "hint"))
+    checked = sum(1 for r in results if r.error is None)
+    text = f"{', '.join(parts)} in {plural(checked, 'file')}"
+    unreadable = len(results) - checked
+    if unreadable:
+        text += f"; {plural(unreadable, 'file')} could not be checked"
+    return text
+
+
+def exit_code(results: Iterable[FileResult]) -> int:
+    code = 0
+    for r in results:
+        if r.error is not None:
+            return 2
+        if any(f.severity == Severity.ERROR for f in r.findings):
+            code = 1
+    return code

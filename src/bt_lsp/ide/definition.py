@@ -1,0 +1,112 @@
+"""Go to definition: where the name under the cursor is declared, in this document, the
+workspace (through the document's :class:`~bt_lsp.rules.context.Context`), the built-in
+catalog, or the file an ``<include>`` names.
+
+Pure: it works on :class:`~bt_lsp.syntax.document.Document` values and returns
+code-point offsets; the server converts them to LSP positions.  The rest of the workspace
+comes in as plain data: ``others`` are the other BT documents by path, ``ctx`` is the
+document's context and ``includes`` its resolved ``<include>`` elements."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
+from bt_lsp.ide.places import IncludeLink, Place
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.elements import Role, Symbol
+
+
+def _declarations(
+    doc: Document, others: Mapping[str, Document], symbol: Symbol, role: Role
+) -> list[Place]:
+    """Occurrences of ``symbol`` in the ``role`` that declares it: this document's first."""
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(symbol) if r.role == role]
+    if own:
+        return own
+    return [
+        Place(path, r.start, r.end)
+        for path, d in others.items()
+        for r in d.model.refs_to(symbol)
+        if r.role == role
+    ]
+
+
+def _place(ctx: Context, path: str | None, start: int, end: int) -> Place:
+    return Place(None if path == ctx.path else path, start, end)
+
+
+def _tree_definition(
+    doc: Document, others: Mapping[str, Document], ctx: Context | None, tree_id: str
+) -> list[Place]:
+    sym: Symbol = ("tree", tree_id)
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.TREE_DEF]
+    if own:
+        return own
+    if ctx is not None:
+        decls = ctx.trees.get(tree_id) or ctx.workspace_trees.get(tree_id)
+        if decls:
+            return [_place(ctx, t.path, t.start, t.end) for t in decls]
+    found = _declarations(doc, others, sym, Role.TREE_DEF)
+    return found or _declarations(doc, others, sym, Role.MODEL_DEF)
+
+
+def _model_definition(
+    doc: Document, others: Mapping[str, Document], ctx: Context | None, model_id: str
+) -> list[Place]:
+    sym: Symbol = ("model", model_id)
+    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.MODEL_DEF]
+    if own:
+        return own
+    if ctx is not None:
+        decl = ctx.models.get(model_id)
+        if decl is not None:
+            return [_place(ctx, decl.path, decl.start, decl.end)]
+    found = _declarations(doc, others, sym, Role.MODEL_DEF)
+    if found:
+        return found
+    span = builtin_catalog().spans.get(sym)
+    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+
+
+def _port_definition(doc: Document, others: Mapping[str, Document], sym: Symbol) -> list[Place]:
+    found = _declarations(doc, others, sym, Role.PORT_DECL)
+    if found:
+        return found
+    span = builtin_catalog().spans.get(sym)
+    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+
+
+def definition(
+    doc: Document,
+    offset: int,
+    others: Mapping[str, Document] | None = None,
+    *,
+    ctx: Context | None = None,
+    includes: Sequence[IncludeLink] = (),
+) -> list[Place]:
+    """Where the name under ``offset`` is declared.
+
+    A ``<SubTree ID>`` or ``main_tree_to_execute`` leads to its ``<BehaviorTree>``, a node
+    to its ``<TreeNodesModel>`` entry (a built-in to the built-in catalog), a port
+    attribute to its port declaration, an ``<include path>`` to the start of that file.
+    A declaration leads to itself.
+    """
+    others = others or {}
+    for start, end, target in includes:
+        if start <= offset <= end:
+            return [Place(target, 0, 0)]
+    ref = doc.model.ref_at(offset)
+    if ref is None or ref.symbol is None:
+        return []
+    if ref.declaration:
+        return [Place(None, ref.start, ref.end)]
+    sym = ref.symbol
+    if sym[0] == "tree":
+        return _tree_definition(doc, others, ctx, sym[1])
+    if sym[0] == "model":
+        return _model_definition(doc, others, ctx, sym[1])
+    if sym[0] == "port":
+        return _port_definition(doc, others, sym)
+    return []

@@ -1,0 +1,227 @@
+"""Sections keep an edit cheap.  Each child of the root element, with everything inside it
+and the root-level tokens after it (whitespace, comments, stray end tags), is a
+:class:`Section` built on its own, in coordinates relative to its first token: offsets
+from its start, token indexes from its first token, element indexes local to it (0 is the
+root).  A :class:`Part` says where a section sits in a document.  Name tokens are not kept
+at all: a section makes them from its elements when asked (they outnumber the elements),
+and keeps only the set of symbols they refer to.
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_right
+from collections import OrderedDict
+from typing import Any
+
+from bt_lsp.syntax.elements import (
+    EXPLICIT_TAGS,
+    Element,
+    NameRef,
+    Role,
+    StructureProblem,
+    Symbol,
+    Zone,
+)
+from bt_lsp.syntax.nametokens import name_refs, shared_symbol
+
+_ROLE_NODE_TYPE_END = Role.NODE_TYPE_END
+_ZONE_NODE = Zone.NODE
+
+OPEN, CLOSED, EOF = 0, 1, 2  # how a section ends: at root level, closing the root, at the end
+
+
+class Section:
+    """One child of the root element and the root-level tokens after it, relative to its
+    first token (see the module docstring).  ``elements`` are local element ``1..n``
+    (local element 0 is the root); ``lexical`` are the problems of its tokens.
+
+    ``cache`` holds what the layers above derive from the section alone (or validate
+    themselves), by their own keys; a section is immutable otherwise, so that it can be
+    shared by the models of successive versions of a document.
+    """
+
+    __slots__ = (
+        "cache",
+        "elements",
+        "end",
+        "length",
+        "lexical",
+        "ntokens",
+        "problems",
+        "root",
+        "root_end",
+    )
+
+    def __init__(
+        self,
+        ntokens: int,
+        length: int,
+        elements: list[Element],
+        problems: list[StructureProblem],
+        lexical: list[StructureProblem],
+        end: int,
+        root_end: tuple[int, int, int] | None,
+        root: Element | None = None,
+    ) -> None:
+        self.ntokens = ntokens
+        self.length = length
+        self.elements = elements
+        self.root = root  # the root element, for the head of a document (its refs)
+        self.problems = problems
+        self.lexical = lexical
+        self.end = end
+        self.root_end = root_end
+        self.cache: dict[str, Any] = {}
+
+    @property
+    def top(self) -> Element:
+        """The root's child that starts the section (local element 1)."""
+        return self.elements[0]
+
+    @property
+    def refs(self) -> list[NameRef]:
+        """The section's name tokens, in order.  Made from its elements when asked for,
+        and kept for the few sections asked about last only: a document has more names
+        than elements."""
+        refs = _RECENT_REFS.get(self)
+        if refs is not None:
+            _RECENT_REFS.move_to_end(self)
+            return refs
+        refs = self._make_refs()
+        if "symbols" not in self.cache:  # small, kept: see symbols()
+            self.cache["symbols"] = tuple(
+                dict.fromkeys(r.symbol for r in refs if r.symbol is not None)
+            )
+        _RECENT_REFS[self] = refs
+        if len(_RECENT_REFS) > 64:
+            _RECENT_REFS.popitem(last=False)
+        return refs
+
+    def _make_refs(self) -> list[NameRef]:
+        refs: list[NameRef] = []
+        root = self.root
+        if root is not None:
+            name_refs(root, 0, None, refs)
+        els = self.elements
+        for i, el in enumerate(els, 1):
+            p = el.parent
+            name_refs(el, i, els[p - 1] if p > 0 else None, refs)
+            if (
+                el.end_name_start >= 0
+                and el.zone == _ZONE_NODE
+                and el.name not in EXPLICIT_TAGS
+                and el.name != "SubTree"
+            ):  # the end tag of a compact node names its type too
+                refs.append(
+                    NameRef(
+                        el.end_name_start,
+                        el.end_name_end,
+                        el.name,
+                        None,
+                        _ROLE_NODE_TYPE_END,
+                        shared_symbol(("model", el.name)),
+                        i,
+                    )
+                )
+        refs.sort(key=_start)
+        return refs
+
+    def ref_at(self, offset: int) -> NameRef | None:
+        """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
+        refs = self.refs
+        i = bisect_right([r.start for r in refs], offset) - 1
+        if i >= 0 and refs[i].start <= offset <= refs[i].end:
+            return refs[i]
+        return None
+
+    def symbols(self) -> tuple[Symbol, ...]:
+        """The symbols the section's names refer to (found when its names are first made,
+        as for its diagnostics)."""
+        found: tuple[Symbol, ...] | None = self.cache.get("symbols")
+        if found is None:
+            refs = self.refs
+            found = self.cache.get("symbols")
+            if found is None:
+                found = self.cache["symbols"] = tuple(
+                    dict.fromkeys(r.symbol for r in refs if r.symbol is not None)
+                )
+        return found
+
+
+_RECENT_REFS: OrderedDict[Section, list[NameRef]] = OrderedDict()
+
+
+class Part:
+    """Where a section (or the head or tail of a document) sits in a document: its offset,
+    its first token and its first element there."""
+
+    __slots__ = ("elem_base", "origin", "section", "tok_origin")
+
+    def __init__(self, section: Section, origin: int, tok_origin: int, elem_base: int) -> None:
+        self.section = section
+        self.origin = origin
+        self.tok_origin = tok_origin
+        self.elem_base = elem_base
+
+    def element_index(self, local: int) -> int:
+        """The document index of local element ``local`` (0 is the root, -1 none)."""
+        if local <= 0:
+            return local
+        return self.elem_base + local - 1
+
+    def element(self, el: Element) -> Element:
+        """An element of the section in document coordinates."""
+        o = self.origin
+        g = self.element_index
+        return Element(
+            el.name,
+            el.zone,
+            el.token_start + o,
+            el.token_index + self.tok_origin,
+            g(el.parent),
+            el.depth,
+            el.attrs,
+            el.self_closing,
+            el.closed,
+            el.end + o if el.end >= 0 else -1,
+            el.end_name_start + o if el.end_name_start >= 0 else -1,
+            el.end_name_end + o if el.end_name_end >= 0 else -1,
+            # Children are never the root (local 0): a top element may have thousands.
+            list(map((self.elem_base - 1).__add__, el.children)),
+            el.content,
+        )
+
+    def top(self) -> Element:
+        """The section's top element in document coordinates."""
+        return section_top(self.section, self.origin, self.tok_origin, self.elem_base)
+
+    def ref(self, r: NameRef) -> NameRef:
+        o = self.origin
+        return NameRef(
+            r.start + o,
+            r.end + o,
+            r.text,
+            r.kind,
+            r.role,
+            r.symbol,
+            self.element_index(r.element),
+            r.quote,
+        )
+
+    def problem(self, p: StructureProblem) -> StructureProblem:
+        return StructureProblem(p.start + self.origin, p.end + self.origin, p.code, p.message)
+
+
+def section_top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> Element:
+    """A section's top element in document coordinates (kept on the section while it
+    stays where it is)."""
+    hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
+    if hit is not None and hit[0] == origin and hit[1] == tok_origin and hit[2] == elem_base:
+        return hit[3]
+    el = Part(sec, origin, tok_origin, elem_base).element(sec.elements[0])
+    sec.cache["top"] = (origin, tok_origin, elem_base, el)
+    return el
+
+
+def _start(r: NameRef) -> int:
+    return r.start
