@@ -20,7 +20,7 @@ from lxml import etree
 from bt_lsp import __version__
 from bt_lsp.cli.main import main
 from bt_lsp.ide import name_fixes as fixes
-from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
 from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from lxml import etree
 
 from bt_lsp.ide.hover import hover_at
-from bt_lsp.ide.name_fixes import Fix, escape_value, fix_all, fixes_for
+from bt_lsp.ide.name_fixes import Fix, escape_value, fix_all, fixes_for_name
 from bt_lsp.ide.rename import RenamePlan, RenameRefused, rename
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
@@ -41,7 +41,7 @@ def name_diags(doc: Document) -> list[str]:
 def preferred_fix(doc: Document, name: str) -> tuple[str, str]:
     for d in own_diagnostics(doc):
         if d.is_name_rule and doc.text[d.start : d.end] == name:
-            fixes = fixes_for(doc, d)
+            fixes = fixes_for_name(doc, d)
             assert fixes[0].preferred and not any(f.preferred for f in fixes[1:])
             return fixes[0].title, apply_edits(doc.text, fixes[0].edits)
     raise AssertionError(f"no diagnostic on {name!r}")
@@ -203,7 +203,7 @@ def _diag_at(doc: Document, needle: str, nth: int = 0) -> Diagnostic:
 
 
 def _quick_fixes(doc: Document, needle: str, nth: int = 0) -> list[Fix]:
-    found = fixes_for(doc, _diag_at(doc, needle, nth))
+    found = fixes_for_name(doc, _diag_at(doc, needle, nth))
     assert found and found[0].preferred and not any(f.preferred for f in found[1:])
     return found
 
@@ -307,7 +307,7 @@ def test_fix_all_is_the_same_as_the_quick_fixes_one_after_the_other() -> None:
         diags = [d for d in own_diagnostics(doc) if d.is_name_rule]
         if not diags:
             break
-        text = apply_edits(text, fixes_for(doc, diags[0])[0].edits)
+        text = apply_edits(text, fixes_for_name(doc, diags[0])[0].edits)
     assert text == PORTS_FIXED
 
 
@@ -420,7 +420,7 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
         '<SetBlackboard output_key="out" value="{bad.port}"/></BehaviorTree></root>',
         "/ws/sub.xml",
     )
-    (fix, *_) = fixes_for(models, _diag_at(models, "bad.port"), {"/ws/sub.xml": tree})
+    (fix, *_) = fixes_for_name(models, _diag_at(models, "bad.port"), {"/ws/sub.xml": tree})
     assert fix.title == "Rename 'bad.port' to 'bad_port' (2 places, 1 other file)"
     assert apply_edits(tree.text, fix.other_edits["/ws/sub.xml"]) == tree.text.replace(
         "{bad.port}", "{bad_port}"

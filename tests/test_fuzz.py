@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from bt_lsp.ide.hover import hover_at
-from bt_lsp.ide.name_fixes import fix_all, fixes_for
+from bt_lsp.ide.name_fixes import fix_all, fixes_for_name
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
@@ -29,7 +29,7 @@ def exercise(doc: Document) -> None:
     n = len(doc.text)
     for d in diags:
         assert 0 <= d.start <= d.end <= n
-        for fix in fixes_for(doc, d):
+        for fix in fixes_for_name(doc, d):
             apply_edits(doc.text, fix.edits)
     apply_edits(doc.text, fix_all(doc, diags).edits)
     for offset in range(0, n + 1, max(1, n // 25)):

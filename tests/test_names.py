@@ -6,7 +6,6 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from bt_lsp.rules.codes import CODES
 from bt_lsp.rules.names import (
     BTCPP_RESERVED_ATTRIBUTES,
     FORBIDDEN,
@@ -21,6 +20,7 @@ from bt_lsp.rules.names import (
     check_name,
     is_allowed_port_name,
 )
+from bt_lsp.rules.registry import CODES
 
 MODEL = NameKind.MODEL
 PORT = NameKind.PORT

@@ -12,8 +12,9 @@ import pytest
 
 from bt_lsp.rules import semantics
 from bt_lsp.rules.analysis import analyze
-from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context
+from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
 from tests.marks import unmark
 

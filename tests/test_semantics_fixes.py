@@ -13,6 +13,7 @@ from bt_lsp.rules import semantics
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.semantics.nodes import UnknownNodeData
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
 from bt_lsp.syntax.scanner import decode_value
@@ -25,7 +26,7 @@ def fixes(doc: Document, code: str, ctx: Context | None = None) -> tuple[Diagnos
     ctx = ctx if ctx is not None else Context.from_document(doc)
     diags = [d for d in analyze(doc, ctx) if d.code == code]
     assert diags, f"no {code}"
-    return diags[0], semantic_fixes.fixes_for(doc, ctx, diags[0])
+    return diags[0], semantic_fixes.fixes_for_rule(doc, ctx, diags[0])
 
 
 def applied(doc: Document, fix: Fix) -> Document:
@@ -208,7 +209,7 @@ def test_unescaped_chars() -> None:
     assert len(diags) == 3
     edits = []
     for d in diags:
-        found = semantic_fixes.fixes_for(doc, ctx, d)
+        found = semantic_fixes.fixes_for_rule(doc, ctx, d)
         assert len(found) == 1 and found[0].preferred
         edits.extend(found[0].edits)
     new = Document(apply_edits(doc.text, edits))
@@ -230,7 +231,7 @@ def test_every_fix_removes_its_diagnostic(marked: str) -> None:
     doc = Document(unmark(marked)[0])
     ctx = Context.from_document(doc)
     for diag in semantics.check(doc, ctx):
-        for fix in semantic_fixes.fixes_for(doc, ctx, diag):
+        for fix in semantic_fixes.fixes_for_rule(doc, ctx, diag):
             new = Document(apply_edits(doc.text, fix.edits))
             after = analyze(new)
             assert not any(d.code == "xml-syntax" for d in after) or any(
@@ -238,7 +239,11 @@ def test_every_fix_removes_its_diagnostic(marked: str) -> None:
             ), fix.title
             if fix.title.startswith("Declare"):
                 still = [d for d in after if d.code == diag.code]
-                assert all(d.data and d.data.get("type") != diag.data["type"] for d in still)
+                assert isinstance(diag.data, UnknownNodeData)
+                assert all(
+                    isinstance(d.data, UnknownNodeData) and d.data.type != diag.data.type
+                    for d in still
+                )
             else:
                 assert not any(d.code == diag.code and d.start == diag.start for d in after), (
                     fix.title
@@ -283,5 +288,5 @@ def test_check_and_fixes_never_raise(tokens: list[str]) -> None:
     ctx = Context.from_document(doc)
     for diag in analyze(doc, ctx):
         assert 0 <= diag.start <= diag.end <= len(doc.text)
-        for fix in semantic_fixes.fixes_for(doc, ctx, diag):
+        for fix in semantic_fixes.fixes_for_rule(doc, ctx, diag):
             apply_edits(doc.text, fix.edits)

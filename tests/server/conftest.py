@@ -31,7 +31,7 @@ from pygls.protocol import default_converter
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
-from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.registry import CODES
 from tests.marks import unmark
 
 # The server under test, as users start it.

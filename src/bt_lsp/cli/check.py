@@ -38,8 +38,9 @@ from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.workspace import Workspace
-from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.diagnostics import with_severities
+from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
 
 __all__ = ["Options", "Progress", "check_file", "parse_severities", "run"]

@@ -15,7 +15,7 @@ from bt_lsp.cli.results import analyze
 from bt_lsp.ide import name_fixes as fixes
 from bt_lsp.project.fileio import Decoded
 from bt_lsp.project.workspace import Workspace
-from bt_lsp.rules.codes import CODES
+from bt_lsp.rules.codes import XML, defined
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, apply_edits
@@ -40,7 +40,7 @@ def _touches(d: Diagnostic, spans: Sequence[tuple[int, int]], starts: Sequence[i
 
 
 def _xml_counts(diags: Iterable[Diagnostic]) -> Counter[str]:
-    return Counter(d.code for d in diags if CODES[d.code].family == "xml")
+    return Counter(d.code for d in diags if defined(d.code).family == XML)
 
 
 def _well_formed(data: bytes) -> bool:

@@ -33,6 +33,7 @@ from bt_lsp.ide.name_edits import (
 from bt_lsp.ide.rename import RenamePlan, Renamer, RenameRefused, combined
 from bt_lsp.ide.sanitize import candidates, sanitize
 from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.names import NAME_FIX_TITLES
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, escape_value
 from bt_lsp.syntax.elements import NameRef, Symbol
@@ -43,7 +44,7 @@ __all__ = [
     "Renaming",
     "escape_value",
     "fix_all",
-    "fixes_for",
+    "fixes_for_name",
     "occurrences",
     "other_file_edits",
     "preferred_renaming",
@@ -78,9 +79,9 @@ class Renaming:
             where += f", {n} other file{'s' if n > 1 else ''}"
         old = shown(self.old)
         title = (
-            f"Clear '{old}' ({where})"
+            NAME_FIX_TITLES["clear"].format(old=old, where=where)
             if not self.new
-            else f"Rename '{old}' to '{shown(self.new)}' ({where})"
+            else NAME_FIX_TITLES["rename"].format(old=old, new=shown(self.new), where=where)
         )
         if self.kept is not None:
             title += f"; {self.kept} left as it is"
@@ -196,7 +197,7 @@ def preferred_renaming(
     return next(renamings(Renamer(doc, others), ref, taken), None)
 
 
-def fixes_for(
+def fixes_for_name(
     doc: Document, diag: Diagnostic, others: Mapping[str, Document] | None = None
 ) -> list[Fix]:
     """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.

@@ -16,66 +16,80 @@ Pure: they return edits.  Each fix leaves the document well-formed.
 from __future__ import annotations
 
 from bisect import bisect_right
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from bt_lsp.ide.fix import Fix
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.diagnostics import XML_UNESCAPED_CHAR, Diagnostic
 from bt_lsp.rules.names import is_allowed_port_name
+from bt_lsp.rules.semantics.document import MISSING_FORMAT
+from bt_lsp.rules.semantics.nodes import ID_ON_COMPACT_NODE, UNKNOWN_NODE, UnknownNodeData
+from bt_lsp.rules.semantics.ports import UNKNOWN_ATTRIBUTE, AttributeSuggestion
 from bt_lsp.syntax.edits import TextEdit, escape_value
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.scanner import UNESCAPED
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
 
-__all__ = ["fixes_for"]
+__all__ = ["fixes_for_rule"]
 
 _ESCAPES = {"&": "&amp;", "<": "&lt;"}
 
 
-def fixes_for(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
-    """The quick fixes of one diagnostic; the preferred one first."""
-    code = diag.code
-    text = doc.text
-    if code == UNESCAPED:
-        ch = text[diag.start : diag.end]
-        if ch in _ESCAPES:
-            new = _ESCAPES[ch]
-            return [
-                Fix(
-                    f"Escape '{ch}' as '{new}'",
-                    (TextEdit(diag.start, diag.end, new),),
-                    True,
-                    diag,
-                )
-            ]
+def fixes_for_rule(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    """The quick fixes of one diagnostic of a rule other than the name rules; the preferred
+    one first."""
+    fixer = _FIXERS.get(diag.code)
+    return fixer(doc, ctx, diag) if fixer is not None else []
+
+
+def _escape(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    ch = doc.text[diag.start : diag.end]
+    new = _ESCAPES.get(ch)
+    if new is None:
         return []
-    model = doc.model
-    if code == "missing-format":
-        root = model.root
-        if root is None or root.attr("BTCPP_format") is not None:
-            return []
-        edit = TextEdit(root.name_end, root.name_end, ' BTCPP_format="4"')
-        return [Fix('Add BTCPP_format="4" to <root>', (edit,), True, diag)]
-    el = _element_at(doc, model, diag.start)
-    if el is None:
+    title = XML_UNESCAPED_CHAR.fix_title("escape", char=ch, escaped=new)
+    return [Fix(title, (TextEdit(diag.start, diag.end, new),), True, diag)]
+
+
+def _add_format(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    root = doc.model.root
+    if root is None or root.attr("BTCPP_format") is not None:
         return []
-    if code == "id-on-compact-node":
-        return _remove_id(text, el, diag)
-    if code == "unknown-attribute":
-        data = diag.data or {}
-        suggestion = data.get("suggestion")
-        if not isinstance(suggestion, str):
-            return []
-        old = text[diag.start : diag.end]
-        edit = TextEdit(diag.start, diag.end, suggestion)
-        title = f"Did you mean '{suggestion}'? Rename '{old}'"
-        return [Fix(title, (edit,), bool(data.get("preferred")), diag)]
-    if code == "unknown-node":
-        return _unknown_node(doc, ctx, model, el, diag)
-    return []
+    edit = TextEdit(root.name_end, root.name_end, ' BTCPP_format="4"')
+    return [Fix(MISSING_FORMAT.fix_title("add"), (edit,), True, diag)]
+
+
+def _suggested_attribute(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    data = diag.data
+    if not isinstance(data, AttributeSuggestion) or _element_at(doc, doc.model, diag.start) is None:
+        return []
+    old = doc.text[diag.start : diag.end]
+    edit = TextEdit(diag.start, diag.end, data.suggestion)
+    title = UNKNOWN_ATTRIBUTE.fix_title("rename", suggestion=data.suggestion, old=old)
+    return [Fix(title, (edit,), data.preferred, diag)]
+
+
+def _remove_id_fix(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    el = _element_at(doc, doc.model, diag.start)
+    return _remove_id(doc.text, el, diag) if el is not None else []
+
+
+def _unknown_node_fixes(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    el = _element_at(doc, doc.model, diag.start)
+    return _unknown_node(doc, ctx, doc.model, el, diag) if el is not None else []
+
+
+# The fixes of each code that has some (their titles are defined with the code).
+_FIXERS: dict[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = {
+    XML_UNESCAPED_CHAR.code: _escape,
+    MISSING_FORMAT.code: _add_format,
+    ID_ON_COMPACT_NODE.code: _remove_id_fix,
+    UNKNOWN_ATTRIBUTE.code: _suggested_attribute,
+    UNKNOWN_NODE.code: _unknown_node_fixes,
+}
 
 
 def _element_at(doc: Document, model: Model, offset: int) -> Element | None:
@@ -101,25 +115,24 @@ def _remove_id(text: str, el: Element, diag: Diagnostic) -> list[Fix]:
         end = el.span_of_name(a)[1]
     else:
         end = el.token_start + a.value_end + (1 if a.quote else 0)
-    return [Fix(f"Remove ID from <{el.name}>", (TextEdit(start, end, ""),), True, diag)]
+    title = ID_ON_COMPACT_NODE.fix_title("remove", element=el.name)
+    return [Fix(title, (TextEdit(start, end, ""),), True, diag)]
 
 
 def _unknown_node(
     doc: Document, ctx: Context, model: Model, el: Element, diag: Diagnostic
 ) -> list[Fix]:
-    data = diag.data or {}
-    type_id = data.get("type")
-    if not isinstance(type_id, str):
+    data = diag.data
+    if not isinstance(data, UnknownNodeData):
         return []
-    explicit = bool(data.get("explicit"))
+    type_id, explicit, new = data.type, data.explicit, data.rename
     fixes: list[Fix] = []
-    new = data.get("rename")
-    if isinstance(new, str):
+    if new is not None:
         fixes.append(
             Fix(
-                f"Rename '{type_id}' to '{new}'",
+                UNKNOWN_NODE.fix_title("rename", type=type_id, new=new),
                 tuple(_rename_edits(el, explicit, new)),
-                bool(data.get("preferred")),
+                data.preferred,
                 diag,
             )
         )
@@ -132,7 +145,7 @@ def _unknown_node(
         call = f'SubTree ID="{escape_value(type_id, chr(34))}"'
         fixes.append(
             Fix(
-                f"Call tree '{type_id}' with <SubTree>",
+                UNKNOWN_NODE.fix_title("subtree", type=type_id),
                 (TextEdit(el.name_start, el.name_end, call),),
                 False,
                 diag,
@@ -140,7 +153,8 @@ def _unknown_node(
         )
     declare = _declare(doc.text, model, el, type_id, explicit)
     if declare is not None:
-        fixes.append(Fix(f"Declare '{type_id}' in <TreeNodesModel>", (declare,), False, diag))
+        title = UNKNOWN_NODE.fix_title("declare", type=type_id)
+        fixes.append(Fix(title, (declare,), False, diag))
     return fixes
 
 

@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import Any, Final
 
 from bt_lsp.project.settings import BTCPP_CHOICES, Settings
-from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.registry import CODES
 
 __all__ = [
     "CONFIG_FILE",

@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final
 
-from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.registry import CODES
 
 DEFAULT_MAX_DOCUMENT_BYTES = 8 * 1024 * 1024
 MAX_DEBOUNCE_MS = 60_000

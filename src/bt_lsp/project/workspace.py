@@ -23,6 +23,13 @@ from bt_lsp.project.settings import Settings
 from bt_lsp.rules import analysis
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic, limited, make
+from bt_lsp.rules.includes import (
+    INCLUDE_CYCLE,
+    INCLUDE_NOT_FOUND,
+    cycle,
+    includes_itself,
+    not_found,
+)
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
@@ -340,13 +347,7 @@ class Workspace:
                 continue  # no path / unmapped ros_pkg: the document's own rules say so
             if inc.target == path:
                 out.append(
-                    make(
-                        inc.start,
-                        inc.end,
-                        "include-cycle",
-                        f"'{inc.written}' includes this file itself; BehaviorTree.CPP "
-                        "recurses until it crashes",
-                    )
+                    make(inc.start, inc.end, INCLUDE_CYCLE.code, includes_itself(inc.written))
                 )
                 continue
             if self.document(inc.target) is None:
@@ -355,23 +356,15 @@ class Workspace:
                     make(
                         inc.start,
                         inc.end,
-                        "include-not-found",
-                        f"Included file '{inc.written}' not found ({inc.target}: {why})",
+                        INCLUDE_NOT_FOUND.code,
+                        not_found(inc.written, str(inc.target), why),
                     )
                 )
                 continue
             chain = self._reaches(inc.target, path)
             if chain is not None:
                 names = " → ".join(_short(p, path) for p in [path, *chain])
-                out.append(
-                    make(
-                        inc.start,
-                        inc.end,
-                        "include-cycle",
-                        f"Include cycle: {names}; BehaviorTree.CPP fails with a "
-                        "misleading 'file not found' or crashes",
-                    )
-                )
+                out.append(make(inc.start, inc.end, INCLUDE_CYCLE.code, cycle(names)))
         return out
 
     # -- what one document sees ----------------------------------------------------------------

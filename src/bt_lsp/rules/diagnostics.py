@@ -8,10 +8,10 @@ from __future__ import annotations
 import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Final
 
-from bt_lsp.rules.codes import CODES, Severity
-from bt_lsp.rules.names import NameKind, Violation, check_name
+from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
+from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.syntax.elements import NameRef, Role
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Scan
@@ -19,6 +19,34 @@ from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
+
+# The codes of these rules (see bt_lsp.rules.registry).
+XML_SYNTAX: Final = define("xml-syntax", Severity.ERROR, "the document is not well-formed XML", XML)
+XML_UNESCAPED_CHAR: Final = define(
+    "xml-unescaped-char",
+    Severity.WARNING,
+    "a raw `&` or `<` in an attribute value (tinyxml2 accepts it, XML does not)",
+    XML,
+    fixes={"escape": "Escape '{char}' as '{escaped}'"},
+)
+XML_DOCTYPE: Final = define(
+    "xml-doctype",
+    Severity.WARNING,
+    "a DOCTYPE; its entities and external DTDs are never expanded or fetched",
+    XML,
+)
+DOCUMENT_TOO_LARGE: Final = define(
+    "document-too-large",
+    Severity.INFORMATION,
+    "analysis limited because the document is larger than the configured maximum",
+    XML,
+)
+TOO_MANY_PROBLEMS: Final = define(
+    "too-many-problems",
+    Severity.INFORMATION,
+    "more problems than a client can usefully show; only the first are reported",
+    XML,
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -30,17 +58,15 @@ class Diagnostic:
     code: str
     message: str
     severity: Severity
-    data: Mapping[str, Any] | None = field(default=None, compare=True)
+    data: FixData | None = field(default=None, compare=True)
 
     @property
     def is_name_rule(self) -> bool:
-        return CODES[self.code].family == "names"
+        return defined(self.code).family == NAMES
 
 
-def make(
-    start: int, end: int, code: str, message: str, data: Mapping[str, Any] | None = None
-) -> Diagnostic:
-    return Diagnostic(start, end, code, message, CODES[code].severity, data)
+def make(start: int, end: int, code: str, message: str, data: FixData | None = None) -> Diagnostic:
+    return Diagnostic(start, end, code, message, defined(code).severity, data)
 
 
 # The violations of each name text, per role (a role decides the kind and whether the
@@ -93,7 +119,7 @@ def ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
                     end,
                     v.code,
                     v.message,
-                    {"name": text, "kind": str(kind), "role": str(role)},
+                    NameData(text, kind, role),
                 )
             )
     return out
@@ -191,7 +217,7 @@ def limited(diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS) -> list[Dia
         make(
             0,
             0,
-            "too-many-problems",
+            TOO_MANY_PROBLEMS.code,
             f"{len(diags) - maximum} more problems are not shown "
             f"(only the first {maximum} are reported)",
         )
@@ -206,3 +232,19 @@ def own_diagnostics(doc: Document) -> list[Diagnostic]:
     if found is None:
         found = doc.own_diagnostics = compute(doc)
     return found
+
+
+def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
+    """What a document larger than ``max_bytes`` (UTF-8) gets: its own diagnostics (XML and
+    names, which stay cheap) and ``document-too-large`` saying the rest does not run."""
+    out = list(own_diagnostics(doc))
+    out.append(
+        make(
+            0,
+            0,
+            DOCUMENT_TOO_LARGE.code,
+            f"Document is {doc.utf8_size} bytes, above btLsp.maxDocumentBytes "
+            f"({max_bytes}): only XML and name checks run",
+        )
+    )
+    return out

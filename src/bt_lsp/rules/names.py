@@ -15,6 +15,8 @@ import re
 from dataclasses import dataclass
 from typing import Final
 
+from bt_lsp.rules.codes import NAMES, FixData, Severity, define
+from bt_lsp.syntax.elements import Role
 from bt_lsp.syntax.vocabulary import (
     BTCPP_RESERVED_ATTRIBUTES,
     FORBIDDEN,
@@ -24,6 +26,78 @@ from bt_lsp.syntax.vocabulary import (
     RESERVED_PORT_NAMES,
     NameKind,
 )
+
+
+@dataclass(frozen=True, slots=True)
+class NameData(FixData):
+    """What a name diagnostic tells its fixes: the name as written, its kind and role."""
+
+    name: str
+    kind: NameKind
+    role: Role
+
+    def as_json(self) -> dict[str, object]:
+        return {"name": self.name, "kind": str(self.kind), "role": str(self.role)}
+
+
+#: The titles of the quick fixes of every name code: a rename to a sanitized, unique name
+#: (``where`` counts the places and the other files it changes), or clearing an instance
+#: name that has nothing left to keep.
+NAME_FIX_TITLES: Final = {
+    "rename": "Rename '{old}' to '{new}' ({where})",
+    "clear": "Clear '{old}' ({where})",
+}
+
+# The codes of these rules (see bt_lsp.rules.registry).
+MODEL_NAME_EMPTY: Final = define(
+    "model-name-empty", Severity.ERROR, "a model name is empty", NAMES, fixes=NAME_FIX_TITLES
+)
+MODEL_NAME_RESERVED: Final = define(
+    "model-name-reserved",
+    Severity.ERROR,
+    "a model name is `Root` or `root`",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+MODEL_NAME_FORBIDDEN_CHAR: Final = define(
+    "model-name-forbidden-char",
+    Severity.ERROR,
+    "a model name contains a forbidden character",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+PORT_NAME_EMPTY: Final = define(
+    "port-name-empty", Severity.ERROR, "a port name is empty", NAMES, fixes=NAME_FIX_TITLES
+)
+PORT_NAME_LEADING_DIGIT: Final = define(
+    "port-name-leading-digit",
+    Severity.ERROR,
+    "a port name starts with an ASCII digit",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+PORT_NAME_RESERVED: Final = define(
+    "port-name-reserved",
+    Severity.ERROR,
+    "a port declared in `<TreeNodesModel>` uses a reserved attribute name",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+PORT_NAME_FORBIDDEN_CHAR: Final = define(
+    "port-name-forbidden-char",
+    Severity.ERROR,
+    "a port name contains a forbidden character",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+INSTANCE_NAME_CONTROL_CHAR: Final = define(
+    "instance-name-control-char",
+    Severity.ERROR,
+    "an instance name contains a control character",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+
 
 __all__ = [
     "BTCPP_RESERVED_ATTRIBUTES",
@@ -151,7 +225,7 @@ class Violation:
     """One broken rule of one name."""
 
     code: str
-    """A diagnostic code from :mod:`bt_lsp.rules.codes`."""
+    """A diagnostic code (defined below, see :mod:`bt_lsp.rules.registry`)."""
     message: str
     """One line: what is wrong, which characters (shown visibly, with columns) and why."""
     chars: tuple[BadChar, ...]

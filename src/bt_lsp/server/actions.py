@@ -15,7 +15,7 @@ from lsprotocol import types
 from pygls.uris import from_fs_path
 
 from bt_lsp.ide import semantic_fixes
-from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for
+from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for_name
 from bt_lsp.project.workspace import normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -66,14 +66,14 @@ def _others(ls: BtServer, od: OpenDocument) -> dict[str, Document]:
 
 
 def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
-    fixes = fixes_for(od.doc, diag, _others(ls, od))
+    fixes = fixes_for_name(od.doc, diag, _others(ls, od))
     if not diag.is_name_rule:
         ctx = (
             ls.project.context_for(od.path, od.doc)
             if od.path is not None
             else Context.from_document(od.doc)
         )
-        fixes += semantic_fixes.fixes_for(od.doc, ctx, diag)
+        fixes += semantic_fixes.fixes_for_rule(od.doc, ctx, diag)
     return fixes
 
 

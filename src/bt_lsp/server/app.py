@@ -21,9 +21,9 @@ from bt_lsp import __version__
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.workspace import Workspace
 from bt_lsp.rules.analysis import analyze
-from bt_lsp.rules.codes import CODES
-from bt_lsp.rules.diagnostics import Diagnostic, make, own_diagnostics, with_severities
+from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
+from bt_lsp.rules.registry import CODES
 from bt_lsp.server.convert import diagnostic_at, to_diagnostic
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
@@ -85,18 +85,8 @@ class BtServer(LanguageServer):
         if not od.is_bt:
             result: list[Diagnostic] = []
         else:
-            size = od.doc.utf8_size
-            if size > self.settings.max_document_bytes:
-                result = list(own_diagnostics(od.doc))
-                result.append(
-                    make(
-                        0,
-                        0,
-                        "document-too-large",
-                        f"Document is {size} bytes, above btLsp.maxDocumentBytes "
-                        f"({self.settings.max_document_bytes}): only XML and name checks run",
-                    )
-                )
+            if od.doc.utf8_size > self.settings.max_document_bytes:
+                result = size_limited(od.doc, self.settings.max_document_bytes)
             elif od.path is not None:
                 result = self.project.diagnostics(od.path, od.doc)
             else:

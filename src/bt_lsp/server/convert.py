@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from bt_lsp.rules.codes import CODES
 from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.text import Encoding, LineIndex
 
@@ -36,7 +36,7 @@ def diagnostic_at(rng: types.Range, d: Diagnostic) -> types.Diagnostic:
         code=d.code,
         code_description=types.CodeDescription(href=info.url) if info else None,
         source="bt-lsp",
-        data=dict(d.data) if d.data is not None else None,
+        data=d.data.as_json() if d.data is not None else None,
     )
 
 

@@ -13,7 +13,8 @@ from urllib.parse import quote
 
 from bt_lsp import __version__
 from bt_lsp.cli.results import FILE_ERROR, FileResult
-from bt_lsp.rules.codes import CODES, DOCS_URL, Severity
+from bt_lsp.rules.codes import DOCS_URL, Severity
+from bt_lsp.rules.registry import CODES
 
 SARIF_SCHEMA: Final = "https://json.schemastore.org/sarif-2.1.0.json"
 SRCROOT: Final = "%SRCROOT%"

@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any, Final, Literal
+from typing import TYPE_CHECKING, Final, Literal
 
 from bt_lsp.rules.builtins import BUILTINS, Category, PortModel
-from bt_lsp.rules.codes import CODES, Severity
+from bt_lsp.rules.codes import BT, FixData, Severity, define, defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
@@ -16,6 +16,15 @@ from bt_lsp.syntax.model import Model
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
+
+# The codes of these rules (see bt_lsp.rules.registry).
+MISSING_ID: Final = define(
+    "missing-id",
+    Severity.ERROR,
+    "a `<BehaviorTree>`, explicit node, `<SubTree>` or model entry has no `ID`",
+    BT,
+)
+
 
 Origin = Literal["builtin", "custom", "subtree"]
 
@@ -117,9 +126,9 @@ class State:
         code: str,
         message: str,
         severity: Severity | None = None,
-        data: Mapping[str, Any] | None = None,
+        data: FixData | None = None,
     ) -> None:
-        sev = CODES[code].severity if severity is None else severity
+        sev = defined(code).severity if severity is None else severity
         if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
             sev = Severity.WARNING
             message += " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"

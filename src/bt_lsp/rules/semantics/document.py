@@ -27,8 +27,38 @@ from __future__ import annotations
 
 from typing import Final
 
+from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.semantics.base import State, quoted
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
+
+# The codes of these rules (see bt_lsp.rules.registry).
+ROOT_ELEMENT: Final = define("root-element", Severity.ERROR, "the top element is not `<root>`", BT)
+MISSING_FORMAT: Final = define(
+    "missing-format",
+    Severity.WARNING,
+    "`<root>` has no `BTCPP_format`",
+    BT,
+    fixes={"add": 'Add BTCPP_format="4" to <root>'},
+)
+DUPLICATE_MODEL_SECTION: Final = define(
+    "duplicate-model-section", Severity.ERROR, "a second `<TreeNodesModel>` section", BT
+)
+INCLUDE_MISSING_PATH: Final = define(
+    "include-missing-path", Severity.ERROR, "an `<include>` without `path`", BT
+)
+INCLUDE_ROS_PKG: Final = define(
+    "include-ros-pkg",
+    Severity.WARNING,
+    "an `<include ros_pkg>` whose package bt-lsp cannot resolve",
+    BT,
+)
+NO_MAIN_TREE: Final = define(
+    "no-main-tree", Severity.INFORMATION, "several trees and no `main_tree_to_execute`", BT
+)
+NESTING_DEPTH: Final = define(
+    "nesting-depth", Severity.ERROR, "a tree nested deeper than 256 levels", BT
+)
+
 
 MAX_DEPTH: Final = 256
 # Element depth in the model: <root> 0, <BehaviorTree> 1, so a node at model depth d is

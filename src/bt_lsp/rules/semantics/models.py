@@ -13,9 +13,17 @@
 
 from __future__ import annotations
 
+from typing import Final
+
+from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.rules.semantics.base import State, quoted
 from bt_lsp.syntax.elements import Element
+
+# The codes of these rules (see bt_lsp.rules.registry).
+MISSING_PORT_NAME: Final = define(
+    "missing-port-name", Severity.ERROR, "a SubTree model port has no `name`", BT
+)
 
 
 def check_entry(st: State, el: Element) -> None:

@@ -33,14 +33,79 @@
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from typing import Final
 
 from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
-from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.codes import BT, FixData, Severity, define
 from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
+
+
+@dataclass(frozen=True, slots=True)
+class UnknownNodeData(FixData):
+    """What ``unknown-node`` tells its fixes: the type as written, whether the node is in
+    explicit form, and the type to rename it to (``preferred`` when that is surely
+    meant: a version 3 name or a built-in spelled in another case)."""
+
+    type: str
+    explicit: bool
+    rename: str | None = None
+    preferred: bool = False
+
+    def as_json(self) -> dict[str, object]:
+        out: dict[str, object] = {"type": self.type, "explicit": self.explicit}
+        if self.rename is not None:
+            out |= {"rename": self.rename, "preferred": self.preferred}
+        return out
+
+
+# The codes of these rules (see bt_lsp.rules.registry).
+ID_ON_COMPACT_NODE: Final = define(
+    "id-on-compact-node",
+    Severity.ERROR,
+    "`ID` on a node written in compact form",
+    BT,
+    fixes={"remove": "Remove ID from <{element}>"},
+)
+UNKNOWN_NODE: Final = define(
+    "unknown-node",
+    Severity.ERROR,
+    (
+        "a node type that is neither built in nor declared (a hint "
+        "unless a catalog of the custom nodes is configured)"
+    ),
+    BT,
+    fixes={
+        "rename": "Rename '{type}' to '{new}'",
+        "subtree": "Call tree '{type}' with <SubTree>",
+        "declare": "Declare '{type}' in <TreeNodesModel>",
+    },
+)
+CHILD_COUNT: Final = define(
+    "child-count", Severity.ERROR, "a node with the wrong number of children", BT
+)
+REACTIVE_ASYNC_CHILDREN: Final = define(
+    "reactive-async-children",
+    Severity.ERROR,
+    "a `ReactiveSequence` with more than one `AsyncSequence` child",
+    BT,
+)
+REACTIVE_EXPLICIT_CHILD: Final = define(
+    "reactive-explicit-child",
+    Severity.ERROR,
+    "a `ReactiveSequence` child written in explicit form (`<Action ID=…>`)",
+    BT,
+)
+PARALLEL_THRESHOLD: Final = define(
+    "parallel-threshold",
+    Severity.ERROR,
+    "a `Parallel` threshold larger than its number of children",
+    BT,
+)
+
 
 _BUILTIN_LOWER: Final[dict[str, str]] = {k.lower(): k for k in BUILTINS}
 _LEADING_INT: Final = re.compile(r"-?[0-9]+")
@@ -115,11 +180,11 @@ def _count(n: int) -> str:
 def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explicit: bool) -> None:
     if not explicit and check_name(type_id, NameKind.MODEL):
         return  # the name rules report it (BehaviorTree.CPP checks the name first)
-    data: dict[str, object] = {"type": type_id, "explicit": explicit}
+    data = UnknownNodeData(type_id, explicit)
     ctx = st.ctx
     if type_id in V3_RENAMES:
         new = V3_RENAMES[type_id]
-        data |= {"rename": new, "preferred": True}
+        data = UnknownNodeData(type_id, explicit, new, preferred=True)
         why = (
             "a misspelling that BehaviorTree.CPP does not register"
             if type_id in _MISSPELLINGS
@@ -157,7 +222,7 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
         return
     known = _BUILTIN_LOWER.get(type_id.lower())
     if known is not None:
-        data |= {"rename": known, "preferred": True}
+        data = UnknownNodeData(type_id, explicit, known, preferred=True)
         st.add(
             start,
             end,
@@ -171,7 +236,7 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
     severity = None if ctx.workspace_has_custom_models else Severity.HINT
     suggestion = _closest(st, type_id)
     if suggestion is not None:
-        data |= {"rename": suggestion, "preferred": False}
+        data = UnknownNodeData(type_id, explicit, suggestion)
     if ctx.workspace_has_custom_models:
         message = (
             f"Node type {quoted(type_id)} is not a built-in node and is not declared in any "

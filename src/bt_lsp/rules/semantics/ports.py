@@ -35,11 +35,12 @@ reserved; everything else is silently ignored by BehaviorTree.CPP.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Final
 
 from bt_lsp.rules.builtins import PortModel
-from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.codes import BT, FixData, Severity, define
 from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
 from bt_lsp.rules.names import (
     POSTCONDITIONS,
@@ -60,6 +61,60 @@ from bt_lsp.rules.semantics.base import (
 )
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.scanner import Attr
+
+
+@dataclass(frozen=True, slots=True)
+class MissingPorts(FixData):
+    """The ports ``missing-required-port`` found missing, in their declared order."""
+
+    ports: tuple[str, ...]
+
+    def as_json(self) -> dict[str, object]:
+        return {"ports": list(self.ports)}
+
+
+@dataclass(frozen=True, slots=True)
+class AttributeSuggestion(FixData):
+    """What ``unknown-attribute`` tells its fix: the reserved attribute most likely meant,
+    and whether it is surely meant (``preferred``)."""
+
+    suggestion: str
+    preferred: bool
+
+    def as_json(self) -> dict[str, object]:
+        return {"suggestion": self.suggestion, "preferred": self.preferred}
+
+
+# The codes of these rules (see bt_lsp.rules.registry).
+UNDECLARED_PORT: Final = define(
+    "undeclared-port", Severity.ERROR, "an attribute the node's model does not declare", BT
+)
+MISSING_REQUIRED_PORT: Final = define(
+    "missing-required-port", Severity.ERROR, "a port without a default that is not given", BT
+)
+INVALID_PORT_VALUE: Final = define(
+    "invalid-port-value", Severity.ERROR, "a literal that does not convert to the port's type", BT
+)
+BLACKBOARD_TYPE_MISMATCH: Final = define(
+    "blackboard-type-mismatch",
+    Severity.ERROR,
+    "one blackboard key used by ports of different types",
+    BT,
+)
+PORT_NAME_NOT_REMAPPABLE: Final = define(
+    "port-name-not-remappable",
+    Severity.WARNING,
+    "a port name that does not start with an ASCII letter, so XML cannot set it",
+    BT,
+)
+UNKNOWN_ATTRIBUTE: Final = define(
+    "unknown-attribute",
+    Severity.WARNING,
+    "an underscore attribute BehaviorTree.CPP silently ignores",
+    BT,
+    fixes={"rename": "Did you mean '{suggestion}'? Rename '{old}'"},
+)
+
 
 # Underscore attributes that editors and BehaviorTree.CPP itself write on purpose:
 # descriptions, WriteTreeToXML's metadata, and the editors' collapsed-node flag.
@@ -169,10 +224,10 @@ def _unknown_attribute(st: State, an: str, s: int, e: int) -> None:
         "(ports start with a letter) nor a reserved attribute"
     )
     sug = suggest_attribute(an)
-    data: dict[str, object] | None = None
+    data: AttributeSuggestion | None = None
     if sug is not None:
         message += f"; did you mean {quoted(sug[0])}?"
-        data = {"suggestion": sug[0], "preferred": sug[1]}
+        data = AttributeSuggestion(sug[0], sug[1])
     st.add(s, e, "unknown-attribute", message, None, data)
 
 
@@ -277,7 +332,12 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         )
         severity = Severity.WARNING
     st.add(
-        el.name_start, el.name_end, "missing-required-port", message, severity, {"ports": missing}
+        el.name_start,
+        el.name_end,
+        "missing-required-port",
+        message,
+        severity,
+        MissingPorts(tuple(missing)),
     )
 
 

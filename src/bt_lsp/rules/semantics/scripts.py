@@ -14,13 +14,17 @@ post-condition attributes (``_skipIf`` … ``_post``) on any node.
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import Final
 
-from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.script import ScriptError, check_script
 from bt_lsp.rules.semantics.base import State
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.scanner import Attr
 from bt_lsp.syntax.values import raw_span
+
+# The codes of these rules (see bt_lsp.rules.registry).
+SCRIPT_SYNTAX: Final = define("script-syntax", Severity.ERROR, "a script that does not parse", BT)
 
 
 @lru_cache(maxsize=16384)

@@ -30,16 +30,48 @@ import os
 import weakref
 from itertools import compress
 from operator import itemgetter
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Final
 
 from bt_lsp.rules.builtins import BUILTINS
-from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.context import TreeDecl
 from bt_lsp.rules.semantics.base import State, TreeScope, quoted
 from bt_lsp.syntax.elements import Element
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
+
+# The codes of these rules (see bt_lsp.rules.registry).
+TREE_CHILD_COUNT: Final = define(
+    "tree-child-count",
+    Severity.ERROR,
+    "a `<BehaviorTree>` does not have exactly one child element",
+    BT,
+)
+UNKNOWN_SUBTREE: Final = define(
+    "unknown-subtree", Severity.ERROR, "a `<SubTree ID>` that names no tree", BT
+)
+UNKNOWN_MAIN_TREE: Final = define(
+    "unknown-main-tree", Severity.ERROR, "`main_tree_to_execute` names no tree", BT
+)
+DUPLICATE_TREE_ID: Final = define(
+    "duplicate-tree-id", Severity.WARNING, "two trees with the same `ID`", BT
+)
+REGISTERED_NAME_AS_TREE_ID: Final = define(
+    "registered-name-as-tree-id",
+    Severity.ERROR,
+    "a tree ID that is the name of a registered node type",
+    BT,
+)
+SUBTREE_RECURSION: Final = define(
+    "subtree-recursion", Severity.ERROR, "trees that call each other in a cycle", BT
+)
+DUPLICATE_SUBTREE_NAME: Final = define(
+    "duplicate-subtree-name",
+    Severity.ERROR,
+    "two `<SubTree>` calls with the same `name` in one tree",
+    BT,
+)
 
 
 def _where(st: State, decl: TreeDecl) -> str:

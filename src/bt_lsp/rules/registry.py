@@ -1,0 +1,41 @@
+"""The one table of every diagnostic code.
+
+Each rule defines its codes beside itself (:func:`bt_lsp.rules.codes.define`); this module
+imports every module that defines one, so :data:`CODES` is complete: the README's code
+table (``scripts/codes_doc.py``), the server's ``codeDescription`` links, SARIF rules and
+the severity settings read it.  Ordered by family, then by name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Final
+
+from bt_lsp.rules import diagnostics, includes, names  # noqa: F401  (they define codes)
+from bt_lsp.rules.codes import BT, NAMES, XML, Code, all_defined
+from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
+    base,
+    document,
+    models,
+    nodes,
+    ports,
+    scripts,
+    trees,
+)
+
+#: The families in the order the README lists them, with their headings.
+FAMILIES: Final[Mapping[str, str]] = MappingProxyType(
+    {NAMES: "Name rules", XML: "XML", BT: "BehaviorTree.CPP semantics"}
+)
+
+CODES: Final[Mapping[str, Code]] = MappingProxyType(
+    {
+        c.code: c
+        for c in sorted(
+            all_defined().values(), key=lambda c: (list(FAMILIES).index(c.family), c.code)
+        )
+    }
+)
+
+__all__ = ["CODES", "FAMILIES"]
