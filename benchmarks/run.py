@@ -47,7 +47,7 @@ from lsp_client import LspClient, path_uri, rss_kib
 HERE = Path(__file__).resolve().parent
 SERVER = [sys.executable, "-m", "bt_lsp", "serve"]
 BARE = [sys.executable, str(HERE / "bare_server.py")]
-DEFAULT_CORPUS = HERE.parent.parent / "shared" / "corpus" / "real"
+DEFAULT_CORPUS = HERE.parent / "tests" / "data" / "corpus_real"
 # The warm-up document: one bad name, to ask for each kind of request once.
 TINY = '<root BTCPP_format="4"><BehaviorTree ID="T 1"><AlwaysSuccess/></BehaviorTree></root>\n'
 

@@ -1,6 +1,6 @@
 """Print a Markdown table of what bt-lsp finds in a corpus of BT XML, per project.
 
-    python scripts/corpus_report.py ../shared/corpus/real
+    python scripts/corpus_report.py tests/data/corpus_real
 
 Each project folder is checked as one workspace, the way `bt-lsp check DIR` does.
 """
@@ -17,7 +17,7 @@ from bt_lsp.rules.codes import Severity
 
 
 def main() -> int:
-    root = Path(sys.argv[1] if len(sys.argv) > 1 else "../shared/corpus/real")
+    root = Path(sys.argv[1] if len(sys.argv) > 1 else "tests/data/corpus_real")
     rows = []
     total: Counter[str] = Counter()
     for project in sorted(p for p in root.iterdir() if p.is_dir()):

@@ -20,7 +20,7 @@ from bt_lsp.rules.builtins import (
 )
 from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
 
-_SPEC = Path(__file__).resolve().parents[2] / "shared" / "spec" / "bt-xml.md"
+_SPEC = Path(__file__).parent / "data" / "spec" / "bt-xml.md"
 
 # Registration order of BehaviorTreeFactory's constructor in BehaviorTree.CPP 4.10.
 _EXPECTED_IDS = {
@@ -216,7 +216,7 @@ def test_selected_ports() -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# Cross-check with the table in shared/spec/bt-xml.md section (d)
+# Cross-check with the table in tests/data/spec/bt-xml.md section (d)
 
 _PORT = re.compile(
     r"\b(inout|in|out) `(\w+)` ([\w:]+(?:[ /][\w:]+)*?)"
@@ -243,14 +243,12 @@ def _spec_rows() -> list[tuple[list[str], str]]:
     return rows
 
 
-@pytest.mark.skipif(not _SPEC.is_file(), reason="shared/spec/bt-xml.md is not beside the repo")
 def test_spec_table_lists_exactly_the_builtins() -> None:
     ids = [id_ for row_ids, _ in _spec_rows() for id_ in row_ids]
     assert len(ids) == 42
     assert set(ids) == set(BUILTINS)
 
 
-@pytest.mark.skipif(not _SPEC.is_file(), reason="shared/spec/bt-xml.md is not beside the repo")
 def test_spec_table_ports_match() -> None:
     checked = 0
     for ids, description in _spec_rows():

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from bt_lsp.rules.script import ScriptError, _Checker, check_script, identifiers
 
-# Every distinct script found in the real corpus (shared/corpus/real): Script/ScriptCondition
+# Every distinct script found in the real corpus (tests/data/corpus_real): Script/ScriptCondition
 # `code`, Precondition `if` and the eight pre/post-condition attributes, XML-decoded.
 # All of them parse with BehaviorTree.CPP 4.10.
 REAL_SCRIPTS: list[str] = [
@@ -605,9 +605,9 @@ def test_appending_a_dangling_token_is_an_error(code: str, suffix: str) -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# The corpus itself, when shared/ sits beside the repository.
+# The corpus itself.
 
-_CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "real"
+_CORPUS = Path(__file__).parent / "data" / "corpus_real"
 _SCRIPT_ATTRIBUTES = frozenset(
     {
         "_skipIf",
@@ -665,7 +665,6 @@ def _corpus_scripts() -> list[str]:
     return scripts
 
 
-@pytest.mark.skipif(not _CORPUS.is_dir(), reason="shared/corpus/real is not beside the repo")
 def test_every_corpus_script_is_listed_and_parses() -> None:
     found = _corpus_scripts()
     assert len(found) > 300

@@ -9,8 +9,7 @@ problem that BehaviorTree.CPP 4 raises (the reason column says which), and
 (the corpus is a sample: those trees live in files that were not copied, and
 BehaviorTree.CPP raises "Can't find a tree" when the file is loaded without them).
 
-The local copy in ``data/corpus`` always runs; the full shared corpus
-(``../shared/corpus/real`` next to the repository) runs when it is there.
+The sample in ``data/corpus`` and the whole corpus in ``data/corpus_real`` both run.
 """
 
 from __future__ import annotations
@@ -20,8 +19,6 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-import pytest
-
 from bt_lsp.project.fileio import read_text
 from bt_lsp.rules import semantics
 from bt_lsp.rules.codes import Severity
@@ -30,7 +27,7 @@ from bt_lsp.syntax.document import Document
 
 HERE = Path(__file__).parent
 LOCAL = HERE / "data" / "corpus"
-SHARED = HERE.parent.parent / "shared" / "corpus" / "real"
+FULL = HERE / "data" / "corpus_real"
 KNOWN_FILE = HERE / "data" / "semantics" / "corpus_known_errors.tsv"
 
 KNOWN: dict[str, set[tuple[int, str, str]]] = defaultdict(set)
@@ -84,9 +81,8 @@ def test_local_corpus_has_only_known_errors() -> None:
     assert found == expected
 
 
-@pytest.mark.skipif(not SHARED.is_dir(), reason="the shared corpus is not available")
-def test_shared_corpus_has_only_known_errors() -> None:
-    docs = load(SHARED)
+def test_full_corpus_has_only_known_errors() -> None:
+    docs = load(FULL)
     found = errors(docs)
     assert found == {f: v for f, v in KNOWN.items() if v}
 

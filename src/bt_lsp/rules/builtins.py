@@ -2,7 +2,7 @@
 
 Pure data: no LSP imports and no I/O. The table mirrors the factory
 constructor of BehaviorTree.CPP 4.10 (42 types) with the ports each type declares in
-``providedPorts()``; see ``shared/spec/bt-xml.md`` section (d).
+``providedPorts()``; see ``tests/data/spec/bt-xml.md`` section (d).
 
 * :data:`BUILTINS` maps a registration ID to its :class:`NodeModel`.
 * :data:`V3_RENAMES` maps names from BehaviorTree.CPP 3.x (and one well-known typo) to
