@@ -176,9 +176,9 @@ def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[E
         ws = Workspace([root], Settings())
         for f in files:
             path = normalize(root / f.path)
-            doc = ws.document(path)
-            assert doc is not None, f.path
-            out.append((f, found(doc, ws.diagnostics(path, doc), str(root))))
+            opened = ws.document(path)
+            assert opened is not None, f.path
+            out.append((f, found(opened, ws.diagnostics(path, opened), str(root))))
     return out
 
 

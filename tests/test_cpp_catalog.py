@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -18,7 +19,7 @@ DATA = Path(__file__).parent / "data" / "cpp"
 FIXTURES = sorted(d.name for d in DATA.iterdir() if d.is_dir())
 
 
-def _summary(catalog):
+def _summary(catalog: Any) -> dict[str, Any]:
     return {
         n.id: {
             "kind": n.kind,
@@ -158,8 +159,8 @@ def test_find_cpp_files_skips_build_folders_and_excludes(tmp_path: Path) -> None
     (tmp_path / "src" / "notes.txt").write_text("")
     found = [p.relative_to(tmp_path).as_posix() for p in find_cpp_files([tmp_path])]
     assert found == ["include/p/a.hpp", "src/a.cpp", "src/t/x_test.cpp"]
-    found = find_cpp_files([tmp_path], exclude=["*_test.cpp"])
-    assert [p.name for p in found] == ["a.hpp", "a.cpp"]
+    kept = find_cpp_files([tmp_path], exclude=["*_test.cpp"])
+    assert [p.name for p in kept] == ["a.hpp", "a.cpp"]
 
 
 def test_library_bases_lose_to_the_projects_own(tmp_path: Path) -> None:

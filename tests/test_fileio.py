@@ -6,6 +6,7 @@ from __future__ import annotations
 import codecs
 import os
 import stat
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -124,7 +125,8 @@ def deny_access(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     fileio's own calls instead, the same ``PermissionError`` a denied ``open`` gives."""
     if os.name == "posix" and not os.access(path, os.R_OK | os.W_OK):
         return
-    real_open, real_mkstemp = open, fileio.tempfile.mkstemp
+    real_open = open
+    real_mkstemp: Any = tempfile.mkstemp
     denied = os.path.abspath(path)
 
     def refuse(target: Any) -> None:
@@ -141,7 +143,7 @@ def deny_access(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
         return real_mkstemp(*args, dir=dir, **kwargs)
 
     monkeypatch.setattr(fileio, "open", guarded_open, raising=False)
-    monkeypatch.setattr(fileio.tempfile, "mkstemp", guarded_mkstemp)
+    monkeypatch.setattr(tempfile, "mkstemp", guarded_mkstemp)
 
 
 def test_permission_denied(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -249,7 +251,9 @@ _ENCODED = st.sampled_from(
 )
 
 
-@settings(max_examples=150, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(text=st.text(st.characters(exclude_categories=["Cs"])), enc=_ENCODED)
 def test_read_then_write_is_byte_identical(
     tmp_path: Path, text: str, enc: tuple[str, bytes]

@@ -112,7 +112,10 @@ bad_name = st.text(
 @given(tree=bad_name, node=bad_name.filter(lambda s: s.strip() != ""), port=bad_name)
 @settings(max_examples=150, deadline=None)
 def test_fix_all_on_random_names_keeps_xml_well_formed(tree: str, node: str, port: str) -> None:
-    q = lambda s: escape_value(s, '"')  # noqa: E731
+
+    def q(s: str) -> str:
+        return escape_value(s, '"')
+
     text = (
         f'<root main_tree_to_execute="{q(tree)}"><BehaviorTree ID="{q(tree)}">'
         f'<Action ID="{q(node)}"/></BehaviorTree><TreeNodesModel>'

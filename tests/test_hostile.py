@@ -13,6 +13,7 @@ import sys
 import textwrap
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -103,7 +104,7 @@ AUDIT = textwrap.dedent(
 
 
 @pytest.fixture
-def hostile(tmp_path: Path) -> tuple[Path, Path, Listener]:
+def hostile(tmp_path: Path) -> Iterator[tuple[Path, Path, Listener]]:
     secret = tmp_path / "secret-do-not-read.txt"
     secret.write_text("TOP SECRET", encoding="utf-8")
     listener = Listener()
@@ -150,7 +151,7 @@ def test_server_reads_no_entity_file_and_connects_nowhere(
     code = AUDIT + "from bt_lsp.server import serve\nserve()\n"
     uri = doc.as_uri()
     text = doc.read_text(encoding="utf-8")
-    messages = [
+    messages: list[dict[str, object]] = [
         {
             "jsonrpc": "2.0",
             "id": 1,

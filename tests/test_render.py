@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 import pytest
@@ -53,7 +54,23 @@ SAMPLE = """<root BTCPP_format="4" main_tree_to_execute="Main">
 """
 
 
-def _picture(text: str = SAMPLE, **kw: object):  # type: ignore[no-untyped-def]
+def _attr(el: etree._Element, name: str) -> str:
+    value = el.get(name)
+    assert value is not None, name
+    return value
+
+
+def _found(el: etree._Element, path: str) -> etree._Element:
+    found = el.find(path)
+    assert found is not None, path
+    return found
+
+
+def _text(el: etree._Element) -> str:
+    return "".join(str(t) for t in el.itertext())
+
+
+def _picture(text: str = SAMPLE, **kw: Any):  # type: ignore[no-untyped-def]
     doc = Document(text)
     tree = main_tree(doc.model)
     assert tree is not None
@@ -302,20 +319,23 @@ def test_svg_parses_and_holds_every_node(text: str) -> None:
     assert set(groups) == {n.id for n in pic.nodes}
     for n in pic.nodes:
         g = groups[n.id]
-        assert (int(g.get("data-start")), int(g.get("data-end"))) == (n.start, n.end)
-        label = "".join(g.find(f"{SVG_NS}text").itertext())
+        assert (int(_attr(g, "data-start")), int(_attr(g, "data-end"))) == (n.start, n.end)
+        label = _text(_found(g, f"{SVG_NS}text"))
         assert label.startswith(n.type[:10])
     assert len(svg.findall(f".//{SVG_NS}path[@class='edge']")) == len(pic.nodes) - 1
 
 
 def test_svg_is_standalone_and_themed() -> None:
-    out, _ = render(Document(SAMPLE).model, main_tree(Document(SAMPLE).model), "svg")
+    model = Document(SAMPLE).model
+    tree = main_tree(model)
+    assert tree is not None
+    out, _ = render(model, tree, "svg")
     svg = etree.fromstring(out.encode())
-    style = svg.find(f"{SVG_NS}style").text
+    style = _found(svg, f"{SVG_NS}style").text or ""
     assert "prefers-color-scheme: dark" in style
     assert "--bt-action:var(--vscode-" in style
     assert "href" not in out and "url(" not in out and "<image" not in out and "<script" not in out
-    texts = ["".join(t.itertext()) for t in svg.iter(f"{SVG_NS}text")]
+    texts = [_text(t) for t in svg.iter(f"{SVG_NS}text")]
     assert "Sequence" in texts and '"root seq"' in texts
 
 
@@ -333,7 +353,7 @@ def test_svg_escapes_what_xml_cannot_hold() -> None:
     text += "</BehaviorTree></root>"
     _, pic = _picture(text)
     svg = etree.fromstring(to_svg(pic).encode())
-    assert '"aU+0007b]]>"' in ["".join(t.itertext()) for t in svg.iter(f"{SVG_NS}text")]
+    assert '"aU+0007b]]>"' in [_text(t) for t in svg.iter(f"{SVG_NS}text")]
 
 
 _MERMAID_NODE = re.compile(r'  n\d+(>|\[|\{\{|\(|\(\[|\[\[|\[/)"[^"]*"(\]|\}\}|\)|\]\)|\]\]|/\])')

@@ -15,7 +15,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.semantics.nodes import UnknownNodeData
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.edits import apply_edits
+from bt_lsp.syntax.edits import TextEdit, apply_edits
 from bt_lsp.syntax.scanner import decode_value
 from bt_lsp.syntax.values import raw_offsets, raw_span
 from tests.marks import unmark
@@ -207,7 +207,7 @@ def test_unescaped_chars() -> None:
     ctx = Context.from_document(doc)
     diags = [d for d in analyze(doc, ctx) if d.code == "xml-unescaped-char"]
     assert len(diags) == 3
-    edits = []
+    edits: list[TextEdit] = []
     for d in diags:
         found = semantic_fixes.fixes_for_rule(doc, ctx, d)
         assert len(found) == 1 and found[0].preferred

@@ -207,7 +207,7 @@ async def test_one_preferred_fix_then_alternatives(client: BtClient) -> None:
     uri = client.open(text)
     diags = names_only(await client.diags(uri, 1))
     # A port name that breaks two rules has two diagnostics over the same span ...
-    assert sorted(d.code for d in diags) == [
+    assert sorted(str(d.code) for d in diags) == [
         "instance-name-control-char",
         "port-name-forbidden-char",
         "port-name-leading-digit",

@@ -628,10 +628,7 @@ async def test_workspace_symbols(lsp: NavClient) -> None:
     a, b = lsp.uri("a.xml"), lsp.uri("b.xml")
     got = await lsp.workspace_symbol_async(types.WorkspaceSymbolParams(query=""))
     assert got is not None
-    found = sorted(
-        (s.name, s.location.uri, s.kind)  # type: ignore[union-attr]
-        for s in got
-    )
+    found = sorted((s.name, s.location.uri, s.kind) for s in got)
     K = types.SymbolKind
     assert found == [
         ("Dock", b, K.Class),

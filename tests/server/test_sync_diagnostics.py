@@ -99,12 +99,12 @@ async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
     assert "'Do.It'" in period.message
     assert "'.' (period)" in period.message
     assert "column 3" in period.message
-    assert period.data["name"] == "Do.It"
+    assert isinstance(period.data, dict) and period.data["name"] == "Do.It"
     space = by_code[("model-name-forbidden-char", 1)]
     assert "' ' (space)" in space.message and "whitespace" in space.message
     bell = by_code[("instance-name-control-char", 3)]
     assert "U+0007" in bell.message and "control" in bell.message
-    assert bell.data["name"] == "x\x07"
+    assert isinstance(bell.data, dict) and bell.data["name"] == "x\x07"
 
 
 async def test_incremental_edits(client: BtClient) -> None:
@@ -230,7 +230,7 @@ async def test_close_clears_pushed_diagnostics(client: BtClient) -> None:
     assert names_only(await client.pushed(uri, 1))
     client.close(uri)
     await client.wait_until(
-        lambda: True if client.latest(uri) and not client.latest(uri).diagnostics else None,
+        lambda: True if (p := client.latest(uri)) and not p.diagnostics else None,
         f"empty diagnostics for {uri} after didClose",
     )
     await client.barrier()
