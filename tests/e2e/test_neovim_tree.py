@@ -11,6 +11,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import pytest
 from lxml import etree
 
 from tests.e2e.test_neovim import (
@@ -24,6 +25,8 @@ from tests.e2e.test_neovim import (
     _workspace,
     target,
 )
+
+pytestmark = pytest.mark.e2e
 
 __all__ = ["target"]  # the fixture, parametrized over the Neovim versions
 
