@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -165,6 +166,16 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
 
     # Moving the cursor highlights its node.
     assert result["highlighted"] == "Charge", context
+
+    # The wheel zoomed in at the pointer; a drag panned by what the mouse moved (60, 40).
+    def transform(t: str) -> tuple[float, float, float]:
+        found = re.fullmatch(r"translate\((-?[\d.]+)px, (-?[\d.]+)px\) scale\(([\d.]+)\)", t)
+        assert found, t
+        return float(found[1]), float(found[2]), float(found[3])
+
+    assert transform(result["wheel"]["after"])[2] > transform(result["wheel"]["before"])[2], context
+    (x0, y0, k0), (x1, y1, k1) = map(transform, (result["drag"]["before"], result["drag"]["after"]))
+    assert k1 == k0 and (x1 - x0, y1 - y0) == (pytest.approx(-60, abs=1), pytest.approx(-40, abs=1))
 
     # The keyboard zoomed, and the next update kept the zoom and scroll.
     assert result["zoomed"] != result["zoomBefore"], context

@@ -186,6 +186,21 @@ async function main(page) {
   result.zoomBefore = before;
   result.zoomed = (await picture(frame)).transform;
 
+  mark('mouse');
+  // The wheel zooms at the pointer, a drag on the background pans.
+  const area = await (await frame.$('#view')).boundingBox();
+  await page.mouse.move(area.x + area.width * 0.8, area.y + area.height * 0.8);
+  const beforeWheel = (await picture(frame)).transform;
+  await page.mouse.wheel(0, -240);
+  result.wheel = await until(async () => {
+    const t = (await picture(frame)).transform;
+    return t !== beforeWheel ? { before: beforeWheel, after: t } : null;
+  }, STEP_TIMEOUT, 100) || { before: beforeWheel, after: beforeWheel };
+  await page.mouse.down();
+  await page.mouse.move(area.x + area.width * 0.8 - 60, area.y + area.height * 0.8 - 40, { steps: 6 });
+  await page.mouse.up();
+  result.drag = { before: result.wheel.after, after: (await picture(frame)).transform };
+
   mark('move the cursor');
   await page.click('.editor-instance .monaco-editor .view-lines');
   await gotoPosition(page, config.cursorAt[0], config.cursorAt[1]);
