@@ -175,7 +175,8 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
 
     assert transform(result["wheel"]["after"])[2] > transform(result["wheel"]["before"])[2], context
     (x0, y0, k0), (x1, y1, k1) = map(transform, (result["drag"]["before"], result["drag"]["after"]))
-    assert k1 == k0 and (x1 - x0, y1 - y0) == (pytest.approx(-60, abs=1), pytest.approx(-40, abs=1))
+    assert k1 == k0, context
+    assert abs(x1 - x0 + 60) <= 1 and abs(y1 - y0 + 40) <= 1, context
 
     # The keyboard zoomed, and the next update kept the zoom and scroll.
     assert result["zoomed"] != result["zoomBefore"], context
