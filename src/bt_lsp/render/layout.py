@@ -4,9 +4,10 @@ Each subtree is laid out once, bottom-up, as its left and right contours (the ex
 its boxes at each depth below its root, relative to the root's centre); a subtree is put
 to the right of its left siblings as close as their contours allow, and a parent is
 centred above its first and last children.  Both passes walk the pre-order list of nodes
-(children after their parent), so no Python recursion happens whatever the depth; the
-contour merge costs the depth of the shallower side, so the whole layout is at most
-nodes × height.
+(children after their parent), so no Python recursion happens whatever the depth.  A
+contour is moved by an offset and merged by rewriting the shallower side's rows, so a
+merge costs the depth of the shallower subtree and a chain of decorators costs one step
+per node.
 
 Rows are as tall as their tallest box, so boxes of different heights never meet.
 """
@@ -78,41 +79,72 @@ def measure(node: Node, lines: list[str]) -> tuple[float, float]:
     return w, len(lines) * LINE_H + 2 * PAD_Y
 
 
+class _Contour:
+    """One side of a subtree: x per row (deepest first) as ``values[j] + offset``."""
+
+    __slots__ = ("offset", "values")
+
+    def __init__(self, values: list[float], offset: float) -> None:
+        self.values = values
+        self.offset = offset
+
+
+def _overlay(top: _Contour, under: _Contour) -> _Contour:
+    """``top``'s rows where it has them, ``under``'s below: the deeper one's list is kept
+    and the other's rows are written over its top rows, so the cost is the shallower's."""
+    if len(top.values) >= len(under.values):
+        return top
+    base = len(under.values) - len(top.values)
+    vals, d = under.values, top.offset - under.offset
+    for j, v in enumerate(top.values):
+        vals[base + j] = v + d
+    return under
+
+
 def layout(picture: Picture) -> Layout:
     nodes = picture.nodes
     n = len(nodes)
     lines = [node_lines(nd) for nd in nodes]
     sizes = [measure(nd, ls) for nd, ls in zip(nodes, lines, strict=True)]
     rel = [0.0] * n  # x of a node's centre relative to its parent's centre
-    left: list[list[float] | None] = [None] * n  # contours, index = depth below the node
-    right: list[list[float] | None] = [None] * n
+    # Each subtree's contours as (values, offset): the deepest row first, the subtree's own
+    # row last, each value plus the offset giving an x relative to the subtree root's centre.
+    # Moving a contour changes its offset; merging two rewrites the rows of the shallower.
+    left: list[_Contour | None] = [None] * n
+    right: list[_Contour | None] = [None] * n
     for i in range(n - 1, -1, -1):  # children (later in pre-order) before parents
         half = sizes[i][0] / 2
         kids = nodes[i].children
         if not kids:
-            left[i], right[i] = [-half], [half]
+            left[i], right[i] = _Contour([-half], 0.0), _Contour([half], 0.0)
             continue
-        first = kids[0]
-        acc_l = left[first]
-        acc_r = right[first]
+        acc_l, acc_r = left[kids[0]], right[kids[0]]
         assert acc_l is not None and acc_r is not None
         offsets = [0.0]
         for k in kids[1:]:
             cl, cr = left[k], right[k]
             assert cl is not None and cr is not None
-            m = min(len(acc_r), len(cl))
-            shift = max(acc_r[d] - cl[d] for d in range(m)) + SIBLING_GAP
-            offsets.append(shift)
-            if len(cl) > len(acc_l):
-                acc_l = acc_l + [c + shift for c in cl[len(acc_l) :]]
-            acc_r = [c + shift for c in cr] + acc_r[len(cr) :]
             left[k] = right[k] = None
-        left[first] = right[first] = None
+            a, c = acc_r.values, cl.values
+            m = min(len(a), len(c))
+            na, nc = len(a) - 1, len(c) - 1
+            shift = (
+                max([a[na - d] - c[nc - d] for d in range(m)]) + acc_r.offset - cl.offset
+            ) + SIBLING_GAP
+            offsets.append(shift)
+            cl.offset += shift
+            cr.offset += shift
+            acc_l = _overlay(acc_l, cl)  # the left side: earlier siblings first
+            acc_r = _overlay(cr, acc_r)  # the right side: this sibling first
+        left[kids[0]] = right[kids[0]] = None
         mid = (offsets[0] + offsets[-1]) / 2
         for k, off in zip(kids, offsets, strict=True):
             rel[k] = off - mid
-        left[i] = [-half, *(c - mid for c in acc_l)]
-        right[i] = [half, *(c - mid for c in acc_r)]
+        acc_l.offset -= mid
+        acc_r.offset -= mid
+        acc_l.values.append(-half - acc_l.offset)
+        acc_r.values.append(half - acc_r.offset)
+        left[i], right[i] = acc_l, acc_r
 
     # Row heights and tops.
     depth_h: list[float] = []
@@ -129,11 +161,13 @@ def layout(picture: Picture) -> Layout:
         cx[i] = cx[nodes[i].parent] + rel[i]
     root_l, root_r = left[0], right[0]
     assert root_l is not None and root_r is not None
-    shift = MARGIN - min(root_l)
+    lo = min(root_l.values) + root_l.offset
+    hi = max(root_r.values) + root_r.offset
+    shift = MARGIN - lo
     boxes = [
         Box(cx[i] + shift - sizes[i][0] / 2, tops[nodes[i].depth], sizes[i][0], sizes[i][1])
         for i in range(n)
     ]
-    width = max(root_r) - min(root_l) + 2 * MARGIN
+    width = hi - lo + 2 * MARGIN
     height = tops[-1] + depth_h[-1] + MARGIN
     return Layout(boxes, lines, width, height)
