@@ -34,6 +34,7 @@ from bt_lsp.cli.formats.json import to_json
 from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
+from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.settings import Settings
@@ -53,6 +54,7 @@ class Options:
     severities: Mapping[str, Severity | None] = field(default_factory=dict)
     progress: bool = True
     max_bytes: int = DEFAULT_MAX_BYTES
+    cpp: bool = True  # learn the node catalog from the C++ of the files' packages
 
 
 def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
@@ -197,6 +199,8 @@ def run(
     workspace = Workspace(
         [p for p in paths if os.path.isdir(p)], Settings(max_document_bytes=options.max_bytes)
     )
+    if options.cpp:
+        workspace.cpp = CppModels(workspace.roots, workspace.packages)
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     for i, path in enumerate(files, 1):
         progress.show(i, path)

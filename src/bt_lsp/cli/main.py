@@ -85,6 +85,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     check.add_argument("--no-progress", action="store_true", help="never show the progress bar")
     check.add_argument(
+        "--no-cpp",
+        action="store_true",
+        help="do not read the node catalog from the packages' C++ sources",
+    )
+    check.add_argument(
         "--max-file-size",
         type=_size,
         default=DEFAULT_MAX_BYTES,
@@ -162,6 +167,7 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         severities=severities,
         progress=not args.no_progress,
         max_bytes=args.max_file_size,
+        cpp=not args.no_cpp,
     )
     return check.run(args.paths, options)
 

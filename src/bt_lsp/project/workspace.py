@@ -17,6 +17,7 @@ from pathlib import Path
 
 from bt_lsp.ide.places import IncludeLink
 from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer
+from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.fileio import FileError, read_text
 from bt_lsp.project.packages import Detected, Packages
 from bt_lsp.project.settings import Settings
@@ -125,6 +126,8 @@ class Workspace:
         self._includes: dict[Path, tuple[Model, Settings, list[Include]]] = {}
         self._paths: tuple[tuple[int, tuple[Path, ...]], list[Path]] | None = None
         self.generation = 0  # bumps whenever a file other than an edited open one changes
+        # The C++ node catalogs (bt_lsp.project.cpp_models), when the caller reads C++.
+        self.cpp: CppModels | None = None
 
     # -- documents --------------------------------------------------------------------------
 
@@ -184,6 +187,8 @@ class Workspace:
         self._files = None
         if self.configs.changed(p) | self.packages.changed(p):
             self._scoped.clear()
+        if self.cpp is not None:
+            self.cpp.file_changed(p)
         self.generation += 1
 
     def refresh(self) -> None:
@@ -395,7 +400,7 @@ class Workspace:
             others.append((str(p), d, False))
             if any(inc.target == path for inc in self.includes(p, d)):
                 included_by.append(str(p))
-        return Context.combine(
+        ctx = Context.combine(
             doc,
             others,
             path=str(path),
@@ -404,6 +409,9 @@ class Workspace:
             included_by=included_by,
             btcpp_version=self.btcpp_for(path, doc).version,
         )
+        if self.cpp is not None:
+            ctx = self.cpp.context_with_models(ctx, path, settings)
+        return ctx
 
     def catalog_files(self, path: Path) -> list[Path]:
         """The node catalog files in scope for the document at ``path``: the ``models``

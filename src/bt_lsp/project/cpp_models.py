@@ -1,0 +1,311 @@
+"""The C++ node catalog each BT file sees: its package's and its dependencies' nodes.
+
+A file inside a ROS package (the nearest ``package.xml``) sees the C++ of that package and
+of the packages it depends on that are in the same workspace (colcon ``src/``), not every
+node of the workspace; a file outside any package sees the C++ under the workspace
+folders.  A package's C++ is its ``src/`` and ``include/`` (the whole package when it has
+neither), or what the ``sources`` globs of the configuration name; build, install and
+log folders and the ``exclude`` globs are skipped.
+
+Files are read once and again only after :meth:`CppModels.file_changed` (or when their
+modification time or size changed, for the command line); their facts come from the
+content-keyed cache of :mod:`bt_lsp.project.cpp_scan`.  The nodes become
+:class:`~bt_lsp.rules.context.ModelDecl` values whose path is the C++ file and whose span
+is the ID's string literal, in code points.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import threading
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import replace
+from pathlib import Path
+from types import MappingProxyType
+from typing import Final
+
+from bt_lsp.cpp.catalog import Catalog, CppNode
+from bt_lsp.cpp.facts import Span
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
+from bt_lsp.project.packages import Manifest, Packages, is_file
+from bt_lsp.project.settings import Settings
+from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
+from bt_lsp.rules.context import Context, ModelDecl
+
+MAX_CPP_FILES: Final = 20000
+_SKIP: Final = frozenset({"build", "install", "log", "node_modules", "__pycache__"})
+
+Progress = Callable[[int, int], None]
+
+
+class CppModels:
+    """The C++ catalogs of one workspace (thread-safe: the server scans in the background)."""
+
+    def __init__(
+        self,
+        roots: Sequence[Path],
+        packages: Packages | None = None,
+        scanner: Scanner | None = None,
+    ) -> None:
+        self.roots = list(roots)
+        self.packages = packages or Packages()
+        self.scanner = scanner or Scanner()
+        self._lock = threading.RLock()
+        self._bytes: dict[Path, tuple[tuple[int, int], bytes | None]] = {}
+        self._overlay: dict[Path, bytes] = {}  # open C++ documents, as edited
+        self._workspace_packages: dict[str, Manifest] | None = None
+        self._catalogs: dict[tuple[Path, ...], tuple[int, Catalog]] = {}
+        self._decls: dict[int, MappingProxyType[str, ModelDecl]] = {}
+        self._line_starts: dict[Path, tuple[bytes, list[int]]] = {}
+        self.generation = 0
+        # "sync" reads the C++ when a context needs it (the command line); "background"
+        # uses only catalogs already read and calls ``on_missing`` for the others (the
+        # server reads them in a thread, then refreshes the diagnostics).
+        self.mode = "sync"
+        self.on_missing: Callable[[Path], None] | None = None
+
+    # --- which files ---------------------------------------------------------------------
+
+    def workspace_packages(self) -> dict[str, Manifest]:
+        """The ROS packages under the workspace folders, by name (the first of a name)."""
+        if self._workspace_packages is None:
+            found: dict[str, Manifest] = {}
+            for root in self.roots:
+                for dirpath, dirnames, filenames in os.walk(root):
+                    dirnames[:] = sorted(
+                        d for d in dirnames if d not in _SKIP and not d.startswith(".")
+                    )
+                    if "package.xml" in filenames:
+                        m = self.packages.manifest(Path(dirpath) / "package.xml")
+                        if m is not None:
+                            found.setdefault(m.name, m)
+            self._workspace_packages = found
+        return self._workspace_packages
+
+    def visible_packages(self, path: Path) -> list[Manifest] | None:
+        """The package of ``path`` and the workspace packages it depends on (transitively);
+        ``None`` when ``path`` is in no package."""
+        own = self.packages.package_of(path.parent)
+        if own is None:
+            return None
+        ws = self.workspace_packages()
+        out: dict[str, Manifest] = {own.name: own}
+        todo = [own]
+        while todo:
+            m = todo.pop()
+            for dep in sorted(m.depends):
+                d = ws.get(dep)
+                if d is not None and d.name not in out:
+                    out[d.name] = d
+                    todo.append(d)
+        return list(out.values())
+
+    def files_for(
+        self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
+    ) -> tuple[Path, ...]:
+        """The C++ files whose registrations the BT file at ``path`` sees."""
+        pkgs = self.visible_packages(path)
+        folders = (
+            [m.folder for m in pkgs]
+            if pkgs is not None
+            else [r if r.is_dir() else r.parent for r in self.roots]
+        )
+        if sources:
+            found = _glob(sources)
+            if pkgs is not None:
+                found = [f for f in found if any(_under(f, d) for d in folders)]
+        else:
+            found = []
+            for folder in folders:
+                parts = [folder / "src", folder / "include"]
+                present = [p for p in parts if p.is_dir()] if pkgs is not None else []
+                found.extend(find_cpp_files(present or [folder]))
+        if exclude:
+            found = [f for f in found if not any(f.match(g) for g in exclude)]
+        return tuple(sorted(dict.fromkeys(found))[:MAX_CPP_FILES])
+
+    # --- reading -------------------------------------------------------------------------
+
+    def _read(self, path: Path) -> bytes | None:
+        with self._lock:
+            over = self._overlay.get(path)
+            if over is not None:
+                return over
+            try:
+                st = path.stat()
+            except (OSError, ValueError):
+                return None
+            stamp = (st.st_mtime_ns, st.st_size)
+            hit = self._bytes.get(path)
+            if hit is not None and hit[0] == stamp:
+                return hit[1]
+            try:
+                data: bytes | None = path.read_bytes()
+            except OSError:
+                data = None
+            self._bytes[path] = (stamp, data)
+            return data
+
+    def catalog(self, files: tuple[Path, ...], progress: Progress | None = None) -> Catalog:
+        """The catalog of ``files``, linked again only when one of them changed."""
+        with self._lock:
+            hit = self._catalogs.get(files)
+            if hit is not None and hit[0] == self.generation:
+                return hit[1]
+            generation = self.generation
+        cat = scan(list(files), self.scanner, read=self._read, progress=progress)
+        with self._lock:
+            if generation == self.generation:
+                self._catalogs[files] = (generation, cat)
+        return cat
+
+    def catalog_for(
+        self,
+        path: Path,
+        sources: Sequence[str] = (),
+        exclude: Sequence[str] = (),
+        progress: Progress | None = None,
+    ) -> Catalog:
+        return self.catalog(self.files_for(path, sources, exclude), progress)
+
+    def cached_catalog_for(
+        self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
+    ) -> Catalog | None:
+        """The catalog of ``path`` if it is up to date, without reading anything."""
+        files = self.files_for(path, sources, exclude)
+        with self._lock:
+            hit = self._catalogs.get(files)
+            return hit[1] if hit is not None and hit[0] == self.generation else None
+
+    # --- changes -------------------------------------------------------------------------
+
+    def file_changed(self, path: Path) -> bool:
+        """A file changed on disk; true when it is one this reads (C++ or a package.xml)."""
+        if path.suffix not in CPP_SUFFIXES and path.name != "package.xml":
+            return False
+        with self._lock:
+            self._bytes.pop(path, None)
+            if path.name == "package.xml":
+                self._workspace_packages = None
+            self.generation += 1
+        return True
+
+    def set_open(self, path: Path, text: str | None) -> None:
+        """An open C++ document's text (``None`` when it is closed)."""
+        with self._lock:
+            if text is None:
+                self._overlay.pop(path, None)
+            else:
+                self._overlay[path] = text.encode("utf-8", "surrogatepass")
+            self.generation += 1
+
+    # --- as models -----------------------------------------------------------------------
+
+    def context_with_models(self, ctx: Context, path: Path, settings: Settings) -> Context:
+        """``ctx`` with the C++ nodes ``path`` sees among its models.
+
+        A node read completely (authoritative) wins over a ``<TreeNodesModel>``
+        declaration of the same ID; one with flags only fills a gap.
+        """
+        if self.mode == "sync":
+            cat: Catalog | None = self.catalog_for(path, settings.sources, settings.exclude)
+        else:
+            cat = self.cached_catalog_for(path, settings.sources, settings.exclude)
+            if cat is None:
+                if self.on_missing is not None:
+                    self.on_missing(path)
+                return ctx
+        if cat is None or not cat.nodes:
+            return ctx
+        decls = self.decls(cat)
+        merged = dict(ctx.models)
+        for id_, d in decls.items():
+            if id_ not in merged or cat.by_id[id_].authoritative:
+                merged[id_] = d
+        return replace(
+            ctx, models=MappingProxyType(merged), sources=(*ctx.sources, ("cpp", id(decls)))
+        )
+
+    def decls(self, catalog: Catalog) -> MappingProxyType[str, ModelDecl]:
+        """The catalog's nodes as models by ID (built-ins and nodes of unknown kind left
+        out: a node's category cannot be guessed)."""
+        key = id(catalog)
+        with self._lock:
+            hit = self._decls.get(key)
+            if hit is not None:
+                return hit
+        out: dict[str, ModelDecl] = {}
+        for n in catalog.nodes:
+            if n.id in BUILTINS or n.kind is None or n.id in out:
+                continue
+            out[n.id] = self.decl(n)
+        proxy = MappingProxyType(out)
+        with self._lock:
+            if len(self._decls) > 64:
+                self._decls.clear()
+            self._decls[key] = proxy
+        return proxy
+
+    def decl(self, n: CppNode) -> ModelDecl:
+        start, end = self.offsets(Path(n.path), n.id_span)
+        ports = tuple(
+            PortModel(p.name, _direction(p.direction), p.type, p.default, p.description)
+            for p in n.ports
+        )
+        return ModelDecl(n.id, _category(n.kind), ports, n.path, start, end)
+
+    def offsets(self, path: Path, span: Span) -> tuple[int, int]:
+        """The code-point offsets of ``span`` in the file at ``path``."""
+        data = self._read(path) or b""
+        with self._lock:
+            hit = self._line_starts.get(path)
+            if hit is None or hit[0] is not data:
+                text = data.decode("utf-8", "replace")
+                starts = [0]
+                for i, ch in enumerate(text):
+                    if ch == "\n":
+                        starts.append(i + 1)
+                hit = (data, starts)
+                self._line_starts[path] = hit
+        starts = hit[1]
+
+        def at(line: int, col: int) -> int:
+            return (starts[line] if line < len(starts) else starts[-1]) + col
+
+        return at(span[0], span[1]), at(span[2], span[3])
+
+
+def _category(kind: str | None) -> Category:
+    if kind == "Condition":
+        return "Condition"
+    if kind == "Control":
+        return "Control"
+    if kind == "Decorator":
+        return "Decorator"
+    return "Action"
+
+
+def _direction(d: str) -> Direction:
+    return "output" if d == "output" else "inout" if d == "inout" else "input"
+
+
+def _under(f: Path, folder: Path) -> bool:
+    try:
+        f.relative_to(folder)
+    except ValueError:
+        return False
+    return True
+
+
+def _glob(patterns: Iterable[str]) -> list[Path]:
+    """The C++ files the ``sources`` globs name (a folder matched means its C++ files)."""
+    out: list[Path] = []
+    for g in patterns:
+        for m in sorted(glob.glob(g, recursive=True)):
+            p = Path(m)
+            if p.is_dir():
+                out.extend(find_cpp_files([p]))
+            elif p.suffix in CPP_SUFFIXES and is_file(p):
+                out.append(p)
+    return out

@@ -1,0 +1,102 @@
+"""A colcon workspace whose nodes are registered in C++: checked through the CLI.
+
+``robot_nodes`` registers its nodes in ``src/``, declares them in ``include/`` and derives
+one from a base of ``robot_base`` (a dependency in ``package.xml``); ``other_nodes`` is no
+dependency, so its node is not visible to ``robot_nodes``' trees; ``build/`` is never read.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from bt_lsp.cli.main import main
+from bt_lsp.project.cpp_models import CppModels
+from bt_lsp.project.cpp_scan import Scanner
+
+WS = Path(__file__).parent / "data" / "cpp_project"
+MAIN = WS / "src" / "robot_nodes" / "trees" / "main.xml"
+
+
+@pytest.fixture(autouse=True)
+def _cache(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+
+
+def _findings(capsys: pytest.CaptureFixture[str], *args: str) -> list[tuple[int, str, str, str]]:
+    main(["check", *args, str(WS)])
+    out = []
+    for line in capsys.readouterr().out.splitlines():
+        m = re.match(r"(.*?):(\d+):\d+: (\w+) ([\w-]+) (.*)", line)
+        if m and m.group(1).endswith("main.xml"):
+            out.append((int(m.group(2)), m.group(3), m.group(4), m.group(5)))
+    return out
+
+
+def test_check_learns_the_catalog_from_the_packages_cpp(capsys: pytest.CaptureFixture[str]) -> None:
+    found = _findings(capsys)
+    by_line = {line: (sev, code, msg) for line, sev, code, msg in found}
+    # <BatteryOk min_percent="lots"/>: an int port read from include/robot_nodes/nodes.hpp.
+    sev, code, msg = by_line[4]
+    assert code == "invalid-port-value" and "int" in msg and sev != "hint"
+    # <DriveTo speed="1.0"/>: ports from DriveTo and its base in another package.
+    sev, code, msg = by_line[5]
+    assert code == "undeclared-port" and "'speed'" in msg
+    assert "distance, max_speed, target" in msg
+    # A typo gets "did you mean" from the C++ catalog.
+    assert by_line[6][1] == "unknown-node" and "did you mean 'DriveTo'" in by_line[6][2]
+    # other_nodes is not a dependency of robot_nodes: its node is not visible.
+    assert by_line[7][1] == "unknown-node" and "did you mean" not in by_line[7][2]
+    assert len([f for f in found if f[2] == "unknown-node"]) == 2
+
+
+def test_no_cpp_keeps_the_old_behaviour(capsys: pytest.CaptureFixture[str]) -> None:
+    found = _findings(capsys, "--no-cpp")
+    assert sorted({code for _, _, code, _ in found}) == ["unknown-node"]
+    assert all(sev == "hint" for sev, *_ in [(f[1],) for f in found])
+
+
+def test_package_scope_and_build_folder() -> None:
+    models = CppModels([WS], scanner=Scanner(None))
+    ids = {n.id for n in models.catalog_for(MAIN).nodes}
+    assert ids == {"DriveTo", "BatteryOk"}
+    other = WS / "src" / "other_nodes" / "src" / "other.cpp"
+    assert {n.id for n in models.catalog_for(other).nodes} == {"OtherNode"}
+    # A file in no package sees the C++ of the whole workspace, build folders left out.
+    files = models.files_for(WS / "x.xml")
+    assert len(files) == 4 and not [f for f in files if "build" in f.parts]
+    assert {n.id for n in models.catalog(files).nodes} == {"DriveTo", "BatteryOk", "OtherNode"}
+
+
+def test_models_span_the_id_literal_in_the_cpp_file() -> None:
+    models = CppModels([WS], scanner=Scanner(None))
+    decls = models.decls(models.catalog_for(MAIN))
+    d = decls["DriveTo"]
+    assert d.path is not None and d.path.endswith("register.cpp")
+    text = Path(d.path).read_text()
+    assert text[d.start : d.end] == '"DriveTo"'
+    assert d.category == "Action" and decls["BatteryOk"].category == "Condition"
+    assert [p.name for p in d.ports] == ["max_speed", "target", "distance"]
+
+
+def test_a_changed_cpp_file_is_read_again(tmp_path: Path) -> None:
+    pkg = tmp_path / "pkg"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "package.xml").write_text("<package><name>pkg</name></package>")
+    cpp = pkg / "src" / "n.cpp"
+    cpp.write_text(
+        "struct A : BT::SyncActionNode { static BT::PortsList providedPorts() { return {}; } };\n"
+        'BT_REGISTER_NODES(f) { f.registerNodeType<A>("A"); }\n'
+    )
+    sc = Scanner(None)
+    models = CppModels([tmp_path], scanner=sc)
+    tree = pkg / "t.xml"
+    assert {n.id for n in models.catalog_for(tree).nodes} == {"A"}
+    cpp.write_text(cpp.read_text().replace('"A"', '"B"'))
+    assert models.file_changed(cpp)
+    assert {n.id for n in models.catalog_for(tree).nodes} == {"B"}
+    assert sc.parsed == 2
+    models.set_open(cpp, cpp.read_text().replace('"B"', '"C"'))
+    assert {n.id for n in models.catalog_for(tree).nodes} == {"C"}
