@@ -26,6 +26,7 @@ import sys
 import traceback
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Final, TextIO
 
 from bt_lsp.cli.fix import fix_document
@@ -35,11 +36,13 @@ from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.workspace import Workspace
 from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
@@ -91,6 +94,11 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
         return result
     try:
         doc = Document(decoded.text, path)
+        if Path(path).suffix in CPP_SUFFIXES:  # the name rules where names are born
+            facts = Scanner().facts(path, decoded.text.encode("utf-8", "surrogatepass"))
+            diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
+            result.findings = findings_of(path, doc, diags)
+            return result
         raw = analyze(doc, workspace)
         diags = with_severities(raw, options.severities)
         if options.fix:
@@ -181,6 +189,8 @@ def run(
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     files, walk_errors = collect_files(paths)
+    if options.cpp:
+        files += [str(f) for p in paths if os.path.isdir(p) for f in find_cpp_files([p])]
     progress = Progress(err, len(files), options.progress and len(files) > 1 and _isatty(err))
 
     def say(stream: TextIO, text: str) -> None:

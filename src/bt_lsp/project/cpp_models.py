@@ -56,6 +56,11 @@ class CppModels:
         self._overlay: dict[Path, bytes] = {}  # open C++ documents, as edited
         self._workspace_packages: dict[str, Manifest] | None = None
         self._catalogs: dict[tuple[Path, ...], tuple[int, Catalog]] = {}
+        self._files: dict[
+            tuple[Path, tuple[str, ...], tuple[str, ...]], tuple[int, tuple[Path, ...]]
+        ] = {}
+        self._known: set[Path] = set()
+        self.tree_generation = 0  # bumps when a C++ file or manifest appears or goes
         self._decls: dict[int, MappingProxyType[str, ModelDecl]] = {}
         self._line_starts: dict[Path, tuple[bytes, list[int]]] = {}
         self.generation = 0
@@ -104,7 +109,24 @@ class CppModels:
     def files_for(
         self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
     ) -> tuple[Path, ...]:
-        """The C++ files whose registrations the BT file at ``path`` sees."""
+        """The C++ files whose registrations the BT file at ``path`` sees (found again only
+        when a C++ file or a manifest appears or goes)."""
+        key = (path.parent, tuple(sources), tuple(exclude))
+        with self._lock:
+            hit = self._files.get(key)
+            if hit is not None and hit[0] == self.tree_generation:
+                return hit[1]
+            generation = self.tree_generation
+        files = self._find(path, sources, exclude)
+        with self._lock:
+            if generation == self.tree_generation:
+                self._files[key] = (generation, files)
+                self._known.update(files)
+        return files
+
+    def _find(
+        self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
+    ) -> tuple[Path, ...]:
         pkgs = self.visible_packages(path)
         folders = (
             [m.folder for m in pkgs]
@@ -126,6 +148,10 @@ class CppModels:
         return tuple(sorted(dict.fromkeys(found))[:MAX_CPP_FILES])
 
     # --- reading -------------------------------------------------------------------------
+
+    def read(self, path: Path) -> bytes | None:
+        """The bytes of the C++ file at ``path`` (an open document's text as edited)."""
+        return self._read(path)
 
     def _read(self, path: Path) -> bytes | None:
         with self._lock:
@@ -156,7 +182,8 @@ class CppModels:
             generation = self.generation
         cat = scan(list(files), self.scanner, read=self._read, progress=progress)
         with self._lock:
-            if generation == self.generation:
+            kept = self._catalogs.get(files)
+            if kept is None or kept[0] <= generation:
                 self._catalogs[files] = (generation, cat)
         return cat
 
@@ -169,14 +196,18 @@ class CppModels:
     ) -> Catalog:
         return self.catalog(self.files_for(path, sources, exclude), progress)
 
-    def cached_catalog_for(
+    def latest_catalog_for(
         self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
     ) -> Catalog | None:
-        """The catalog of ``path`` if it is up to date, without reading anything."""
-        files = self.files_for(path, sources, exclude)
+        """The last catalog read for ``path`` (maybe stale), without reading anything."""
+        return self._latest(self.files_for(path, sources, exclude))[0]
+
+    def _latest(self, files: tuple[Path, ...]) -> tuple[Catalog | None, bool]:
         with self._lock:
             hit = self._catalogs.get(files)
-            return hit[1] if hit is not None and hit[0] == self.generation else None
+            if hit is None:
+                return None, False
+            return hit[1], hit[0] == self.generation
 
     # --- changes -------------------------------------------------------------------------
 
@@ -186,8 +217,9 @@ class CppModels:
             return False
         with self._lock:
             self._bytes.pop(path, None)
-            if path.name == "package.xml":
+            if path.name == "package.xml" or path not in self._known or not path.exists():
                 self._workspace_packages = None
+                self.tree_generation += 1
             self.generation += 1
         return True
 
@@ -210,12 +242,10 @@ class CppModels:
         """
         if self.mode == "sync":
             cat: Catalog | None = self.catalog_for(path, settings.sources, settings.exclude)
-        else:
-            cat = self.cached_catalog_for(path, settings.sources, settings.exclude)
-            if cat is None:
-                if self.on_missing is not None:
-                    self.on_missing(path)
-                return ctx
+        else:  # the last catalog read, while a newer one is read in the background
+            cat, fresh = self._latest(self.files_for(path, settings.sources, settings.exclude))
+            if not fresh and self.on_missing is not None:
+                self.on_missing(path)
         if cat is None or not cat.nodes:
             return ctx
         decls = self.decls(cat)

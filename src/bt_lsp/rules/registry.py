@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Final
 
-from bt_lsp.rules import diagnostics, includes, names  # noqa: F401  (they define codes)
+from bt_lsp.rules import cpp_names, diagnostics, includes, names  # noqa: F401  (they define codes)
 from bt_lsp.rules.codes import BT, NAMES, XML, Code, all_defined
 from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
     base,

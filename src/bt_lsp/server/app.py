@@ -25,6 +25,8 @@ from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
 from bt_lsp.server.convert import diagnostic_at, to_diagnostic
+from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
+from bt_lsp.server.cpp import CppService
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import looks_like_bt
@@ -64,6 +66,7 @@ class BtServer(LanguageServer):
         self.project = Workspace()
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
+        self.cpp = CppService(self)
 
     # -- state ----------------------------------------------------------------------------
 
@@ -83,7 +86,7 @@ class BtServer(LanguageServer):
         if od.cache_key == key:
             return od.cached
         if not od.is_bt:
-            result: list[Diagnostic] = []
+            result: list[Diagnostic] = self.cpp.diagnostics(od)
         else:
             if od.doc.utf8_size > self.settings.max_document_bytes:
                 result = size_limited(od.doc, self.settings.max_document_bytes)
@@ -299,6 +302,7 @@ def create_server() -> BtServer:
             roots = [params.root_uri]
         paths = [p for p in (to_fs_path(r) for r in roots) if p]
         ls.project = Workspace(paths, ls.settings)
+        ls.cpp.attach(params)
         ls.watch_files = bool(
             ws and ws.did_change_watched_files and ws.did_change_watched_files.dynamic_registration
         )
@@ -317,6 +321,10 @@ def create_server() -> BtServer:
                                     watchers=[
                                         types.FileSystemWatcher(glob_pattern="**/*.xml"),
                                         types.FileSystemWatcher(glob_pattern="**/*.btproj"),
+                                        *(
+                                            types.FileSystemWatcher(glob_pattern=g)
+                                            for g in CPP_WATCH_GLOBS
+                                        ),
                                     ]
                                 ),
                             )

@@ -33,6 +33,7 @@ def register(server: BtServer) -> None:
         ls.docs[item.uri] = od
         if od.path is not None:
             ls.project.open(od.path, od.doc)
+        ls.cpp.document_changed(od)
         ls.edits += 1
         ls.schedule_all(item.uri)
 
@@ -53,6 +54,7 @@ def register(server: BtServer) -> None:
                 od.doc.replace_all(change.text)
         od.version = params.text_document.version
         od.refresh_kind()
+        ls.cpp.document_changed(od)
         ls.edits += 1
         if was_bt and not od.is_bt:
             ls.clear(uri)
@@ -65,6 +67,7 @@ def register(server: BtServer) -> None:
         if od is not None:
             if od.path is not None:
                 ls.project.close(od.path)
+            ls.cpp.document_changed(od, closed=True)
             ls.clear(uri)
 
     @server.feature(

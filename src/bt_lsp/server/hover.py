@@ -26,7 +26,9 @@ def register(server: BtServer) -> None:
         found = hover_at(od.doc, offset, context_of(ls, od))
         if found is None:
             return None
+        learned = ls.cpp.hover_markdown(od, offset)  # where the C++ declares it
+        markdown = found.markdown if learned is None else f"{found.markdown}\n\n{learned}"
         return types.Hover(
-            contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=found.markdown),
+            contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=markdown),
             range=to_range(lines, found.start, found.end, enc),
         )

@@ -168,6 +168,9 @@ def register(server: BtServer) -> None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
+        in_cpp = ls.cpp.definition(od, offset_of(ls, od, params.position))
+        if in_cpp is not None:  # a node or port learned from C++: its class, registration, call
+            return in_cpp
         sources = workspace_sources(ls, od)
         places = find_definition(
             od.doc,
