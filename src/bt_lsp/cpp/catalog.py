@@ -180,6 +180,7 @@ class _Linker:
         # Class and constant names looked up and not found: the project layer reads the
         # files that may define them (lazily: most files declare no node) and links again.
         self.missing: set[str] = set()
+        self._resolved: dict[tuple[str, int, str], _Resolved] = {}
         for path, f in [*files, *library]:
             for c in f.classes:
                 self.classes.setdefault(c.name, []).append(_Class(path, c))
@@ -297,6 +298,13 @@ class _Linker:
 
     def _resolve(self, ref: str, ctx: _Class | None, path: str, depth: int = 0) -> _Resolved:
         """The class ``ref`` names (as written, maybe with template arguments)."""
+        key = (ref, id(ctx.facts) if ctx is not None else 0, path)
+        hit = self._resolved.get(key)
+        if hit is None:
+            hit = self._resolved[key] = self._resolve_uncached(ref, ctx, path, depth)
+        return hit[0], dict(hit[1])
+
+    def _resolve_uncached(self, ref: str, ctx: _Class | None, path: str, depth: int) -> _Resolved:
         ref = ref.strip().removeprefix("typename ").removeprefix("class ").strip()
         base = strip_args(ref)
         if ctx is not None and depth < _MAX_DEPTH:

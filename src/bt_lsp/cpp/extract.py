@@ -44,30 +44,29 @@ _SIMPLE_REGISTRARS: Final = {
     "registerSimpleCondition": "Condition",
     "registerSimpleDecorator": "Decorator",
 }
+# Only files holding one of these are parsed at first (the others are read when they name a
+# base class, constant or macro that the catalog misses).
 _KEYWORDS: Final = (
     b"providedPorts",
     b"providedBasicPorts",
-    b"register",
+    b"registerNodeType",
+    b"registerBuilder",
+    b"registerSimple",
+    b"registerBehavior",
     b"BT_REGISTER",
     b"CreateRosNodePlugin",
     b"CreateManifest",
 )
-
-_QUERY_SOURCE: Final = """
-((field_identifier) @callee
-  (#any-of? @callee "registerNodeType" "registerBuilder" "registerSimpleAction"
-     "registerSimpleCondition" "registerSimpleDecorator" "providedPorts" "providedBasicPorts"))
-((identifier) @callee
-  (#any-of? @callee "registerNodeType" "registerBuilder" "registerSimpleAction"
-     "registerSimpleCondition" "registerSimpleDecorator" "providedPorts" "providedBasicPorts"
-     "CreateManifest" "registerBehavior"))
-(class_specifier name: (_) body: (field_declaration_list)) @class
-(struct_specifier name: (_) body: (field_declaration_list)) @class
-(preproc_function_def) @macro
-(preproc_def name: (identifier) value: (preproc_arg)) @define
-(translation_unit (declaration) @const)
-(namespace_definition body: (declaration_list (declaration) @const))
-"""
+# The places that matter, found in the text (in C, much faster than a query over every
+# identifier) and then looked up in the tree: the match must be the node found there.
+_CALLEES: Final = re.compile(
+    rb"\b(?:registerNodeType|registerBuilder|registerSimpleAction|registerSimpleCondition"
+    rb"|registerSimpleDecorator|providedPorts|providedBasicPorts|CreateManifest|registerBehavior)\b"
+)
+_CLASS_KEYWORD: Final = re.compile(rb"\b(?:class|struct)\b")
+_DEFINE: Final = re.compile(rb"#[ \t]*define\b")
+_CONST_STRING: Final = re.compile(rb"\b(?:const|constexpr)\b[^;{}\n]*?(\")")
+_CLASS_TYPES: Final = frozenset({"class_specifier", "struct_specifier"})
 
 # Invocations of macros that may register nodes (ALL_CAPS names, or names that say so),
 # with one or two arguments: a type and maybe a string.  Found in the text, because a
@@ -86,11 +85,6 @@ _MACRO_BODY: Final = re.compile(
 @cache
 def _language() -> tree_sitter.Language:
     return tree_sitter.Language(tree_sitter_cpp.language())
-
-
-@cache
-def _query() -> tree_sitter.Query:
-    return tree_sitter.Query(_language(), _QUERY_SOURCE)
 
 
 def parser() -> tree_sitter.Parser:
@@ -146,18 +140,45 @@ class _Reader:
     # --- the file ----------------------------------------------------------------------
 
     def read(self, root: Node) -> FileFacts:
-        cursor = tree_sitter.QueryCursor(_query())
-        caps = cursor.captures(root)
-        for n in caps.get("define", ()):
-            self._define(n)
-        for n in caps.get("macro", ()):
-            self._macro(n)
-        for n in caps.get("const", ()):
-            self._file_constant(n)
-        for n in caps.get("class", ()):
-            self._class(n)
-        for n in caps.get("callee", ()):
-            self._callee(n)
+        src = self.src
+        for m in _DEFINE.finditer(src):
+            n = _up(root.descendant_for_byte_range(m.start(), m.end()), 2)
+            if n is not None and n.type == "preproc_def":
+                self._define(n)
+            elif n is not None and n.type == "preproc_function_def":
+                self._macro(n)
+        for m in _CONST_STRING.finditer(src):
+            lit = root.descendant_for_byte_range(m.start(1), m.start(1) + 1)
+            decl = _up_to(lit, ("declaration", "field_declaration"), 5)
+            if (
+                decl is not None
+                and decl.parent is not None
+                and decl.parent.type
+                in (
+                    "translation_unit",
+                    "declaration_list",
+                )
+            ):
+                self._file_constant(decl)
+        for m in _CLASS_KEYWORD.finditer(src):
+            kw = root.descendant_for_byte_range(m.start(), m.end())
+            cls = kw.parent if kw is not None else None
+            if (
+                cls is not None
+                and cls.type in _CLASS_TYPES
+                and cls.start_byte == m.start()
+                and cls.child_by_field_name("body") is not None
+            ):
+                self._class(cls)
+        for m in _CALLEES.finditer(src):
+            n = root.descendant_for_byte_range(m.start(), m.end())
+            if (
+                n is not None
+                and n.type in ("identifier", "field_identifier")
+                and n.start_byte == m.start()
+                and n.end_byte == m.end()
+            ):
+                self._callee(n)
         calls = tuple(self._macro_calls(root)) if self.src.find(b"(") >= 0 else ()
         return FileFacts(
             tuple(self.classes),
@@ -610,6 +631,23 @@ class _Reader:
                 tuple(self._span_of_bytes(m.start(g), m.end(g)) for g in groups),
                 self._span_of_bytes(m.start(), m.end()),
             )
+
+
+def _up(n: Node | None, steps: int) -> Node | None:
+    """``n``'s parent ``steps`` times at most, stopping at a preprocessor definition."""
+    for _ in range(steps):
+        if n is None or n.type in ("preproc_def", "preproc_function_def"):
+            return n
+        n = n.parent
+    return n
+
+
+def _up_to(n: Node | None, types: tuple[str, ...], steps: int) -> Node | None:
+    for _ in range(steps):
+        if n is None or n.type in types:
+            return n
+        n = n.parent
+    return n if n is not None and n.type in types else None
 
 
 _STRING_TYPES: Final = frozenset(

@@ -34,6 +34,8 @@ def squash(s: str) -> str:
 
 def strip_args(name: str) -> str:
     """``ns::Foo<int>`` -> ``ns::Foo``; ``A<B>::C`` -> ``A::C``."""
+    if "<" not in name:
+        return name.strip()
     out: list[str] = []
     depth = 0
     for ch in name:

@@ -79,22 +79,39 @@ class Scanner:
 
     cache_dir: Path | None = field(default_factory=default_cache_dir)
     _parser: tree_sitter.Parser = field(default_factory=parser, repr=False)
-    _facts: dict[str, tuple[bytes, FileFacts]] = field(default_factory=dict, repr=False)
+    _facts: dict[str, tuple[bytes, bytes, FileFacts]] = field(default_factory=dict, repr=False)
+    _eager: dict[str, tuple[bytes, bool]] = field(default_factory=dict, repr=False)
     parsed: int = 0  # files parsed (not found in memory or on disk), for benchmarks and tests
 
     def facts(self, path: str, data: bytes) -> FileFacts:
-        """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse."""
-        key = hashlib.sha256(_FORMAT.encode() + __version__.encode() + b"\0" + data).digest()
+        """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse.
+
+        The same bytes object as last time (a caller that keeps what it read) is not even
+        hashed again.
+        """
         kept = self._facts.get(path)
-        if kept is not None and kept[0] == key:
-            return kept[1]
+        if kept is not None and kept[0] is data:
+            return kept[2]
+        key = hashlib.sha256(_FORMAT.encode() + __version__.encode() + b"\0" + data).digest()
+        if kept is not None and kept[1] == key:
+            self._facts[path] = (data, key, kept[2])
+            return kept[2]
         f = self._load(key)
         if f is None:
             f = extract(data, self._parser)
             self.parsed += 1
             self._store(key, f)
-        self._facts[path] = (key, f)
+        self._facts[path] = (data, key, f)
         return f
+
+    def may_declare_nodes(self, path: str, data: bytes) -> bool:
+        """:func:`~bt_lsp.cpp.extract.may_declare_nodes`, remembered for the same bytes."""
+        hit = self._eager.get(path)
+        if hit is not None and hit[0] is data:
+            return hit[1]
+        found = may_declare_nodes(data)
+        self._eager[path] = (data, found)
+        return found
 
     def _entry(self, key: bytes) -> Path | None:
         if self.cache_dir is None:
@@ -131,6 +148,7 @@ class Scanner:
 
     def forget(self, path: str) -> None:
         self._facts.pop(path, None)
+        self._eager.pop(path, None)
 
 
 ReadFile = Callable[[Path], bytes | None]
@@ -161,8 +179,9 @@ def scan(
         data = read(f)
         if data is not None:
             texts[str(f)] = data
-    eager = [p for p, d in texts.items() if may_declare_nodes(d)]
-    rest = [p for p in texts if p not in set(eager)]
+    eager = [p for p, d in texts.items() if sc.may_declare_nodes(p, d)]
+    eager_set = set(eager)
+    rest = [p for p in texts if p not in eager_set]
     read_facts: dict[str, FileFacts] = {}
     total = len(eager)
     for i, p in enumerate(eager):
@@ -183,6 +202,7 @@ def scan(
             break
         for p in more:
             read_facts[p] = sc.facts(p, texts[p])
-        rest = [p for p in rest if p not in set(more)]
+        more_set = set(more)
+        rest = [p for p in rest if p not in more_set]
         catalog = link(sorted(read_facts.items()), library_facts())
     return catalog
