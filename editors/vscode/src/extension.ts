@@ -106,6 +106,9 @@ async function startClient(): Promise<void> {
     documentSelector: [
       { scheme: 'file', language: 'xml' },
       { scheme: 'untitled', language: 'xml' },
+      // C++ sources: the node catalog is learned from them, and their registered IDs and
+      // port names are checked where they are written.
+      { scheme: 'file', language: 'cpp' },
     ],
     outputChannel: log,
     traceOutputChannel: log,

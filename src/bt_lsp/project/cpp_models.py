@@ -23,7 +23,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import Final
+from typing import Any, Final, cast
 
 from bt_lsp.cpp.catalog import Catalog, CppNode
 from bt_lsp.cpp.facts import Span
@@ -283,7 +283,12 @@ class CppModels:
             PortModel(p.name, _direction(p.direction), p.type, p.default, p.description)
             for p in n.ports
         )
-        return ModelDecl(n.id, _category(n.kind), ports, n.path, start, end)
+        decl = ModelDecl(n.id, _category(n.kind), ports, n.path, start, end)
+        if n.authoritative and "source" in ModelDecl._fields:
+            # Models that say where they come from: a node read completely is what
+            # BehaviorTree.CPP registers (authoritative); one with flags stays advisory.
+            decl = cast(Any, decl)._replace(source="cpp")
+        return decl
 
     def offsets(self, path: Path, span: Span) -> tuple[int, int]:
         """The code-point offsets of ``span`` in the file at ``path``."""
