@@ -82,6 +82,8 @@ class Scanner:
     _facts: dict[str, tuple[bytes, bytes, FileFacts]] = field(default_factory=dict, repr=False)
     _eager: dict[str, tuple[bytes, bool]] = field(default_factory=dict, repr=False)
     parsed: int = 0  # files parsed (not found in memory or on disk), for benchmarks and tests
+    # The last catalog linked and what it was linked from (facts and bytes, by identity).
+    _linked: tuple[object, Catalog] | None = field(default=None, repr=False)
 
     def facts(self, path: str, data: bytes) -> FileFacts:
         """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse.
@@ -101,6 +103,8 @@ class Scanner:
             f = extract(data, self._parser)
             self.parsed += 1
             self._store(key, f)
+        if kept is not None and kept[2] == f:
+            f = kept[2]  # the same facts: the same object, so the catalog is kept too
         self._facts[path] = (data, key, f)
         return f
 
@@ -188,6 +192,23 @@ def scan(
         read_facts[p] = sc.facts(p, texts[p])
         if progress is not None:
             progress(i + 1, total)
+    # An edit that changes no fact (inside a function body, the same lines) keeps the
+    # facts object, and so the catalog: nothing is linked again.
+    key = (
+        tuple((p, id(f)) for p, f in read_facts.items()),
+        tuple((p, id(texts[p])) for p in rest),
+    )
+    if sc._linked is not None and sc._linked[0] == key:
+        return sc._linked[1]
+    catalog = _link_lazily(sc, texts, read_facts, rest)
+    sc._linked = (key, catalog)
+    return catalog
+
+
+def _link_lazily(
+    sc: Scanner, texts: dict[str, bytes], read_facts: dict[str, FileFacts], rest: list[str]
+) -> Catalog:
+    """Link, then read the other files that name what the catalog misses, and again."""
     catalog = link(sorted(read_facts.items()), library_facts())
     for _ in range(_LAZY_ROUNDS):
         names = set(catalog.missing)
