@@ -268,6 +268,15 @@ RULES: Final[dict[str, str]] = {
     "port-name-reserved": _RULE_PORT_RESERVED,
     "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
     "instance-name-control-char": _RULE_INSTANCE_CONTROL,
+    # Where names are born (bt_lsp.rules.cpp_names).
+    "cpp-model-name": (
+        "A node ID registered in C++ follows the model name rules, or a tree can name it "
+        "only in the explicit form <Action ID=...>."
+    ),
+    "cpp-port-name": (
+        "A port name in C++ starts with an ASCII letter, has no forbidden character and is "
+        "not a reserved attribute (BehaviorTree.CPP's IsAllowedPortName)."
+    ),
 }
 
 
