@@ -26,12 +26,15 @@ from types import MappingProxyType
 from typing import Any, Final, cast
 
 from bt_lsp.cpp.catalog import Catalog, CppNode
+from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
 from bt_lsp.project.packages import Manifest, Packages, is_file
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
 from bt_lsp.rules.context import Context, ModelDecl
+from bt_lsp.rules.cpp_names import cpp_name_diagnostics
+from bt_lsp.rules.diagnostics import Diagnostic
 
 MAX_CPP_FILES: Final = 20000
 _SKIP: Final = frozenset({"build", "install", "log", "node_modules", "__pycache__"})
@@ -309,6 +312,13 @@ class CppModels:
             return (starts[line] if line < len(starts) else starts[-1]) + col
 
         return at(span[0], span[1]), at(span[2], span[3])
+
+
+def cpp_diagnostics(text: str, scanner: Scanner | None = None) -> list[Diagnostic]:
+    """The name-rule diagnostics of a C++ source's string literals."""
+    data = text.encode("utf-8", "surrogatepass")
+    facts = scanner.facts("<document>", data) if scanner is not None else extract(data)
+    return cpp_name_diagnostics(facts, text)
 
 
 def _category(kind: str | None) -> Category:

@@ -17,7 +17,8 @@ from pathlib import Path
 
 from bt_lsp.ide.places import IncludeLink
 from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer
-from bt_lsp.project.cpp_models import CppModels
+from bt_lsp.project.cpp_models import CppModels, cpp_diagnostics
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError, read_text
 from bt_lsp.project.packages import Detected, Packages
 from bt_lsp.project.settings import Settings
@@ -426,6 +427,8 @@ class Workspace:
     @with_gc_paused
     def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
         """Every diagnostic of ``doc`` in this workspace."""
+        if path.suffix in CPP_SUFFIXES:  # a C++ source: the name rules at its literals
+            return limited(cpp_diagnostics(doc.text, self.cpp.scanner if self.cpp else None))
         out = analysis.analyze(doc, self.context_for(path, doc))
         out.extend(self.include_diagnostics(path, doc))
         out.sort(key=lambda d: (d.start, d.end, d.code))
