@@ -104,6 +104,7 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
         "clickType": "Fallback",
         "cursorAt": [charge_line, LINES[charge_line - 1].index("Charge") + 3],
         "cursorType": "Charge",
+        "expandedType": "Align",
         "subtreeType": "Dock",
         "subtreeTree": "Dock",
         "big": {"file": "big.xml", "nodes": BIG_NODES},
@@ -181,6 +182,10 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     # The keyboard zoomed, and the next update kept the zoom and scroll.
     assert result["zoomed"] != result["zoomBefore"], context
     assert result["afterSecondEdit"]["transform"] == result["transformBeforeSecondEdit"], context
+
+    # "expand SubTrees" inlines the called tree below its SubTree node; "ports" shows ports.
+    assert result["expanded"]["types"][6:10] == ["Dock", "Sequence", "Align", "Stop"], context
+    assert result["withPorts"]["keys"] == ["{battery}"], context
 
     # A double click on a SubTree node opens its tree, which the view then draws.
     assert result["subtree"]["tree"] == "Dock", context

@@ -12,7 +12,9 @@
 // and wait for the picture to show a node of type expectType; click the node of type clickType
 // and read the editor's selection from the status bar; zoom with the keyboard; move the cursor to
 // cursorAt and read which node the webview highlights; check that an update keeps the zoom;
-// double-click the SubTree node of type subtreeType and wait for the picture of subtreeTree.
+// tick "expand SubTrees" (a node of type expandedType appears) and "ports" (blackboard keys
+// appear); double-click the SubTree node of type subtreeType and wait for the picture of
+// subtreeTree; with `big`, open its file and check that its tree is drawn in full.
 // Screenshots: tree.png (after the click), tree-failure.png on failure, in shotDir.
 // Exit status: 0 when every step ran (the caller judges the result), 1 when one failed.
 
@@ -82,6 +84,7 @@ async function picture(frame) {
       // The SVG's style sheet applied (the CSP let it in): a node outline has its kind's colour.
       stroke: nodes.length ? getComputedStyle(nodes[1].querySelector('.shape')).stroke : null,
       status: document.getElementById('status').textContent,
+      keys: [...document.querySelectorAll('#canvas tspan.key')].map((t) => t.textContent),
     };
   });
 }
@@ -218,6 +221,18 @@ async function main(page) {
   result.afterSecondEdit = await until(async () => {
     const p = await picture(frame);
     return p.renders > renders ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+
+  mark('expand and ports');
+  await frame.click('#expand');
+  result.expanded = await until(async () => {
+    const p = await picture(frame);
+    return p.types.includes(config.expandedType) ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+  await frame.click('#ports');
+  result.withPorts = await until(async () => {
+    const p = await picture(frame);
+    return p.keys.length > 0 ? p : null;
   }, STEP_TIMEOUT) || (await picture(frame));
 
   mark('open a subtree');

@@ -209,7 +209,23 @@
     event.preventDefault();
   });
 
+  const ports = document.getElementById('ports');
+  const expand = document.getElementById('expand');
+  ports.checked = state.ports === true;
+  expand.checked = state.expandSubtrees === true;
+  function options() {
+    state.ports = ports.checked;
+    state.expandSubtrees = expand.checked;
+    vscode.setState(state);
+    vscode.postMessage({ type: 'options', ports: ports.checked, expandSubtrees: expand.checked });
+  }
+  ports.addEventListener('change', options);
+  expand.addEventListener('change', options);
+
   window.addEventListener('resize', () => apply());
   apply();
   vscode.postMessage({ type: 'ready' });
+  if (ports.checked || expand.checked) {
+    options();
+  }
 })();

@@ -34,7 +34,11 @@ interface Rendered {
   nodes: TreeNode[];
 }
 
-type FromWebview = { type: 'ready' } | { type: 'reveal'; id: string } | { type: 'open'; id: string };
+type FromWebview =
+  | { type: 'ready' }
+  | { type: 'reveal'; id: string }
+  | { type: 'open'; id: string }
+  | { type: 'options'; ports: boolean; expandSubtrees: boolean };
 
 function toRange(r: LspRange): vscode.Range {
   return new vscode.Range(r.start.line, r.start.character, r.end.line, r.end.character);
@@ -63,6 +67,7 @@ class TreePanel {
   private timer: ReturnType<typeof setTimeout> | undefined;
   private generation = 0;
   private ready = false;
+  private options = { ports: false, expandSubtrees: false };
 
   constructor(
     private readonly extensionUri: vscode.Uri,
@@ -133,6 +138,8 @@ class TreePanel {
 </head>
 <body>
 <div id="bar"><span id="title"></span><span id="status"></span>
+<label><input type="checkbox" id="ports"> ports</label>
+<label><input type="checkbox" id="expand"> expand SubTrees</label>
 <span id="help">drag: pan · wheel or +/−: zoom · 0: fit · click: select in the XML · double click a SubTree: open its tree</span></div>
 <div id="view" tabindex="0" aria-label="Behavior tree"><div id="canvas" data-nonce="${this.nonce}"></div></div>
 <script nonce="${this.nonce}" src="${media('treeView.js')}"></script>
@@ -169,6 +176,8 @@ class TreePanel {
           {
             uri: client.code2ProtocolConverter.asUri(doc.uri),
             position: { line: position.line, character: position.character },
+            ports: this.options.ports,
+            expandSubtrees: this.options.expandSubtrees,
           },
         ],
       })) as Rendered | null;
@@ -239,6 +248,11 @@ class TreePanel {
         void this.panel.webview.postMessage(this.pending);
         this.pending = undefined;
       }
+      return;
+    }
+    if (message.type === 'options') {
+      this.options = { ports: message.ports === true, expandSubtrees: message.expandSubtrees === true };
+      await this.refresh();
       return;
     }
     const node = this.rendered?.nodes.find((n) => n.id === message.id);
