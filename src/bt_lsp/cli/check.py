@@ -34,13 +34,13 @@ from bt_lsp.cli.formats import Format
 from bt_lsp.cli.formats.json import to_json
 from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
+from bt_lsp.cli.project import config_errors, project_workspace, version_lines
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
 from bt_lsp.project.files import collect_files
-from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
+from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
@@ -58,6 +58,10 @@ class Options:
     progress: bool = True
     max_bytes: int = DEFAULT_MAX_BYTES
     cpp: bool = True  # learn the node catalog from the C++ of the files' packages
+    config: str | None = None  # --config: one configuration file for every file
+    models: tuple[str, ...] = ()  # --models
+    btcpp: str | None = None  # --btcpp
+    verbose: bool = False
 
 
 def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
@@ -100,7 +104,14 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
             result.findings = findings_of(path, doc, diags)
             return result
         raw = analyze(doc, workspace)
-        diags = with_severities(raw, options.severities)
+        # The workspace's settings for the file hold the flags' severities over its
+        # configuration file's.
+        severities = (
+            options.severities
+            if workspace is None
+            else workspace.settings_for(normalize(path)).severity
+        )
+        diags = with_severities(raw, severities)
         if options.fix:
             outcome = fix_document(decoded, doc, raw, diags, workspace)
             if isinstance(outcome, str):
@@ -111,7 +122,7 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
                 )
                 if workspace is not None:
                     workspace.file_changed(path)
-                fixed_diags = with_severities(outcome.raw, options.severities)
+                fixed_diags = with_severities(outcome.raw, severities)
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
                 result.notes = outcome.notes
                 doc, diags = outcome.doc, fixed_diags
@@ -206,11 +217,18 @@ def run(
 
     # The folders named on the command line are the workspace: includes resolve as
     # BehaviorTree.CPP resolves them, and every file's models and trees are known.
-    workspace = Workspace(
-        [p for p in paths if os.path.isdir(p)], Settings(max_document_bytes=options.max_bytes)
-    )
+    workspace = project_workspace(paths, options)
     if options.cpp:
         workspace.cpp = CppModels(workspace.roots, workspace.packages)
+    broken = config_errors(workspace, files)
+    if broken:
+        for ce in broken:
+            where = f"{visible(str(ce.path))}:{ce.line}:{ce.column}"
+            say(err, f"{where}: error config-error {ce.message}\n")
+        return 2
+    if options.verbose:
+        for line in version_lines(workspace, files):
+            say(err, line + "\n")
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     for i, path in enumerate(files, 1):
         progress.show(i, path)

@@ -96,6 +96,33 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SIZE",
         help="refuse files larger than this (e.g. 64M; default: 64M)",
     )
+    check.add_argument(
+        "--config",
+        metavar="FILE",
+        help="the configuration file for every checked file (default: the nearest "
+        "bt-lsp.toml or pyproject.toml with [tool.bt-lsp] above each file)",
+    )
+    check.add_argument(
+        "--models",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a node catalog: a TreeNodesModel XML (e.g. written by "
+        "writeTreeNodesModelXML) or a Groot2 .btproj (repeatable; replaces the "
+        "configuration's models)",
+    )
+    check.add_argument(
+        "--btcpp",
+        choices=("auto", "3", "4"),
+        help="the BehaviorTree.CPP major version (default: the configuration's, else "
+        "detected from package.xml, CMakeLists.txt or BTCPP_format)",
+    )
+    check.add_argument(
+        "--verbose",
+        action="store_true",
+        help="say which files were skipped and which BehaviorTree.CPP version each is "
+        "checked against",
+    )
     check.set_defaults(subparser=check)
 
     models = sub.add_parser(
@@ -168,6 +195,10 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         max_bytes=args.max_file_size,
         cpp=not args.no_cpp,
+        config=args.config,
+        models=tuple(args.models),
+        btcpp=args.btcpp,
+        verbose=args.verbose,
     )
     return check.run(args.paths, options)
 

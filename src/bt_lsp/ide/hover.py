@@ -180,3 +180,21 @@ def _raw_offset(doc: Document, ref: NameRef, index: int) -> int:
         else:
             pos += 1
     return ref.start + min(pos, len(raw))
+
+
+def root_hover(doc: Document, offset: int, version: str | None, source: str) -> HoverText | None:
+    """On the ``root`` of ``<root>``: the BehaviorTree.CPP version the document is checked
+    against and where that was read (``source``), so that a wrong guess is visible."""
+    root = doc.model.root
+    if root is None or root.name != "root" or not root.name_start <= offset <= root.name_end:
+        return None
+    if version is None:
+        lines = [
+            "**BehaviorTree.CPP version: not detected**",
+            "",
+            "Checked as BehaviorTree.CPP 4. Set `btcpp` in `bt-lsp.toml` (or the package's "
+            "`package.xml` dependency) to say which version the project builds against.",
+        ]
+    else:
+        lines = [f"**BehaviorTree.CPP {version}**", "", f"From {source}."]
+    return HoverText("\n".join(lines), root.name_start, root.name_end)

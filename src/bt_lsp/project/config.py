@@ -131,14 +131,17 @@ def _mentions_table(text: str) -> bool:
 _AT: Final = re.compile(r"\(at line (\d+), column (\d+)\)")
 
 
-def load_config(path: Path) -> Config | None:
-    """The configuration in ``path``; ``None`` for a ``pyproject.toml`` without a
-    ``[tool.bt-lsp]`` table.  :class:`ConfigError` when it cannot be used."""
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_CONFIG_BYTES + 1)
-    except (OSError, ValueError) as e:
-        raise ConfigError(path, 1, 1, f"cannot read the file: {e}") from None
+def load_config(path: Path, data: bytes | None = None) -> Config | None:
+    """The configuration in ``path`` (or ``data``, its text as an editor has it);
+    ``None`` for a ``pyproject.toml`` without a ``[tool.bt-lsp]`` table.
+    :class:`ConfigError` when it cannot be used."""
+    if data is None:
+        try:
+            with open(path, "rb") as f:
+                data = f.read(MAX_CONFIG_BYTES + 1)
+        except (OSError, ValueError) as e:
+            why = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
+            raise ConfigError(path, 1, 1, f"cannot read the file: {why}") from None
     if len(data) > MAX_CONFIG_BYTES:
         raise ConfigError(path, 1, 1, f"larger than {MAX_CONFIG_BYTES} bytes")
     try:
@@ -364,6 +367,7 @@ class Configs:
         self.explicit = explicit
         self._found: dict[Path, Path | None] = {}
         self._loaded: dict[Path, Config | ConfigError | None] = {}
+        self._texts: dict[Path, str] = {}  # configuration files open in an editor
 
     def path_for(self, path: Path) -> Path | None:
         """The configuration file that applies to ``path`` (a file or folder)."""
@@ -376,8 +380,11 @@ class Configs:
 
     def load(self, config_path: Path) -> Config | ConfigError | None:
         if config_path not in self._loaded:
+            text = self._texts.get(config_path)
             try:
-                self._loaded[config_path] = load_config(config_path)
+                self._loaded[config_path] = load_config(
+                    config_path, None if text is None else text.encode("utf-8")
+                )
             except ConfigError as e:
                 self._loaded[config_path] = e
         return self._loaded[config_path]
@@ -392,6 +399,17 @@ class Configs:
 
     def loaded(self) -> list[Path]:
         return list(self._loaded)
+
+    def set_text(self, path: Path, text: str | None) -> bool:
+        """An editor opened, changed (``text``) or closed (``None``) the file at ``path``;
+        true if it may be a configuration file (then it is read again)."""
+        if path.name not in CONFIG_NAMES and path != self.explicit:
+            return False
+        if text is None:
+            self._texts.pop(path, None)
+        else:
+            self._texts[path] = text
+        return self.changed(path)
 
     def changed(self, path: Path) -> bool:
         """``path`` changed on disk; true (and everything forgotten) if it may be a

@@ -229,6 +229,15 @@ class Workspace:
             return self.settings
         return replace(self.settings, models=models)
 
+    def config_edited(self, path: Path, text: str | None) -> bool:
+        """A configuration file open in an editor changed (``None``: closed); true if
+        ``path`` may be one, and then every file's settings are made again."""
+        if not self.configs.set_text(normalize(path), text):
+            return False
+        self._scoped.clear()
+        self.generation += 1
+        return True
+
     def config_errors(self) -> list[ConfigError]:
         """The configuration files read so far that cannot be used."""
         return self.configs.errors()

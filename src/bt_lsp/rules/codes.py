@@ -78,6 +78,7 @@ class FixData:
 NAMES = "names"
 XML = "xml"
 BT = "behaviortree"
+PROJECT = "project"
 
 # Every code defined so far, by name (the registry imports every module that defines one).
 _DEFINED: dict[str, Code] = {}

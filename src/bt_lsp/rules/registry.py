@@ -12,8 +12,14 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Final
 
-from bt_lsp.rules import cpp_names, diagnostics, includes, names  # noqa: F401  (they define codes)
-from bt_lsp.rules.codes import BT, NAMES, XML, Code, all_defined
+from bt_lsp.rules import (  # noqa: F401  (they define codes)
+    configuration,
+    cpp_names,
+    diagnostics,
+    includes,
+    names,
+)
+from bt_lsp.rules.codes import BT, NAMES, PROJECT, XML, Code, all_defined
 from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
     base,
     document,
@@ -26,7 +32,7 @@ from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
 
 #: The families in the order the README lists them, with their headings.
 FAMILIES: Final[Mapping[str, str]] = MappingProxyType(
-    {NAMES: "Name rules", XML: "XML", BT: "BehaviorTree.CPP semantics"}
+    {NAMES: "Name rules", XML: "XML", BT: "BehaviorTree.CPP semantics", PROJECT: "Project"}
 )
 
 CODES: Final[Mapping[str, Code]] = MappingProxyType(

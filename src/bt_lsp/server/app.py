@@ -10,6 +10,7 @@ import asyncio
 import logging
 import traceback
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from lsprotocol import types
@@ -27,6 +28,13 @@ from bt_lsp.rules.registry import CODES
 from bt_lsp.server.convert import diagnostic_at, to_diagnostic
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
+from bt_lsp.server.project import (
+    WATCHED,
+    config_diagnostics,
+    is_project_file,
+    log_version,
+    sync_config_diagnostics,
+)
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import looks_like_bt
@@ -67,6 +75,9 @@ class BtServer(LanguageServer):
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
         self.cpp = CppService(self)
+        # Configuration files' errors as published, by URI (see server/project.py).
+        self.config_published: dict[str, tuple[int, int, str]] = {}
+        self.versions_logged: set[Path] = set()  # folders whose version was logged
 
     # -- state ----------------------------------------------------------------------------
 
@@ -92,16 +103,21 @@ class BtServer(LanguageServer):
                 result = size_limited(od.doc, self.settings.max_document_bytes)
             elif od.path is not None:
                 result = self.project.diagnostics(od.path, od.doc)
+                log_version(self, od.path)
             else:
                 result = analyze(od.doc)
             settings = self.settings if od.path is None else self.project.settings_for(od.path)
             result = with_severities(result, settings.severity)
         od.cache_key, od.cached = key, result
+        sync_config_diagnostics(self)  # the files' settings were made: their errors known
         return result
 
     def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
         enc = self.encoding
-        return [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
+        found = [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
+        if not od.is_bt:
+            found.extend(config_diagnostics(self, od.uri))
+        return found
 
     # -- publishing -------------------------------------------------------------------------
 
@@ -275,7 +291,7 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 
 def create_server() -> BtServer:
-    from bt_lsp.server import actions, completion, documents, hover, navigation
+    from bt_lsp.server import actions, completion, documents, hover, navigation, project
     from bt_lsp.server import render as render_command
 
     server = BtServer()
@@ -325,6 +341,7 @@ def create_server() -> BtServer:
                                             types.FileSystemWatcher(glob_pattern=g)
                                             for g in CPP_WATCH_GLOBS
                                         ),
+                                        *(types.FileSystemWatcher(glob_pattern=g) for g in WATCHED),
                                     ]
                                 ),
                             )
@@ -336,14 +353,23 @@ def create_server() -> BtServer:
         if ls.configuration_support:
             await ls.fetch_settings()
             ls.settings_changed()
+        for root in ls.project.roots:  # a broken configuration is shown before any file
+            ls.project.configs.for_path(root)
+        sync_config_diagnostics(ls)
 
     @server.feature(types.WORKSPACE_DID_CHANGE_WATCHED_FILES)
     def did_change_watched_files(ls: BtServer, params: types.DidChangeWatchedFilesParams) -> None:
+        project_files = False
         for change in params.changes:
             path = to_fs_path(change.uri)
             if path:
                 ls.project.file_changed(path)
+                project_files = project_files or is_project_file(Path(path))
+        if project_files:
+            ls.versions_logged.clear()
         ls.refresh_all()
+        if project_files:
+            sync_config_diagnostics(ls)
 
     @server.feature(types.WORKSPACE_DID_CHANGE_CONFIGURATION)
     async def did_change_configuration(
@@ -362,6 +388,7 @@ def create_server() -> BtServer:
     navigation.register(server)
     completion.register(server)
     render_command.register(server)
+    project.register(server)
     return server
 
 

@@ -9,6 +9,7 @@ from lsprotocol import types
 from pygls.uris import to_fs_path
 
 from bt_lsp.server.convert import to_offsets
+from bt_lsp.server.project import document_edited
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 
@@ -36,6 +37,7 @@ def register(server: BtServer) -> None:
         ls.cpp.document_changed(od)
         ls.edits += 1
         ls.schedule_all(item.uri)
+        document_edited(ls, od, opened=True)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
     def did_change(ls: BtServer, params: types.DidChangeTextDocumentParams) -> None:
@@ -59,6 +61,7 @@ def register(server: BtServer) -> None:
         if was_bt and not od.is_bt:
             ls.clear(uri)
         ls.schedule_all(uri)
+        document_edited(ls, od)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(ls: BtServer, params: types.DidCloseTextDocumentParams) -> None:
@@ -69,6 +72,7 @@ def register(server: BtServer) -> None:
                 ls.project.close(od.path)
             ls.cpp.document_changed(od, closed=True)
             ls.clear(uri)
+            document_edited(ls, od, closed=True)
 
     @server.feature(
         types.TEXT_DOCUMENT_DIAGNOSTIC,

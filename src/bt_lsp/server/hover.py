@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 from lsprotocol import types
 
-from bt_lsp.ide.hover import hover_at
+from bt_lsp.ide.hover import hover_at, root_hover
 from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, offset_of
 
@@ -24,6 +24,9 @@ def register(server: BtServer) -> None:
         lines = od.doc.lines
         offset = offset_of(ls, od, params.position)
         found = hover_at(od.doc, offset, context_of(ls, od))
+        if found is None and od.path is not None:
+            detected = ls.project.btcpp_for(od.path, od.doc)
+            found = root_hover(od.doc, offset, detected.version, detected.source)
         if found is None:
             return None
         learned = ls.cpp.hover_markdown(od, offset)  # where the C++ declares it

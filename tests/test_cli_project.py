@@ -1,0 +1,112 @@
+"""``bt-lsp check`` with the project around it: configuration files, --config, --models,
+--btcpp, --verbose."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from bt_lsp.cli.main import main
+
+TREE = (
+    '<root main_tree_to_execute="T">\n'
+    '  <BehaviorTree ID="T"><Sequence><Go/></Sequence></BehaviorTree>\n'
+    "</root>\n"
+)
+CATALOG = '<root BTCPP_format="4"><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>\n'
+
+
+def write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(["check", "--no-progress", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def codes(out: str) -> list[str]:
+    return [line.split()[2] for line in out.splitlines() if line.strip()]
+
+
+def test_broken_configuration_exits_2_with_its_position(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = write(tmp_path / "bt-lsp.toml", 'btcpp = "4"\nexclude = "build"\n')
+    write(tmp_path / "t.xml", TREE)
+    code, out, err = run(capsys, str(tmp_path))
+    assert code == 2
+    assert out == ""
+    assert err.splitlines() == [
+        f"{cfg}:2:1: error config-error 'exclude' must be a list of strings"
+    ]
+
+
+def test_discovered_configuration_severity_and_version(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    write(tmp_path / "t.xml", TREE)
+    code, out, _ = run(capsys, str(tmp_path))
+    assert "missing-format" in codes(out)
+    write(tmp_path / "pyproject.toml", '[tool.bt-lsp.severity]\nmissing-format = "error"\n')
+    code, out, _ = run(capsys, str(tmp_path / "t.xml"))
+    assert code == 1
+    assert any(" error missing-format " in line for line in out.splitlines())
+    # --severity over the file.
+    code, out, _ = run(capsys, "--severity", "missing-format=off", str(tmp_path))
+    assert "missing-format" not in codes(out)
+
+
+def test_btcpp_flag_over_the_file_and_verbose(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    write(tmp_path / "bt-lsp.toml", 'btcpp = "4"\n')
+    write(tmp_path / "t.xml", TREE)
+    code, out, err = run(capsys, "--verbose", str(tmp_path))
+    assert "missing-format" in codes(out)
+    assert "bt-lsp: BehaviorTree.CPP 4: 1 file (the btcpp setting)" in err.splitlines()
+    code, out, err = run(capsys, "--verbose", "--btcpp", "3", str(tmp_path))
+    assert "missing-format" not in codes(out)
+    assert "bt-lsp: BehaviorTree.CPP 3: 1 file (the btcpp setting)" in err.splitlines()
+
+
+def test_verbose_names_the_package(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    manifest = write(
+        tmp_path / "pkg" / "package.xml",
+        "<package><name>pkg</name><exec_depend>behaviortree_cpp_v3</exec_depend></package>",
+    )
+    write(tmp_path / "pkg" / "trees" / "t.xml", TREE)
+    _, out, err = run(capsys, "--verbose", str(tmp_path / "pkg" / "trees"))
+    assert "missing-format" not in codes(out)
+    assert (
+        f"bt-lsp: BehaviorTree.CPP 3: 1 file ({manifest} depends on behaviortree_cpp_v3)"
+        in err.splitlines()
+    )
+
+
+def test_models_flag_and_key(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tree = write(tmp_path / "trees" / "t.xml", TREE)
+    cat = write(tmp_path / "catalog" / "nodes.xml", CATALOG)
+    _, out, _ = run(capsys, str(tree))
+    assert "unknown-node" in codes(out)
+    _, out, _ = run(capsys, "--models", str(cat), str(tree))
+    assert "unknown-node" not in codes(out)
+    write(tmp_path / "bt-lsp.toml", 'models = ["catalog/nodes.xml"]\n')
+    _, out, _ = run(capsys, str(tree))
+    assert "unknown-node" not in codes(out)
+
+
+def test_explicit_config(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    write(tmp_path / "t.xml", TREE)
+    other = write(tmp_path / "elsewhere" / "mine.toml", '[severity]\nmissing-format = "off"\n')
+    _, out, _ = run(capsys, "--config", str(other), str(tmp_path / "t.xml"))
+    assert "missing-format" not in codes(out)
+    code, _, err = run(capsys, "--config", str(tmp_path / "none.toml"), str(tmp_path))
+    assert code == 2 and "config-error cannot read the file" in err
+    py = write(tmp_path / "pyproject.toml", '[project]\nname = "x"\n')
+    code, _, err = run(capsys, "--config", str(py), str(tmp_path))
+    assert code == 2 and "has no [tool.bt-lsp] table" in err
