@@ -67,9 +67,11 @@ def test_btcpp_flag_over_the_file_and_verbose(
     write(tmp_path / "bt-lsp.toml", 'btcpp = "4"\n')
     write(tmp_path / "t.xml", TREE)
     code, out, err = run(capsys, "--verbose", str(tmp_path))
+    assert code == 0
     assert "missing-format" in codes(out)
     assert "bt-lsp: BehaviorTree.CPP 4: 1 file (the btcpp setting)" in err.splitlines()
     code, out, err = run(capsys, "--verbose", "--btcpp", "3", str(tmp_path))
+    assert code == 0
     assert "missing-format" not in codes(out)
     assert "bt-lsp: BehaviorTree.CPP 3: 1 file (the btcpp setting)" in err.splitlines()
 
