@@ -11,7 +11,7 @@ Nothing here ever fetches a URL or follows a DOCTYPE.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -21,6 +21,7 @@ from bt_lsp.project.cpp_models import CppModels, cpp_diagnostics
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError, read_text
 from bt_lsp.project.packages import Detected, Packages
+from bt_lsp.project.ros import RosIndex
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules import analysis
 from bt_lsp.rules.context import Context
@@ -80,7 +81,14 @@ def links(includes: Iterable[Include]) -> list[IncludeLink]:
     return [IncludeLink(i.start, i.end, str(i.target)) for i in includes if i.target is not None]
 
 
-def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
+def includes_of(
+    path: Path,
+    doc: Document,
+    settings: Settings,
+    package: Callable[[str], Path | None] | None = None,
+) -> list[Include]:
+    """The includes of ``doc``; ``ros_pkg`` resolves through the settings, else through
+    ``package`` (the workspace's and the installed ROS packages)."""
     out: list[Include] = []
     for el in doc.model.root_children_named(("include",)):  # the INCLUDE zone
         a = el.attr("path")
@@ -93,7 +101,9 @@ def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
         if os.path.isabs(written):
             target = normalize(written)
         elif pkg:
-            base = settings.ros_packages.get(pkg)
+            base: str | Path | None = settings.ros_packages.get(pkg)
+            if base is None and package is not None:
+                base = package(pkg)
             target = normalize(Path(base) / written) if base else None
         else:
             target = normalize(path.parent / written)
@@ -113,12 +123,16 @@ class Workspace:
         *,
         configs: Configs | None = None,
         overrides: Layer | None = None,
+        ament_prefix_path: Sequence[str] | None = None,
     ) -> None:
         self.roots = [normalize(r) for r in roots]
         self.settings = settings or Settings()
         self.configs = configs if configs is not None else Configs()
         self.overrides = overrides
         self.packages = Packages()
+        # Installed ROS packages (AMENT_PREFIX_PATH unless given) and their catalogs.
+        self.ros = RosIndex(self.packages, ament_prefix_path)
+        self._ros_workspace: tuple[list[Path], dict[str, Path]] | None = None
         # Folder -> (the editor settings they were made from, the folder's settings).
         self._scoped: dict[Path, tuple[Settings, Settings]] = {}
         self._open: dict[Path, Document] = {}
@@ -188,6 +202,9 @@ class Workspace:
         self._files = None
         if self.configs.changed(p) | self.packages.changed(p):
             self._scoped.clear()
+            self.ros.changed()
+        elif p.suffix == ".xml":
+            self.ros.changed()  # it may be a catalog
         if self.cpp is not None:
             self.cpp.file_changed(p)
         self.generation += 1
@@ -199,6 +216,7 @@ class Workspace:
         self._scoped.clear()
         self.configs.changed(Path(CONFIG_FILE))
         self.packages.changed(Path("package.xml"))
+        self.ros.changed()
         self.generation += 1
 
     # -- each file's settings -------------------------------------------------------------------
@@ -311,7 +329,7 @@ class Workspace:
         hit = self._includes.get(path)
         if hit is not None and hit[0] is model and hit[1] is settings:
             return hit[2]
-        found = includes_of(path, doc, settings)
+        found = includes_of(path, doc, settings, lambda name: self.ros_package(name, settings))
         self._includes[path] = (model, settings, found)
         return found
 
@@ -397,13 +415,21 @@ class Workspace:
                 others.append((str(p), d, True))
         included_by: list[str] = []
         settings = self.settings_for(path)
-        model_paths = self.catalog_files(path)
+        model_paths = self.model_catalogs(path)
         model_files: list[tuple[str, Document]] = []
         for p in model_paths:
             d = self.document(p)
             if d is not None and p != path:
                 model_files.append((str(p), d))
         skip = set(model_paths)
+        # The catalogs of the document's ROS package and its dependencies: their models
+        # count, as another file's would (one package's catalog does not list every
+        # node the application registers, so a node missing from it is not an error).
+        for p in self.ros_catalogs(path):
+            d = self.document(p)
+            if d is not None and p != path and p not in skip and p not in in_closure:
+                skip.add(p)
+                others.append((str(p), d, False))
         for p, d in self.bt_documents():
             if p == path or p in in_closure or p in skip:
                 continue
@@ -414,7 +440,7 @@ class Workspace:
             doc,
             others,
             path=str(path),
-            ros_pkg_paths=settings.ros_packages,
+            ros_pkg_paths=self._ros_paths(path, doc, settings),
             model_files=model_files,
             included_by=included_by,
             btcpp_version=self.btcpp_for(path, doc).version,
@@ -425,12 +451,74 @@ class Workspace:
 
     def catalog_files(self, path: Path) -> list[Path]:
         """The node catalog files in scope for the document at ``path``: the ``models``
-        of its settings (configuration file, flags, editor)."""
+        of its settings (configuration file, flags, editor), then those its ROS package
+        ships and those of the packages its ``package.xml`` depends on."""
+        out = self.model_catalogs(path)
+        out.extend(p for p in self.ros_catalogs(path) if p not in out)
+        return out
+
+    def model_catalogs(self, path: Path) -> list[Path]:
+        """The ``models`` of the settings of the file at ``path``, as absolute paths."""
         out: list[Path] = []
         for m in self.settings_for(path).models:
             p = normalize(m if m.is_absolute() or not self.roots else self.roots[0] / m)
             if p not in out:
                 out.append(p)
+        return out
+
+    def ros_catalogs(self, path: Path) -> list[Path]:
+        """The catalogs that the ROS package of the file at ``path`` ships and those of
+        the packages its ``package.xml`` depends on (workspace or installed)."""
+        settings = self.settings_for(path)
+        out: list[Path] = []
+        own = self.packages.package_of(path.parent)
+        if own is None:
+            return out
+        folders = [own.folder]
+        for dep in sorted(own.depends):
+            folder = self.ros_package(dep, settings)
+            if folder is not None and folder not in folders:
+                folders.append(folder)
+        for folder in folders:
+            for p in self.ros.catalogs(folder):
+                p = normalize(p)
+                if p not in out and p != path:
+                    out.append(p)
+        return out
+
+    # -- ROS packages --------------------------------------------------------------------------
+
+    def workspace_packages(self) -> Mapping[str, Path]:
+        """The ROS packages of the workspace folders: each ``package.xml`` among their
+        files (a colcon workspace's ``src/``), by package name, the first found kept."""
+        files = self.files()
+        if self._ros_workspace is None or self._ros_workspace[0] is not files:
+            found: dict[str, Path] = {}
+            for p in files:
+                if p.name == "package.xml":
+                    m = self.packages.manifest(p)
+                    if m is not None:
+                        found.setdefault(m.name, m.folder)
+            self._ros_workspace = (files, found)
+        return self._ros_workspace[1]
+
+    def ros_package(self, name: str, settings: Settings | None = None) -> Path | None:
+        """The folder of ROS package ``name``: the settings' ``ros-packages``, the
+        workspace's packages, then the installed ones (``AMENT_PREFIX_PATH``)."""
+        configured = (settings or self.settings).ros_packages
+        return self.ros.folder(name, configured, self.workspace_packages())
+
+    def _ros_paths(self, path: Path, doc: Document, settings: Settings) -> Mapping[str, str]:
+        """The packages the rules may take as known: the configured ones and those the
+        document's includes name that resolve."""
+        named = {i.ros_pkg for i in self.includes(path, doc) if i.ros_pkg and i.target}
+        if not named - settings.ros_packages.keys():
+            return settings.ros_packages
+        out = dict(settings.ros_packages)
+        for name in sorted(named):
+            folder = self.ros_package(name, settings)
+            if folder is not None and name not in out:
+                out[name] = str(folder)
         return out
 
     @with_gc_paused

@@ -1,0 +1,60 @@
+"""What kind of XML a file is, from its first bytes: enough to tell a BehaviorTree.CPP
+document (top element ``<root>``) from the other XML of a source tree (``package.xml``,
+launch files, URDF and xacro, pluginlib descriptions) without parsing it."""
+
+from __future__ import annotations
+
+import codecs
+import re
+from pathlib import Path
+from typing import Final
+
+__all__ = ["SNIFF_BYTES", "head_of", "is_bt_file", "top_element"]
+
+SNIFF_BYTES: Final = 64 * 1024
+
+# Before the top element: an XML declaration, processing instructions, comments, a
+# DOCTYPE without an internal subset, white space.
+_TOP: Final = re.compile(
+    r"(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>)*<([^\s/>!?]+)",
+    re.DOTALL,
+)
+_BOMS: Final = (
+    (codecs.BOM_UTF32_LE, "utf-32-le"),
+    (codecs.BOM_UTF32_BE, "utf-32-be"),
+    (codecs.BOM_UTF8, "utf-8"),
+    (codecs.BOM_UTF16_LE, "utf-16-le"),
+    (codecs.BOM_UTF16_BE, "utf-16-be"),
+)
+
+
+def head_of(path: Path | str, size: int = SNIFF_BYTES) -> str | None:
+    """The first ``size`` bytes of a file as text (``None`` if it cannot be read)."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read(size)
+    except (OSError, ValueError):
+        return None
+    for bom, enc in _BOMS:
+        if data.startswith(bom):
+            return data[len(bom) :].decode(enc, "replace")
+    if data.startswith((b"<\x00?\x00", b"<\x00")):
+        return data.decode("utf-16-le", "replace")
+    if data.startswith((b"\x00<\x00?", b"\x00<")):
+        return data.decode("utf-16-be", "replace")
+    return data.decode("utf-8", "replace")
+
+
+def top_element(text: str) -> str | None:
+    """The name of the first element of an XML text (``None`` if there is none in it)."""
+    m = _TOP.match(text)
+    return m.group(1) if m is not None else None
+
+
+def is_bt_file(path: Path | str) -> bool:
+    """Whether the file looks like BehaviorTree.CPP XML: its top element is ``<root>``.
+    A file that cannot be read counts as one, so that reading it reports the error."""
+    head = head_of(path)
+    if head is None:
+        return True
+    return top_element(head) == "root"

@@ -1,0 +1,135 @@
+"""ROS workspaces: installed packages through AMENT_PREFIX_PATH, a colcon workspace's
+src/ packages, <include ros_pkg>, and the catalogs of a package's dependencies."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from bt_lsp.project.ros import is_catalog
+from bt_lsp.project.settings import Settings
+from bt_lsp.project.workspace import Workspace
+from bt_lsp.syntax.document import Document
+
+CATALOG = (
+    '<?xml version="1.0"?>\n<!-- generated -->\n<root BTCPP_format="4">\n  <TreeNodesModel>\n'
+    '    <Action ID="ComputePathToPose"><input_port name="goal"/></Action>\n'
+    "  </TreeNodesModel>\n</root>\n"
+)
+LIB_CATALOG = CATALOG.replace("ComputePathToPose", "LibNode")
+SUB = '<root BTCPP_format="4"><BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree></root>\n'
+MAIN = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <include ros_pkg="my_trees" path="trees/sub.xml"/>\n'
+    '  <BehaviorTree ID="Main">\n'
+    "    <Sequence>\n"
+    '      <ComputePathToPose goal="{g}"/>\n'
+    '      <SubTree ID="Sub"/>\n'
+    "    </Sequence>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+
+
+def write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def manifest(name: str, *depends: str) -> str:
+    deps = "".join(f"<exec_depend>{d}</exec_depend>" for d in depends)
+    return f'<package format="3"><name>{name}</name>{deps}</package>'
+
+
+def installed(tmp_path: Path) -> Path:
+    prefix = tmp_path / "opt" / "ros" / "humble"
+    share = prefix / "share"
+    write(share / "nav2_behavior_tree" / "package.xml", manifest("nav2_behavior_tree"))
+    write(share / "nav2_behavior_tree" / "nav2_tree_nodes.xml", CATALOG)
+    write(share / "my_trees" / "package.xml", manifest("my_trees"))
+    write(share / "my_trees" / "trees" / "sub.xml", SUB)
+    (share / "not_a_package").mkdir()
+    return prefix
+
+
+def codes(ws: Workspace, path: Path) -> set[str]:
+    doc = Document(path.read_text(encoding="utf-8"), str(path))
+    return {d.code for d in ws.diagnostics(path, doc)}
+
+
+def test_is_catalog(tmp_path: Path) -> None:
+    assert is_catalog(write(tmp_path / "a.xml", CATALOG))
+    assert not is_catalog(write(tmp_path / "b.xml", SUB))
+    assert not is_catalog(write(tmp_path / "c.xml", CATALOG.replace("</root>", SUB + "</root>")))
+    assert not is_catalog(write(tmp_path / "d.xml", "<package><TreeNodesModel/></package>"))
+    assert not is_catalog(tmp_path / "missing.xml")
+
+
+def test_installed_packages_resolve_includes_and_ship_catalogs(tmp_path: Path) -> None:
+    prefix = installed(tmp_path)
+    app = tmp_path / "ws" / "src" / "app"
+    write(app / "package.xml", manifest("app", "nav2_behavior_tree", "my_trees"))
+    main = write(app / "behavior_trees" / "main.xml", MAIN)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(tmp_path / "nowhere"), str(prefix)])
+    assert ws.ros_package("my_trees") == prefix / "share" / "my_trees"
+    assert ws.catalog_files(main) == [
+        prefix / "share" / "nav2_behavior_tree" / "nav2_tree_nodes.xml"
+    ]
+    [inc] = ws.includes(main)
+    assert inc.target == prefix / "share" / "my_trees" / "trees" / "sub.xml"
+    found = codes(ws, main)
+    assert "include-ros-pkg" not in found  # resolved
+    assert "unknown-subtree" not in found  # Sub comes from the included file
+    assert "unknown-node" not in found  # ComputePathToPose from nav2's catalog
+    # Without AMENT_PREFIX_PATH, none of it is known.
+    bare = Workspace([tmp_path / "ws"], ament_prefix_path=[])
+    found = codes(bare, main)
+    assert {"include-ros-pkg", "unknown-node"} <= found
+
+
+def test_catalogs_only_for_packages_that_depend(tmp_path: Path) -> None:
+    prefix = installed(tmp_path)
+    other = tmp_path / "ws" / "src" / "other"
+    write(other / "package.xml", manifest("other", "rclcpp"))
+    tree = write(other / "trees" / "t.xml", MAIN)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(prefix)])
+    assert ws.catalog_files(tree) == []
+    assert "unknown-node" in codes(ws, tree)
+
+
+def test_colcon_src_packages_see_their_own_and_their_dependencies_catalogs(
+    tmp_path: Path,
+) -> None:
+    src = tmp_path / "ws" / "src"
+    write(src / "lib" / "package.xml", manifest("lib"))
+    lib_catalog = write(src / "lib" / "lib_nodes.xml", LIB_CATALOG)
+    write(src / "app" / "package.xml", manifest("app", "lib"))
+    app_catalog = write(src / "app" / "models" / "app_nodes.xml", CATALOG)
+    app_tree = write(src / "app" / "trees" / "t.xml", MAIN.replace("ComputePathToPose", "LibNode"))
+    write(src / "solo" / "package.xml", manifest("solo"))
+    solo_tree = write(src / "solo" / "t.xml", MAIN)
+    # The build and install folders are never the workspace's packages.
+    write(tmp_path / "ws" / "install" / "lib" / "package.xml", manifest("lib"))
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[])
+    assert ws.workspace_packages() == {
+        "app": src / "app",
+        "lib": src / "lib",
+        "solo": src / "solo",
+    }
+    assert ws.catalog_files(app_tree) == [app_catalog, lib_catalog]
+    assert ws.catalog_files(solo_tree) == []
+    assert "unknown-node" not in codes(ws, app_tree)
+
+
+def test_configured_packages_come_first(tmp_path: Path) -> None:
+    prefix = installed(tmp_path)
+    mine = tmp_path / "mine"
+    write(mine / "trees" / "sub.xml", SUB)
+    ws = Workspace(
+        [tmp_path], Settings(ros_packages={"my_trees": str(mine)}), ament_prefix_path=[str(prefix)]
+    )
+    assert ws.ros_package("my_trees", ws.settings) == mine
+    write(tmp_path / "bt-lsp.toml", '[ros-packages]\nmy_trees = "elsewhere"\n')
+    f = write(tmp_path / "t.xml", MAIN)
+    [inc] = ws.includes(f)
+    assert inc.target == tmp_path / "elsewhere" / "trees" / "sub.xml"
