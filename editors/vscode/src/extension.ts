@@ -66,13 +66,17 @@ function restart(): Promise<void> {
   });
 }
 
-/** The `btLsp` settings the server understands, also sent as initializationOptions. */
-function serverSettings(): { debounceMs?: number; severity?: Record<string, string> } {
+/** The `btLsp` settings the server understands (every one declared in package.json but the
+ * extension's own `server.command` and `trace.server`), also sent as initializationOptions. */
+const SERVER_SETTINGS = ['debounceMs', 'severity', 'maxDocumentBytes', 'rosPackages', 'modelFiles', 'btcpp'];
+
+function serverSettings(): Record<string, unknown> {
   const config = vscode.workspace.getConfiguration('btLsp');
-  return {
-    debounceMs: config.get<number>('debounceMs'),
-    severity: config.get<Record<string, string>>('severity'),
-  };
+  const out: Record<string, unknown> = {};
+  for (const key of SERVER_SETTINGS) {
+    out[key] = config.get(key);
+  }
+  return out;
 }
 
 async function startClient(): Promise<void> {
@@ -158,6 +162,14 @@ function errorText(error: unknown): string {
   return error instanceof Error ? error.message : String(error);
 }
 
+/** Opens the settings where `btLsp.server.command` belongs. It is machine-overridable, so in a
+ * remote window (SSH, WSL, container) VS Code ignores it in the local user settings: there it
+ * goes in the remote machine's settings, where the server runs; elsewhere in the user settings. */
+function openServerCommandSetting(): Thenable<unknown> {
+  const command = vscode.env.remoteName ? 'workbench.action.openRemoteSettings' : 'workbench.action.openGlobalSettings';
+  return vscode.commands.executeCommand(command, { query: 'btLsp.server.command' });
+}
+
 /** Logs why the server is not running and shows a notification saying how to install it. */
 function showInstallHelp(reason: string, tried: string[]): void {
   const help =
@@ -174,7 +186,7 @@ function showInstallHelp(reason: string, tried: string[]): void {
   // Not awaited: the notification stays until the user closes it, and a restart must not wait for that.
   void vscode.window.showErrorMessage(`bt-lsp: ${reason}. ${help}`, openSettings, showOutput).then((choice) => {
     if (choice === openSettings) {
-      void vscode.commands.executeCommand('workbench.action.openSettings', 'btLsp.server.command');
+      void openServerCommandSetting();
     } else if (choice === showOutput) {
       log.show();
     }

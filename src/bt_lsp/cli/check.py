@@ -24,6 +24,7 @@ import os
 import shutil
 import sys
 import traceback
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +35,13 @@ from bt_lsp.cli.formats import Format
 from bt_lsp.cli.formats.json import to_json
 from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
-from bt_lsp.cli.project import config_errors, project_workspace, version_lines
+from bt_lsp.cli.project import (
+    BUILD_FOLDER,
+    config_errors,
+    project_workspace,
+    skip_reason,
+    version_lines,
+)
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
@@ -199,7 +206,20 @@ def run(
     """Check ``paths`` and print the report; returns the exit status."""
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
-    files, walk_errors = collect_files(paths)
+    # The folders named on the command line are the workspace: includes resolve as
+    # BehaviorTree.CPP resolves them, and every file's models and trees are known.
+    workspace = project_workspace(paths, options)
+    if options.cpp:
+        workspace.cpp = CppModels(workspace.roots, workspace.packages)
+    skipped: Counter[str] = Counter()
+
+    def skip(path: str, is_dir: bool) -> bool:
+        why = skip_reason(workspace, path, is_dir)
+        if why is not None:
+            skipped[why] += 1
+        return why is not None
+
+    files, walk_errors = collect_files(paths, skip)
     if options.cpp:
         files += [str(f) for p in paths if os.path.isdir(p) for f in find_cpp_files([p])]
     progress = Progress(err, len(files), options.progress and len(files) > 1 and _isatty(err))
@@ -209,25 +229,24 @@ def run(
         write(stream, text)
         stream.flush()
 
-    for e in walk_errors:
-        say(err, f"bt-lsp: {e.message}\n")
-    if not files:
-        say(err, "bt-lsp: no XML files to check\n")
-        return 2 if walk_errors else 0
-
-    # The folders named on the command line are the workspace: includes resolve as
-    # BehaviorTree.CPP resolves them, and every file's models and trees are known.
-    workspace = project_workspace(paths, options)
-    if options.cpp:
-        workspace.cpp = CppModels(workspace.roots, workspace.packages)
     broken = config_errors(workspace, files)
     if broken:
         for ce in broken:
             where = f"{visible(str(ce.path))}:{ce.line}:{ce.column}"
             say(err, f"{where}: error config-error {ce.message}\n")
         return 2
+    for e in walk_errors:
+        say(err, f"bt-lsp: {e.message}\n")
+    if not files:
+        none = "no BehaviorTree.CPP XML files" if skipped else "no XML files"
+        say(err, f"bt-lsp: {none} to check\n")
+        return 2 if walk_errors else 0
+
     if options.verbose:
-        for line in version_lines(workspace, files):
+        for why, n in sorted(skipped.items()):
+            what = "folder" if why == BUILD_FOLDER else "file"
+            say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
+        for line in version_lines(workspace, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     for i, path in enumerate(files, 1):

@@ -6,14 +6,29 @@ from __future__ import annotations
 import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from typing import Protocol
+from typing import Final, Protocol
 
-from bt_lsp.project.config import ConfigError, Configs, Layer
+from bt_lsp.project.config import ConfigError, Configs, Layer, excluded
 from bt_lsp.project.settings import Settings
+from bt_lsp.project.sniff import is_bt_file
 from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.codes import Severity
 
-__all__ = ["config_errors", "project_workspace", "version_lines"]
+__all__ = [
+    "NOT_BT",
+    "WALK_SKIP_DIRS",
+    "config_errors",
+    "project_workspace",
+    "skip_reason",
+    "version_lines",
+]
+
+# Folders a walk never enters: colcon's build, install and log folders, version control,
+# JavaScript dependencies.
+WALK_SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules"})
+NOT_BT: Final = "not BehaviorTree.CPP XML"
+EXCLUDED: Final = "excluded"
+BUILD_FOLDER: Final = "build, install, log and VCS folders"
 
 
 class ProjectOptions(Protocol):
@@ -70,3 +85,17 @@ def version_lines(workspace: Workspace, files: Sequence[str]) -> list[str]:
         f"bt-lsp: BehaviorTree.CPP {version}: {n} file{'s' if n != 1 else ''} ({why})"
         for (version, why), n in sorted(counts.items())
     ]
+
+
+def skip_reason(workspace: Workspace, path: str, is_dir: bool) -> str | None:
+    """Why a walk over a folder leaves ``path`` out (``None``: it is checked): a build or
+    VCS folder, an ``exclude`` glob of its configuration, or a file whose top element is
+    not ``<root>`` (``package.xml``, launch files, URDF, pluginlib descriptions)."""
+    p = normalize(path)
+    if is_dir:
+        if p.name in WALK_SKIP_DIRS:
+            return BUILD_FOLDER
+        return EXCLUDED if excluded(p, workspace.settings_for(p / "-").exclude) else None
+    if excluded(p, workspace.settings_for(p).exclude):
+        return EXCLUDED
+    return None if is_bt_file(p) else NOT_BT

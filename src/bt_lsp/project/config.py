@@ -419,3 +419,47 @@ class Configs:
         self._found.clear()
         self._loaded.clear()
         return True
+
+
+# -- exclude globs -------------------------------------------------------------------------
+
+
+def _glob_regex(glob: str) -> re.Pattern[str]:
+    """A glob over ``/``-separated paths: ``**`` spans folders, ``*`` and ``?`` stay in one."""
+    out: list[str] = []
+    i = 0
+    while i < len(glob):
+        c = glob[i]
+        if glob.startswith("**/", i):
+            out.append("(?:.*/)?")
+            i += 3
+        elif glob.startswith("**", i):
+            out.append(".*")
+            i += 2
+        elif c == "*":
+            out.append("[^/]*")
+            i += 1
+        elif c == "?":
+            out.append("[^/]")
+            i += 1
+        else:
+            out.append(re.escape(c))
+            i += 1
+    return re.compile("".join(out) + r"\Z")
+
+
+_GLOBS: dict[str, re.Pattern[str]] = {}
+
+
+def excluded(path: Path, globs: tuple[str, ...]) -> bool:
+    """Whether ``path`` (absolute) matches one of the anchored ``exclude`` globs."""
+    if not globs:
+        return False
+    text = path.as_posix()
+    for g in globs:
+        pattern = _GLOBS.get(g)
+        if pattern is None:
+            pattern = _GLOBS[g] = _glob_regex(g)
+        if pattern.match(text):
+            return True
+    return False

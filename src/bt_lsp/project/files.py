@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 import stat
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Final
 
 from bt_lsp.project.fileio import FileError
@@ -17,9 +17,14 @@ def _part_key(path: str, root: str) -> list[str]:
     return os.path.relpath(path, root).split(os.sep)
 
 
-def _search(root: str, errors: list[FileError]) -> list[str]:
+# Whether a walk leaves out a path (the path, whether it is a folder).
+Skip = Callable[[str, bool], bool]
+
+
+def _search(root: str, errors: list[FileError], skip: Skip | None = None) -> list[str]:
     """Every ``*.xml`` file under ``root`` (regular files or links to them; hidden
-    files and folders and ``node_modules`` skipped), sorted by path components."""
+    files and folders and ``node_modules`` skipped, and what ``skip`` leaves out), sorted
+    by path components."""
 
     def onerror(e: OSError) -> None:
         where = e.filename if isinstance(e.filename, str) else root
@@ -27,13 +32,21 @@ def _search(root: str, errors: list[FileError]) -> list[str]:
 
     found: list[str] = []
     for dirpath, dirnames, filenames in os.walk(root, onerror=onerror):
-        dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and d not in SKIP_DIRS)
+        dirnames[:] = sorted(
+            d
+            for d in dirnames
+            if not d.startswith(".")
+            and d not in SKIP_DIRS
+            and (skip is None or not skip(os.path.join(dirpath, d), True))
+        )
         for name in filenames:
             if name.startswith(".") or not name.endswith(".xml"):
                 continue
             path = os.path.join(dirpath, name)
             if root == os.curdir:
                 path = os.path.relpath(path)
+            if skip is not None and skip(path, False):
+                continue
             try:
                 st = os.stat(path)
             except OSError:
@@ -45,17 +58,20 @@ def _search(root: str, errors: list[FileError]) -> list[str]:
     return found
 
 
-def collect_files(paths: Iterable[str]) -> tuple[list[str], list[FileError]]:
+def collect_files(
+    paths: Iterable[str], skip: Skip | None = None
+) -> tuple[list[str], list[FileError]]:
     """The files to check, in order, each once: a directory gives its ``*.xml`` files
-    (recursively), anything else is taken as a file (a missing one is reported when read).
-    Also returns the folders that could not be searched."""
+    (recursively, but what ``skip`` leaves out), anything else is taken as a file (a
+    missing one is reported when read). Also returns the folders that could not be
+    searched."""
     files: list[str] = []
     errors: list[FileError] = []
     seen: set[str] = set()
     for given in paths:
         if os.path.isdir(given):
             root = given.rstrip("/" + os.sep) or given
-            candidates = _search(root, errors)
+            candidates = _search(root, errors, skip)
         else:
             candidates = [given]
         for path in candidates:

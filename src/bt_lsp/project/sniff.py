@@ -47,7 +47,7 @@ def head_of(path: Path | str, size: int = SNIFF_BYTES) -> str | None:
 
 def top_element(text: str) -> str | None:
     """The name of the first element of an XML text (``None`` if there is none in it)."""
-    m = _TOP.match(text)
+    m = _TOP.match(text.removeprefix("\ufeff"))
     return m.group(1) if m is not None else None
 
 

@@ -1,0 +1,110 @@
+"""``bt-lsp check`` over a real source tree: only BT XML is checked when a folder is
+walked; package.xml, launch files, URDF/xacro and pluginlib XML are skipped (``--verbose``
+counts them), as are ``exclude`` globs and colcon's build, install and log folders; a file
+named on the command line is checked as given."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from bt_lsp.cli.main import main
+from bt_lsp.project.config import anchor, excluded
+from bt_lsp.project.sniff import is_bt_file, top_element
+
+PKG = Path(__file__).parent / "data" / "ros_pkg" / "my_robot_bt"
+
+
+@pytest.fixture
+def pkg(tmp_path: Path) -> Path:
+    dest = tmp_path / "my_robot_bt"
+    shutil.copytree(PKG, dest)
+    return dest
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(["check", "--no-progress", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_package_checks_its_trees_alone(pkg: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "--format", "json", "--verbose", str(pkg))
+    assert code == 0, out + err
+    assert out.strip() == "[]"
+    lines = err.splitlines()
+    # package.xml, two launch files, the xacro as .xml, the plugin description (robot.urdf
+    # is not *.xml: never looked at).
+    assert "bt-lsp: skipped 5 files: not BehaviorTree.CPP XML" in lines
+    assert "bt-lsp: skipped 1 file: excluded" in lines
+    assert "bt-lsp: skipped 2 folders: build, install, log and VCS folders" in lines
+    assert any(
+        line.startswith("bt-lsp: BehaviorTree.CPP 4: 2 files (") and "package.xml" in line
+        for line in lines
+    )
+
+
+def test_text_summary_counts_the_trees(pkg: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, str(pkg))
+    assert code == 0
+    assert out == ""
+    assert "2 files" in err.splitlines()[-1]
+
+
+def test_a_named_file_is_checked_as_given(pkg: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, str(pkg / "package.xml"))
+    assert code == 1
+    assert " error root-element " in out
+    code, out, _ = run(capsys, str(pkg / "generated" / "broken.xml"))
+    assert code == 1 and "xml-syntax" in out
+
+
+def test_without_the_exclude_the_generated_tree_is_checked(
+    pkg: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (pkg / "bt-lsp.toml").unlink()
+    code, out, _ = run(capsys, str(pkg))
+    assert code == 1
+    assert {line.split(":")[0] for line in out.splitlines()} == {
+        str(pkg / "generated" / "broken.xml")
+    }
+
+
+def test_only_skipped_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "package.xml").write_text("<package><name>x</name></package>")
+    code, _, err = run(capsys, str(tmp_path))
+    assert code == 0
+    assert "no BehaviorTree.CPP XML files to check" in err
+
+
+def test_sniffing() -> None:
+    assert top_element('<?xml version="1.0"?>\n<!-- <root> -->\n<launch>') == "launch"
+    assert top_element("\ufeff<root/>") == "root"
+    assert top_element('<!DOCTYPE root [<!ENTITY a "b">]>\n<root>') == "root"
+    assert top_element("<?xml version='1.0'?><!-- unterminated") is None
+    assert top_element("") is None
+    assert is_bt_file(PKG / "behavior_trees" / "main.xml")
+    assert not is_bt_file(PKG / "plugins.xml")
+    assert is_bt_file(PKG / "missing.xml")  # unreadable: checked, so that the error shows
+
+
+def test_utf16_files_are_sniffed(tmp_path: Path) -> None:
+    p = tmp_path / "t.xml"
+    p.write_bytes("\ufeff<root/>".encode("utf-16-le"))
+    assert is_bt_file(p)
+    p.write_bytes("<robot/>".encode("utf-16-be"))
+    assert not is_bt_file(p)
+
+
+def test_exclude_globs(tmp_path: Path) -> None:
+    base = tmp_path.as_posix()
+    globs = (anchor(tmp_path, "generated"), anchor(tmp_path, "test/**/*.xml"))
+    assert excluded(Path(f"{base}/generated"), globs)
+    assert excluded(Path(f"{base}/a/b/generated"), globs)
+    assert not excluded(Path(f"{base}/generated_not"), globs)
+    assert excluded(Path(f"{base}/test/x.xml"), globs)
+    assert excluded(Path(f"{base}/test/a/b/x.xml"), globs)
+    assert not excluded(Path(f"{base}/other/test/x.xml"), globs)
+    assert not excluded(Path(f"{base}/test/x.xmlx"), globs)
