@@ -24,6 +24,9 @@ Directives (lines of their own): ``<!-- check: max-diagnostics=N -->`` limits th
 as the server and the check command do at their maximum; ``<!-- check:
 max-document-bytes=N -->`` analyses the text as the server does a document above its
 size limit.
+
+A ``bt-lsp.toml`` (or ``pyproject.toml``) among the files is the configuration of the
+others; its annotations are its ``config-error``, if it has one.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from pathlib import Path
 from bt_lsp.ide.fix import Fix
 from bt_lsp.ide.name_fixes import fixes_for_name
 from bt_lsp.ide.semantic_fixes import fixes_for_rule
+from bt_lsp.project.config import CONFIG_NAMES, ConfigError
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.analysis import analyze
@@ -176,10 +180,22 @@ def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[E
         ws = Workspace([root], Settings())
         for f in files:
             path = normalize(root / f.path)
+            if path.name in CONFIG_NAMES:  # a configuration file: its error, if any
+                out.append((f, _config_found(ws, path, f.text.replace("\n", newline))))
+                continue
             opened = ws.document(path)
             assert opened is not None, f.path
             out.append((f, found(opened, ws.diagnostics(path, opened), str(root))))
     return out
+
+
+def _config_found(ws: Workspace, path: Path, text: str) -> list[Expected]:
+    """The ``config-error`` of a configuration file, where the server shows it."""
+    loaded = ws.configs.load(path)
+    if not isinstance(loaded, ConfigError):
+        return []
+    row, start, end = loaded.span(text)
+    return [Expected((row, start), (row, end), "error", "config-error", loaded.message)]
 
 
 def check(fixture: str) -> None:

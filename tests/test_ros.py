@@ -133,3 +133,14 @@ def test_configured_packages_come_first(tmp_path: Path) -> None:
     f = write(tmp_path / "t.xml", MAIN)
     [inc] = ws.includes(f)
     assert inc.target == tmp_path / "elsewhere" / "trees" / "sub.xml"
+
+
+def test_a_new_catalog_is_heard(tmp_path: Path) -> None:
+    src = tmp_path / "ws" / "src"
+    write(src / "app" / "package.xml", manifest("app"))
+    tree = write(src / "app" / "trees" / "t.xml", MAIN)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[])
+    assert ws.catalog_files(tree) == []
+    cat = write(src / "app" / "nodes.xml", CATALOG)
+    ws.file_changed(cat)
+    assert ws.catalog_files(tree) == [cat]

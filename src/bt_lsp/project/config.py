@@ -54,6 +54,18 @@ class ConfigError(Exception):
         self.column = column
         self.message = message
 
+    def span(self, text: str) -> tuple[int, int, int]:
+        """Where the error shows in the file's ``text``: its 0-based line and the columns
+        (code points) from the error to the end of that line, at least one character when
+        the line has one."""
+        lines = [line.removesuffix("\r") for line in text.split("\n")]  # as TOML counts
+        row = min(max(self.line - 1, 0), len(lines) - 1)
+        length = len(lines[row])
+        start = min(max(self.column - 1, 0), length)
+        if start == length and start > 0:
+            start -= 1
+        return row, start, length
+
 
 @dataclass(frozen=True, slots=True)
 class Layer:

@@ -96,6 +96,12 @@ class RosIndex:
         self._catalogs[folder] = result
         return result
 
+    def file_changed(self, path: Path) -> None:
+        """An XML file changed: forget the catalogs of the package folders it may be in
+        (the top folder or one below)."""
+        for folder in (path.parent, path.parent.parent):
+            self._catalogs.pop(folder, None)
+
     def changed(self) -> None:
         self._installed = None
         self._catalogs.clear()

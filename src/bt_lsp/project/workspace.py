@@ -204,7 +204,7 @@ class Workspace:
             self._scoped.clear()
             self.ros.changed()
         elif p.suffix == ".xml":
-            self.ros.changed()  # it may be a catalog
+            self.ros.file_changed(p)  # it may be a catalog
         if self.cpp is not None:
             self.cpp.file_changed(p)
         self.generation += 1

@@ -78,15 +78,11 @@ def _diagnostic(ls: BtServer, uri: str, e: ConfigError) -> types.Diagnostic:
         except OSError:
             text = ""
     lines = LineIndex(text)
-    line = min(max(e.line - 1, 0), max(lines.line_count - 1, 0))
-    start_offset = lines.line_start(line)
-    end_offset = lines.line_end(line)
-    start = min(start_offset + max(e.column - 1, 0), end_offset)
-    if start == end_offset and start > start_offset:
-        start -= 1  # at the end of a line: the last character, so that it shows
+    row, start_col, end_col = e.span(text)
+    line_start = lines.line_start(row) if row < lines.line_count else len(text)
     enc = ls.encoding
-    a = lines.position(start, enc)
-    b = lines.position(max(end_offset, start), enc)
+    a = lines.position(min(line_start + start_col, len(text)), enc)
+    b = lines.position(min(line_start + end_col, len(text)), enc)
     return types.Diagnostic(
         range=types.Range(types.Position(*a), types.Position(*b)),
         message=f"bt-lsp configuration: {e.message}",
