@@ -48,4 +48,5 @@ def draw(
         ports=ports,
         expand_subtrees=expand_subtrees,
         resolve=workspace_resolver(doc.model, ctx, others),
+        text_length=len(doc.text),
     )
