@@ -31,6 +31,9 @@ from bt_lsp.syntax.scanner import Attr, Kind, Token
 
 __all__ = ["Completions", "Item", "ItemKind", "complete", "ports_markdown"]
 
+# Models learned from C++ (bt_lsp.project.cpp_models) are declared in a C++ file.
+_CPP = (".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp")
+
 
 class ItemKind(StrEnum):
     ELEMENT = "element"  # a structural element (BehaviorTree, include, input_port, ...)
@@ -272,8 +275,12 @@ def _node_items(ctx: Context, bare: bool, current_tree: str | None) -> Iterable[
         yield Item(
             mid,
             ItemKind.NODE,
-            detail=f"{decl.category} (TreeNodesModel)",
-            documentation=f"{decl.category} declared in the TreeNodesModel of {where}.\n\n"
+            detail=f"{decl.category} ({'C++' if where.endswith(_CPP) else 'TreeNodesModel'})",
+            documentation=(
+                f"{decl.category} registered in the C++ of {where}.\n\n"
+                if where.endswith(_CPP)
+                else f"{decl.category} declared in the TreeNodesModel of {where}.\n\n"
+            )
             + ports_markdown(decl.ports),
             insert=plain if bare else mid,
             snippet=snip if bare else None,

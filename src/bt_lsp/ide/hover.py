@@ -14,6 +14,8 @@ from bt_lsp.rules.names import RULES
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import DECLARING_ROLES, NameRef, Role
 
+_CPP_SUFFIXES = (".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp")
+
 
 @dataclass(frozen=True, slots=True)
 class HoverText:
@@ -86,7 +88,9 @@ def _node_info(ref: NameRef, ctx: Context | None) -> list[str]:
     where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
     return [
         "",
-        f"{decl.category} declared in the TreeNodesModel of {where}.",
+        f"{decl.category} registered in the C++ of {where}."
+        if where.endswith(_CPP_SUFFIXES)  # learned from C++ (the server says where)
+        else f"{decl.category} declared in the TreeNodesModel of {where}.",
         "",
         *_ports_table(decl.ports),
     ]
