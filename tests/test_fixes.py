@@ -428,5 +428,17 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
     assert apply_edits(tree.text, fix.other_edits["/ws/sub.xml"]) == tree.text.replace(
         "{bad.port}", "{bad_port}"
     )
-    # fix_all changes its own document only.
-    assert fix_all(models, own_diagnostics(models)).edits == list(fix.edits)
+    # fix_all makes the same edits, in both documents.
+    both = fix_all(models, own_diagnostics(models), {"/ws/sub.xml": tree})
+    assert both.edits == list(fix.edits)
+    assert both.other_edits == fix.other_edits
+    # Without the document defining the tree, the port is left as it is: renaming the
+    # declaration alone would disconnect it from the tree's key.
+    alone = fix_all(models, own_diagnostics(models))
+    assert alone.edits == [] and alone.other_edits == {}
+    assert alone.notes == [
+        "left 'bad.port' as it is: the tree 'Sub' is not defined in the workspace (it comes "
+        "from elsewhere, such as an installed package, and keeps its ID there); rename it "
+        "where it is defined first, then this reference"
+    ]
+    assert fixes_for(models, _diag_at(models, "bad.port")) == []

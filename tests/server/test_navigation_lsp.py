@@ -25,6 +25,8 @@ from pygls.uris import from_fs_path, to_fs_path
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
+from tests.server.conftest import plain
+
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 # The built-in catalog is written to the cache folder: keep it out of the user's.
@@ -201,9 +203,7 @@ def edits_by_uri(edit: types.WorkspaceEdit) -> dict[str, list[types.TextEdit]]:
         out.setdefault(uri, []).extend(edits)
     for dc in edit.document_changes or []:
         assert isinstance(dc, types.TextDocumentEdit)
-        out.setdefault(dc.text_document.uri, []).extend(
-            e for e in dc.edits if isinstance(e, types.TextEdit)
-        )
+        out.setdefault(dc.text_document.uri, []).extend(plain(e) for e in dc.edits)
     return out
 
 

@@ -40,7 +40,7 @@ from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
+from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
@@ -84,8 +84,14 @@ def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
     return out
 
 
-def check_file(path: str, options: Options, workspace: Workspace | None = None) -> FileResult:
-    """Read, analyze and (with ``options.fix``) fix one file, in ``workspace`` if given."""
+def check_file(
+    path: str,
+    options: Options,
+    workspace: Workspace | None = None,
+    before: Mapping[Path, Document] | None = None,
+) -> FileResult:
+    """Read, analyze and (with ``options.fix``) fix one file, in ``workspace`` if given;
+    ``before`` are the workspace's documents before any file was fixed."""
     result = FileResult(path)
     try:
         decoded = read_text(path, options.max_bytes)
@@ -102,7 +108,9 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
         raw = analyze(doc, workspace)
         diags = with_severities(raw, options.severities)
         if options.fix:
-            outcome = fix_document(decoded, doc, raw, diags, workspace)
+            me = normalize(path)
+            others = {str(p): d for p, d in (before or {}).items() if p != me}
+            outcome = fix_document(decoded, doc, raw, diags, workspace, others)
             if isinstance(outcome, str):
                 result.not_fixed = outcome
             elif outcome is not None:
@@ -212,9 +220,11 @@ def run(
     if options.cpp:
         workspace.cpp = CppModels(workspace.roots, workspace.packages)
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
+    # What fixes see of the other files: the workspace before any file is fixed.
+    before = dict(workspace.bt_documents()) if options.fix else None
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        r = check_file(path, options, workspace)
+        r = check_file(path, options, workspace, before)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from bt_lsp.cli.results import analyze
@@ -74,10 +74,13 @@ def fix_document(
     raw: list[Diagnostic],
     diags: list[Diagnostic],
     workspace: Workspace | None = None,
+    others: Mapping[str, Document] | None = None,
 ) -> Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
-    fix)."""
-    fix_all = fixes.fix_all(doc, diags)
+    fix).  ``others`` are the other files of the workspace as they were before any was
+    fixed: a name is renamed only with its target, and every file's fixes give a symbol
+    the same new name."""
+    fix_all = fixes.fix_all(doc, diags, others)
     edits = fix_all.edits
     if not edits:
         return None

@@ -61,6 +61,7 @@ class BtServer(LanguageServer):
         self.refresh_support = False
         self.resolve_edits = False
         self.versioned_edits = False
+        self.annotated_edits = False  # change annotations (confirm edits of other files)
         self.watch_files = False
         self.generation = 0  # bumped when settings change; part of every resultId
         self.project = Workspace()
@@ -289,6 +290,9 @@ def create_server() -> BtServer:
         ls.configuration_support = bool(ws and ws.configuration)
         ls.refresh_support = bool(ws and ws.diagnostics and ws.diagnostics.refresh_support)
         ls.versioned_edits = bool(ws and ws.workspace_edit and ws.workspace_edit.document_changes)
+        ls.annotated_edits = ls.versioned_edits and bool(
+            ws and ws.workspace_edit and ws.workspace_edit.change_annotation_support
+        )
         ca = td.code_action if td else None
         ls.resolve_edits = bool(
             ca and ca.resolve_support and "edit" in ca.resolve_support.properties

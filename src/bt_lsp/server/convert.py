@@ -44,22 +44,55 @@ def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit
     return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)
 
 
+# The change annotation of the edits a fix or rename makes in files other than the one the
+# user is in: clients that support annotations (VS Code) show those edits in a preview to be
+# confirmed before they write the other files.
+OTHER_FILES = "bt-lsp.other-files"
+
+
 def workspace_edit(
-    per_uri: list[tuple[str, int | None, list[types.TextEdit]]], versioned: bool
+    per_uri: list[tuple[str, int | None, list[types.TextEdit]]],
+    versioned: bool,
+    annotated: bool = False,
 ) -> types.WorkspaceEdit:
     """Edits to several documents as one WorkspaceEdit: versioned ``documentChanges`` when
     the client supports them (it then refuses edits to a document that has moved on),
-    else plain ``changes``."""
+    else plain ``changes``.  The first entry is the document the user is in; with
+    ``annotated`` (the client supports change annotations) the edits of the other
+    documents carry an annotation that needs confirmation."""
     if versioned:
-        return types.WorkspaceEdit(
-            document_changes=[
+        changes: list[types.TextDocumentEdit] = []
+        others = False
+        for i, (uri, version, lsp_edits) in enumerate(per_uri):
+            edits: list[types.TextEdit | types.AnnotatedTextEdit | types.SnippetTextEdit]
+            if annotated and i > 0 and lsp_edits:
+                others = True
+                edits = [
+                    types.AnnotatedTextEdit(
+                        range=e.range, new_text=e.new_text, annotation_id=OTHER_FILES
+                    )
+                    for e in lsp_edits
+                ]
+            else:
+                edits = list(lsp_edits)
+            changes.append(
                 types.TextDocumentEdit(
                     text_document=types.OptionalVersionedTextDocumentIdentifier(
                         uri=uri, version=version
                     ),
-                    edits=list(lsp_edits),
+                    edits=edits,
                 )
-                for uri, version, lsp_edits in per_uri
-            ]
+            )
+        return types.WorkspaceEdit(
+            document_changes=list(changes),
+            change_annotations={
+                OTHER_FILES: types.ChangeAnnotation(
+                    label="Other files",
+                    needs_confirmation=True,
+                    description="bt-lsp renames the same name in files other than this one",
+                )
+            }
+            if others
+            else None,
         )
     return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})

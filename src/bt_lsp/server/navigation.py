@@ -145,7 +145,7 @@ def rename_edit(
         per_uri.append(
             (src.uri, src.version, [to_text_edit(src.doc.lines, e, enc) for e in file_edits])
         )
-    return workspace_edit(per_uri, ls.versioned_edits)
+    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
 
 
 def _document_symbol(lines: LineIndex, s: DocSymbol, enc: Encoding) -> types.DocumentSymbol:
