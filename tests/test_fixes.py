@@ -367,15 +367,15 @@ def test_hover_tells_what_the_fix_renames_and_leaves() -> None:
     doc = Document(AUTOREMAP)
     found = hover_at(doc, _diag_at(doc, "bad.port", 2).start)
     assert found is not None
-    assert "Suggested replacement: `bad_port` (the quick fix renames 1 place)" in found.markdown
+    assert "Suggested replacement: `bad_port` (the quick fix renames 1 place)" in found.text
     assert (
         f"The quick fix leaves the key 'bad.port' in tree 'Sub' as it is: {AUTOREMAP_WHY}"
-        in found.markdown
+        in found.text
     )
     doc = Document(PORTS)
     found = hover_at(doc, _diag_at(doc, 'name="bad.port"').start + len('name="'))
     assert found is not None
-    assert "Suggested replacement: `bad_port` (the quick fix renames 4 places)" in found.markdown
+    assert "Suggested replacement: `bad_port` (the quick fix renames 4 places)" in found.text
 
 
 def test_a_new_name_that_would_merge_two_keys_is_passed_over() -> None:

@@ -33,7 +33,20 @@ from tests.test_fixes_elsewhere import FIXED, HELPER, OBJECTIVE, OUTSIDE_TREE
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 
-@pytest_lsp.fixture(config=CONFIG, scope="module", params=["visual-studio-code", "neovim@v0.11.0"])
+def _capabilities(spec: str) -> types.ClientCapabilities:
+    """The client's capabilities; ``eglot-plain`` is Emacs's eglot without markdown-mode,
+    which asks for plain-text hovers only."""
+    if spec != "eglot-plain":
+        return pytest_lsp.client_capabilities(spec)
+    caps = pytest_lsp.client_capabilities("emacs")
+    assert caps.text_document is not None and caps.text_document.hover is not None
+    caps.text_document.hover.content_format = [types.MarkupKind.PlainText]
+    return caps
+
+
+@pytest_lsp.fixture(
+    config=CONFIG, scope="module", params=["visual-studio-code", "neovim@v0.11.0", "eglot-plain"]
+)
 async def lsp(lsp_client: NavClient, request: pytest.FixtureRequest) -> AsyncIterator[None]:
     ws = Path(tempfile.mkdtemp(prefix="bt-lsp-elsewhere-ws-")).resolve()
     (ws / "pick.xml").write_text(OBJECTIVE, encoding="utf-8")
@@ -44,7 +57,7 @@ async def lsp(lsp_client: NavClient, request: pytest.FixtureRequest) -> AsyncIte
     assert folder_uri is not None
     lsp_client.init_result = await lsp_client.initialize_session(
         types.InitializeParams(
-            capabilities=pytest_lsp.client_capabilities(request.param),
+            capabilities=_capabilities(request.param),
             workspace_folders=[types.WorkspaceFolder(uri=folder_uri, name="ws")],
             root_uri=folder_uri,
             initialization_options={"debounceMs": 0},
@@ -128,9 +141,14 @@ async def test_edits_of_other_files_need_confirmation(lsp: NavClient) -> None:
             for e in dc.edits:
                 if isinstance(e, types.AnnotatedTextEdit):
                     assert e.annotation_id in annotations
-    else:  # no annotation support: plain edits
+    elif lsp.spec == "neovim@v0.11.0":  # no documentChanges: plain edits
         assert fix.edit.change_annotations is None
         assert set((fix.edit.changes or {}).keys()) == {pick, helper}
+    else:  # documentChanges without annotation support: plain edits
+        assert fix.edit.change_annotations is None
+        for dc in fix.edit.document_changes or []:
+            assert isinstance(dc, types.TextDocumentEdit)
+            assert all(type(e) is types.TextEdit for e in dc.edits)
 
 
 async def test_fix_all_keeps_calls_of_trees_defined_elsewhere(lsp: NavClient) -> None:
@@ -142,3 +160,36 @@ async def test_fix_all_keeps_calls_of_trees_defined_elsewhere(lsp: NavClient) ->
     assert apply(lsp, HELPER, by_uri[helper]) == HELPER.replace(
         "Pick Object Helper", "Pick_Object_Helper"
     )
+
+
+async def _hover(lsp: NavClient, needle: str) -> types.MarkupContent:
+    got = await lsp.text_document_hover_async(
+        types.HoverParams(
+            text_document=ident(lsp.uri("pick.xml")),
+            position=doc_pos(lsp, OBJECTIVE, needle, into=2),
+        )
+    )
+    assert got is not None and isinstance(got.contents, types.MarkupContent)
+    plain = lsp.spec == "eglot-plain"
+    kind = types.MarkupKind.PlainText if plain else types.MarkupKind.Markdown
+    assert got.contents.kind == kind
+    if plain:
+        assert "**" not in got.contents.value and "`" not in got.contents.value
+    return got.contents
+
+
+async def test_hover_counts_the_places_the_quick_fix_renames(lsp: NavClient) -> None:
+    (fix, *_) = await _actions(lsp, "Pick Object Helper")
+    assert fix.title.endswith("(2 places, 1 other file)")
+    hover = await _hover(lsp, "Pick Object Helper")
+    new = "'Pick_Object_Helper'" if lsp.spec == "eglot-plain" else "`Pick_Object_Helper`"
+    assert f"Suggested replacement: {new} (the quick fix renames 2 places, 1 other file)" in (
+        hover.value
+    )
+
+
+async def test_hover_says_why_a_call_of_a_tree_defined_elsewhere_has_no_fix(
+    lsp: NavClient,
+) -> None:
+    hover = await _hover(lsp, "Open Right Gripper")
+    assert f"No quick fix renames it: {OUTSIDE_TREE}." in hover.value

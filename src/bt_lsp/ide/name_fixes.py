@@ -79,12 +79,18 @@ class Renaming:
     caution: str | None = None  # what must be renamed too, outside the workspace
 
     @property
-    def title(self) -> str:
+    def where(self) -> str:
+        """How many places the renaming changes: ``"5 places, 4 other files"``."""
         places = self.plan.places
         where = "1 place" if places == 1 else f"{places} places"
         n = len(self.plan.other_edits)
         if n:
             where += f", {n} other file{'s' if n > 1 else ''}"
+        return where
+
+    @property
+    def title(self) -> str:
+        where = self.where
         old = shown(self.old)
         title = (
             NAME_FIX_TITLES["clear"].format(old=old, where=where)
