@@ -114,9 +114,11 @@ def register(server: BtServer) -> None:
                 for i, fix in enumerate(_all_fixes(ls, od, d)):
                     fixed = same_fix.get((d.start, d.end, fix.title))
                     if fixed is not None:
-                        fixed.append(to_diagnostic(lines, d, enc))
+                        fixed.append(to_diagnostic(lines, d, enc, ls.code_descriptions))
                         continue
-                    fixed = same_fix[(d.start, d.end, fix.title)] = [to_diagnostic(lines, d, enc)]
+                    fixed = same_fix[(d.start, d.end, fix.title)] = [
+                        to_diagnostic(lines, d, enc, ls.code_descriptions)
+                    ]
                     action = types.CodeAction(
                         title=fix.title,
                         kind=types.CodeActionKind.QuickFix,

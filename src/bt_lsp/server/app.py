@@ -62,6 +62,8 @@ class BtServer(LanguageServer):
         self.resolve_edits = False
         self.versioned_edits = False
         self.annotated_edits = False  # change annotations (confirm edits of other files)
+        self.code_descriptions = False  # the client shows a diagnostic's codeDescription
+        self._fetching: asyncio.Future[None] | None = None  # a workspace/configuration
         self.watch_files = False
         self.generation = 0  # bumped when settings change; part of every resultId
         self.project = Workspace()
@@ -102,7 +104,8 @@ class BtServer(LanguageServer):
 
     def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
         enc = self.encoding
-        return [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
+        described = self.code_descriptions
+        return [to_diagnostic(od.doc.lines, d, enc, described) for d in self.diagnostics_of(od)]
 
     # -- publishing -------------------------------------------------------------------------
 
@@ -125,7 +128,9 @@ class BtServer(LanguageServer):
                 uri=uri,
                 diagnostics=[
                     diagnostic_at(
-                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])), d
+                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
+                        d,
+                        self.code_descriptions,
                     )
                     for d in found
                 ],
@@ -254,8 +259,23 @@ class BtServer(LanguageServer):
         return self._settings_stamps
 
     async def fetch_settings(self) -> None:
+        """Ask for the ``btLsp`` section.  While a request is on its way, a second one is
+        not sent (VS Code sends a didChangeConfiguration right after ``initialized``): the
+        answer to the first one is as new as the change, since the client sent the change
+        before answering it."""
         if not self.configuration_support:
             return
+        pending = self._fetching
+        if pending is not None and not pending.done():
+            await asyncio.shield(pending)
+            return
+        self._fetching = asyncio.get_running_loop().create_future()
+        try:
+            await self._fetch_settings()
+        finally:
+            self._fetching.set_result(None)
+
+    async def _fetch_settings(self) -> None:
         issued = self._next_settings_stamp()
         try:
             result = await self.workspace_configuration_async(
@@ -292,6 +312,13 @@ def create_server() -> BtServer:
         ls.versioned_edits = bool(ws and ws.workspace_edit and ws.workspace_edit.document_changes)
         ls.annotated_edits = ls.versioned_edits and bool(
             ws and ws.workspace_edit and ws.workspace_edit.change_annotation_support
+        )
+        ls.code_descriptions = bool(
+            td
+            and (
+                (td.publish_diagnostics and td.publish_diagnostics.code_description_support)
+                or (td.diagnostic and td.diagnostic.code_description_support)
+            )
         )
         ca = td.code_action if td else None
         ls.resolve_edits = bool(

@@ -22,13 +22,17 @@ def to_offsets(lines: LineIndex, rng: types.Range, enc: Encoding) -> tuple[int, 
     return (start, end) if start <= end else (end, start)
 
 
-def to_diagnostic(lines: LineIndex, d: Diagnostic, enc: Encoding) -> types.Diagnostic:
-    return diagnostic_at(to_range(lines, d.start, d.end, enc), d)
+def to_diagnostic(
+    lines: LineIndex, d: Diagnostic, enc: Encoding, described: bool = True
+) -> types.Diagnostic:
+    return diagnostic_at(to_range(lines, d.start, d.end, enc), d, described)
 
 
-def diagnostic_at(rng: types.Range, d: Diagnostic) -> types.Diagnostic:
-    """``d`` as an LSP diagnostic over ``rng`` (its offsets converted by the caller)."""
-    info = CODES.get(d.code)
+def diagnostic_at(rng: types.Range, d: Diagnostic, described: bool = True) -> types.Diagnostic:
+    """``d`` as an LSP diagnostic over ``rng`` (its offsets converted by the caller), with
+    a link to its code's documentation when ``described`` (the client declared
+    ``codeDescriptionSupport``)."""
+    info = CODES.get(d.code) if described else None
     return types.Diagnostic(
         range=rng,
         message=d.message,
