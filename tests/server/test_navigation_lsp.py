@@ -689,10 +689,10 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         assert move.text_edit.range == rng(lsp, C_XML, (at, at))
         if lsp.snippets:
             assert move.insert_text_format == types.InsertTextFormat.Snippet
-            assert move.text_edit.new_text == 'MoveBase goal="$1"/>'
-        else:
+            assert move.text_edit.new_text == 'MoveBase goal="${1}"/>'
+        else:  # no tab stops, so no empty value: the missing port is then reported
             assert move.insert_text_format == types.InsertTextFormat.PlainText
-            assert move.text_edit.new_text == 'MoveBase goal=""/>'
+            assert move.text_edit.new_text == "MoveBase/>"
         assert {"Sequence", "Fallback", "SubTree", "SubTree Dock", "SubTree Main"} <= set(items)
         doc = move.documentation
         if lsp.markdown:
@@ -705,6 +705,9 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         assert {"goal", "speed", "name", "_skipIf", "_onSuccess"} <= set(items)
         assert items["speed"].detail == "input port: double"
+        speed = items["speed"].text_edit
+        assert isinstance(speed, types.TextEdit)  # its default, to accept or overwrite
+        assert speed.new_text == ('speed="${1:0.5}"' if lsp.snippets else 'speed="0.5"')
         # Tree IDs in SubTree ID (not the tree itself) and main_tree_to_execute.
         at = C_XML.index('<SubTree ID=""') + 13
         got = await complete_at(lsp, uri, C_XML, at)
@@ -717,10 +720,17 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         assert set(items) == {"here"}
         assert items["here"].text_edit.new_text == "here}"  # type: ignore[union-attr]
-        # Between elements: nothing.
+        # Between elements, no '<' typed (Ctrl+Space on an empty line): the node types,
+        # each with its '<', inserted at the cursor.
         at = C_XML.index("      <\n")
-        got = await complete_at(lsp, uri, C_XML, at)
-        assert not got.items
+        items = by_label(await complete_at(lsp, uri, C_XML, at))
+        move = items["MoveBase"]
+        assert isinstance(move.text_edit, types.TextEdit)
+        assert move.text_edit.range == rng(lsp, C_XML, (at, at))
+        assert move.filter_text == "MoveBase"
+        expected = '<MoveBase goal="${1}"/>' if lsp.snippets else "<MoveBase/>"
+        assert move.text_edit.new_text == expected
+        assert {"Sequence", "Fallback", "SubTree Dock"} <= set(items)
     finally:
         close_doc(lsp, uri)
 
