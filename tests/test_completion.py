@@ -326,6 +326,10 @@ def test_a_word_typed_between_tags_is_replaced() -> None:
     text = DOC.format(here="").replace("<Sequence>\n", "<Sequence>⟦⟧‸")
     found, _, _ = run(text)  # right after a start tag's '>'
     assert "Fallback" in labels(found)
+    # Not in the indentation before a tag, where no new element goes.
+    text = here("").replace("      <MoveBase goal", "  ‸    <MoveBase goal")
+    at = text.index(CURSOR)
+    assert complete(Document(text.replace(CURSOR, "")), at) is None
 
 
 def test_between_tags_elsewhere_offers_what_fits_there() -> None:

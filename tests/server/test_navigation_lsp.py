@@ -720,9 +720,9 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         assert set(items) == {"here"}
         assert items["here"].text_edit.new_text == "here}"  # type: ignore[union-attr]
-        # Between elements, no '<' typed (Ctrl+Space on an empty line): the node types,
-        # each with its '<', inserted at the cursor.
-        at = C_XML.index("      <\n")
+        # Between elements, no '<' typed (Ctrl+Space at the end of a line): the node
+        # types, each with its '<', inserted at the cursor.
+        at = C_XML.index('<SubTree ID=""/>') + len('<SubTree ID=""/>')
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         move = items["MoveBase"]
         assert isinstance(move.text_edit, types.TextEdit)

@@ -18,6 +18,7 @@ and returns plain items with the span they replace (code-point offsets).  Contex
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -271,6 +272,15 @@ def _is_name_char(c: str) -> bool:
     return c.isalnum() or c in "_-.:" or ord(c) > 127
 
 
+def _at_line_end(text: str, offset: int) -> bool:
+    """Whether only white space follows ``offset`` on its line."""
+    m = _REST_OF_LINE_RE.match(text, offset)
+    return m is not None and (m.end() == len(text) or text[m.end()] in "\r\n")
+
+
+_REST_OF_LINE_RE = re.compile(r"[ \t]*")
+
+
 def _fits(doc: Document, ctx: Context, parent: int) -> bool:
     """Whether another element fits in the element ``parent``: not in a leaf node, a
     decorator that has its child, or a tree that has its one child."""
@@ -305,6 +315,8 @@ def _between_tags(doc: Document, ctx: Context, offset: int, text_start: int) -> 
         start -= 1
     if text[text_start:start].strip(" \t\r\n"):
         return None  # after text content (BT elements have none), not between tags
+    if start == offset and not _at_line_end(text, offset) and text[offset - 1] != ">":
+        return None  # in the indentation before a tag: the place of no new element
     model = doc.model
     parent = _innermost(model, offset)
     if parent < 0:
