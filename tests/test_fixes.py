@@ -441,4 +441,4 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
         "from elsewhere, such as an installed package, and keeps its ID there); rename it "
         "where it is defined first, then this reference"
     ]
-    assert fixes_for(models, _diag_at(models, "bad.port")) == []
+    assert fixes_for_name(models, _diag_at(models, "bad.port")) == []

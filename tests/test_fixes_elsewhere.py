@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from bt_lsp.cli.main import main
-from bt_lsp.ide.name_fixes import fix_all, fixes_for
-from bt_lsp.ide.navigation import RenameRefused, rename
+from bt_lsp.ide.name_fixes import fix_all, fixes_for_name
+from bt_lsp.ide.rename import RenameRefused, rename
 from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
@@ -70,9 +70,9 @@ def _docs() -> tuple[Document, dict[str, Document]]:
 
 def test_a_call_of_a_tree_defined_elsewhere_gets_no_fix() -> None:
     doc, others = _docs()
-    assert fixes_for(doc, _diag(doc, "Open Right Gripper"), others) == []
+    assert fixes_for_name(doc, _diag(doc, "Open Right Gripper"), others) == []
     # Nor does a port of that call: renaming it would disconnect it from the tree's port.
-    assert fixes_for(doc, _diag(doc, "target.pose"), others) == []
+    assert fixes_for_name(doc, _diag(doc, "target.pose"), others) == []
 
 
 def test_rename_refuses_a_call_of_a_tree_defined_elsewhere() -> None:
@@ -92,7 +92,7 @@ def test_rename_refuses_a_call_of_a_tree_defined_elsewhere() -> None:
 
 def test_a_tree_in_another_file_is_renamed_with_its_call() -> None:
     doc, others = _docs()
-    (fix, *_) = fixes_for(doc, _diag(doc, "Pick Object Helper"), others)
+    (fix, *_) = fixes_for_name(doc, _diag(doc, "Pick Object Helper"), others)
     assert fix.preferred
     assert fix.title == (
         "Rename 'Pick Object Helper' to 'Pick_Object_Helper' (2 places, 1 other file)"
@@ -101,12 +101,12 @@ def test_a_tree_in_another_file_is_renamed_with_its_call() -> None:
         "Pick Object Helper", "Pick_Object_Helper"
     )
     # Without the other file the tree is elsewhere: no fix.
-    assert fixes_for(doc, _diag(doc, "Pick Object Helper")) == []
+    assert fixes_for_name(doc, _diag(doc, "Pick Object Helper")) == []
 
 
 def test_a_node_type_registered_elsewhere_gets_no_preferred_fix() -> None:
     doc, others = _docs()
-    found = fixes_for(doc, _diag(doc, "Say.Hi"), others)
+    found = fixes_for_name(doc, _diag(doc, "Say.Hi"), others)
     assert found and not any(f.preferred for f in found)
     assert found[0].title == (
         "Rename 'Say.Hi' to 'Say_Hi' (1 place); the node type 'Say.Hi' is registered outside "
@@ -118,7 +118,7 @@ def test_a_node_type_registered_elsewhere_gets_no_preferred_fix() -> None:
         '<input_port name="text"/></Action></TreeNodesModel></root>',
         "/ws/models.xml",
     )
-    (fix, *_) = fixes_for(doc, _diag(doc, "Say.Hi"), {**others, "/ws/models.xml": models})
+    (fix, *_) = fixes_for_name(doc, _diag(doc, "Say.Hi"), {**others, "/ws/models.xml": models})
     assert fix.preferred
     assert fix.title == "Rename 'Say.Hi' to 'Say_Hi' (2 places, 1 other file)"
 
@@ -127,7 +127,7 @@ def test_a_port_of_a_node_type_registered_elsewhere_gets_no_preferred_fix() -> N
     doc = Document(
         '<root BTCPP_format="4"><BehaviorTree ID="T"><Spin spin.dist="1.57"/></BehaviorTree></root>'
     )
-    found = fixes_for(doc, _diag(doc, "spin.dist"))
+    found = fixes_for_name(doc, _diag(doc, "spin.dist"))
     assert found and not any(f.preferred for f in found)
     assert found[0].title.endswith(
         "; the port 'spin.dist' of the node type 'Spin' is registered outside the workspace: "
@@ -161,7 +161,7 @@ def test_an_empty_name_has_no_target_to_break() -> None:
         '<root BTCPP_format="4"><BehaviorTree ID="T"><SubTree ID=""/></BehaviorTree></root>'
     )
     # No tree can be defined under an empty ID, so no call that works can break.
-    (fix,) = fixes_for(doc, _diag(doc, 'ID=""'))
+    (fix,) = fixes_for_name(doc, _diag(doc, 'ID=""'))
     assert fix.preferred and fix.title == "Rename '' to 'Unnamed' (1 place)"
 
 

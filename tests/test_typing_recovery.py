@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.model import Zone
+from bt_lsp.syntax.elements import Zone
 
 OPEN_TREE = (
     '<root BTCPP_format="4" main_tree_to_execute="A">\n'

@@ -84,7 +84,7 @@ class Session:
         return await asyncio.wait_for(wait(), TIMEOUT)
 
     async def answer(self, msg_id: int) -> dict[str, Any]:
-        return await self.until(lambda: self.answers.get(msg_id))  # type: ignore[no-any-return]
+        return await self.until(lambda: self.answers.get(msg_id))
 
     async def close(self) -> str:
         """Shut down and exit; the server's stderr."""
@@ -135,10 +135,10 @@ async def _diagnostics(s: Session) -> list[dict[str, Any]]:
     def published() -> list[dict[str, Any]] | None:
         for n in reversed(s.notifications):
             if n["method"] == "textDocument/publishDiagnostics" and n["params"]["uri"] == URI:
-                return n["params"]["diagnostics"]  # type: ignore[no-any-return]
+                return n["params"]["diagnostics"]
         return None
 
-    return await s.until(published)  # type: ignore[no-any-return]
+    return await s.until(published)
 
 
 async def test_a_refused_rename_is_a_quiet_error_answer() -> None:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
 from bt_lsp.ide.name_edits import elsewhere, occurrences
 from bt_lsp.ide.name_fixes import preferred_renaming
-from bt_lsp.ide.navigation import ports_of
+from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import name_violations
