@@ -17,7 +17,7 @@ from bt_lsp.ide.places import Place
 from bt_lsp.ide.references import highlights, references
 from bt_lsp.ide.rename import RenameRefused, prepare_rename, rename
 from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
-from bt_lsp.project.workspace import Workspace, links, normalize
+from bt_lsp.project.index import ProjectIndex, links, normalize
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.diagnostics import own_diagnostics
@@ -180,7 +180,7 @@ def test_definition_across_files_prefers_the_include_closure(tmp_path: Path) -> 
         tmp_path / "a_other.xml",
         '<root BTCPP_format="4"><BehaviorTree ID="Dock"><Nav/></BehaviorTree></root>',
     )
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     doc = ws.document(main)
     assert doc is not None
     others = {str(p): d for p, d in ws.bt_documents() if p != main}

@@ -39,8 +39,8 @@ from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
 from bt_lsp.project.files import collect_files
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
@@ -87,10 +87,10 @@ def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
 def check_file(
     path: str,
     options: Options,
-    workspace: Workspace | None = None,
+    project: ProjectIndex | None = None,
     before: Mapping[Path, Document] | None = None,
 ) -> FileResult:
-    """Read, analyze and (with ``options.fix``) fix one file, in ``workspace`` if given;
+    """Read, analyze and (with ``options.fix``) fix one file, in ``project`` if given;
     ``before`` are the workspace's documents before any file was fixed."""
     result = FileResult(path)
     try:
@@ -105,20 +105,20 @@ def check_file(
             diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
             result.findings = findings_of(path, doc, diags)
             return result
-        raw = analyze(doc, workspace)
+        raw = analyze(doc, project)
         diags = with_severities(raw, options.severities)
         if options.fix:
             me = normalize(path)
             others = {str(p): d for p, d in (before or {}).items() if p != me}
-            outcome = fix_document(decoded, doc, raw, diags, workspace, others)
+            outcome = fix_document(decoded, doc, raw, diags, project, others)
             if isinstance(outcome, str):
                 result.not_fixed = outcome
             elif outcome is not None:
                 write_text_atomic(
                     path, outcome.doc.text, decoded.encoding, decoded.bom, expect=decoded.stamp
                 )
-                if workspace is not None:
-                    workspace.file_changed(path)
+                if project is not None:
+                    project.file_changed(path)
                 fixed_diags = with_severities(outcome.raw, options.severities)
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
                 result.notes = outcome.notes
@@ -214,17 +214,17 @@ def run(
 
     # The folders named on the command line are the workspace: includes resolve as
     # BehaviorTree.CPP resolves them, and every file's models and trees are known.
-    workspace = Workspace(
+    project = ProjectIndex(
         [p for p in paths if os.path.isdir(p)], Settings(max_document_bytes=options.max_bytes)
     )
     if options.cpp:
-        workspace.cpp = CppModels(workspace.roots, workspace.packages)
+        project.cpp = CppModels(project.roots, project.packages)
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     # What fixes see of the other files: the workspace before any file is fixed.
-    before = dict(workspace.bt_documents()) if options.fix else None
+    before = dict(project.bt_documents()) if options.fix else None
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        r = check_file(path, options, workspace, before)
+        r = check_file(path, options, project, before)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

@@ -139,9 +139,9 @@ def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
 
 
 # For each document, the sections of its last model and those of them with diagnostics.
-_NOISY: weakref.WeakKeyDictionary[Document, tuple[set[Section], set[Section]]] = (
-    weakref.WeakKeyDictionary()
-)
+_SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
+    Document, tuple[set[Section], set[Section]]
+] = weakref.WeakKeyDictionary()
 
 
 def _own(section: Section) -> list[Diagnostic]:
@@ -168,14 +168,14 @@ def compute(doc: Document) -> list[Diagnostic]:
         out = list(_own(model.head))
         sections = model.sections
         now = set(sections)
-        seen, noisy = _NOISY.get(doc, (set(), set()))
-        noisy = noisy & now
-        noisy.update(sec for sec in now - seen if _own(sec))
-        _NOISY[doc] = (now, noisy)
-        if noisy:
+        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc, (set(), set()))
+        with_diagnostics = with_diagnostics & now
+        with_diagnostics.update(sec for sec in now - seen if _own(sec))
+        _SECTIONS_WITH_DIAGNOSTICS[doc] = (now, with_diagnostics)
+        if with_diagnostics:
             origins = model.origins
             index = dict(zip(sections, range(len(sections)), strict=True))
-            for k in sorted(index[sec] for sec in noisy):
+            for k in sorted(index[sec] for sec in with_diagnostics):
                 o = origins[k]
                 out.extend(
                     Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)

@@ -16,7 +16,7 @@ from pygls.uris import from_fs_path
 
 from bt_lsp.ide import semantic_fixes
 from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for_name
-from bt_lsp.project.workspace import normalize
+from bt_lsp.project.index import normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit

@@ -18,8 +18,8 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
@@ -66,7 +66,7 @@ class BtServer(LanguageServer):
         self._fetching: asyncio.Future[None] | None = None  # a workspace/configuration
         self.watch_files = False
         self.generation = 0  # bumped when settings change; part of every resultId
-        self.project = Workspace()
+        self.project = ProjectIndex()
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
         self.cpp = CppService(self)
@@ -332,7 +332,7 @@ def create_server() -> BtServer:
         if not roots and params.root_uri:
             roots = [params.root_uri]
         paths = [p for p in (to_fs_path(r) for r in roots) if p]
-        ls.project = Workspace(paths, ls.settings)
+        ls.project = ProjectIndex(paths, ls.settings)
         ls.cpp.attach(params)
         ls.watch_files = bool(
             ws and ws.did_change_watched_files and ws.did_change_watched_files.dynamic_registration

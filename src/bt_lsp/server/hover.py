@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from lsprotocol import types
 
 from bt_lsp.ide.hover import hover_at
-from bt_lsp.project.workspace import normalize
+from bt_lsp.project.index import normalize
 from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, offset_of
 

@@ -26,7 +26,7 @@ from bt_lsp.ide.rename import RenameRefused
 from bt_lsp.ide.rename import prepare_rename as rename_target
 from bt_lsp.ide.rename import rename as plan_rename
 from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
-from bt_lsp.project.workspace import links
+from bt_lsp.project.index import links
 from bt_lsp.server.convert import to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,

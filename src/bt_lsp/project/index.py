@@ -101,7 +101,7 @@ def includes_of(path: Path, doc: Document, settings: Settings) -> list[Include]:
     return out
 
 
-class Workspace:
+class ProjectIndex:
     """The files of one or more folders.  ``settings`` are the editor's (or the defaults);
     each file's settings are those with its configuration file (:mod:`bt_lsp.project.config`)
     over them, and ``overrides`` (command-line flags) over both."""
