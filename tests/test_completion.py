@@ -9,9 +9,7 @@ from bt_lsp.ide.completion import Completions, Item, ItemKind, complete
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
-from tests.marks import unmark
-
-CURSOR = "‸"
+from tests.marks import CURSOR, cursor
 
 DOC = """\
 <root BTCPP_format="4">
@@ -41,9 +39,8 @@ DOC = """\
 
 
 def run(marked: str, ctx: Context | None = None) -> tuple[Completions, str, list[tuple[int, int]]]:
-    at = marked.index(CURSOR)
-    offset = at - sum(marked[:at].count(c) for c in "⟦⟧")
-    text, spans = unmark(marked.replace(CURSOR, ""))
+    text, offset, spans = cursor(marked)
+    assert offset >= 0, "no cursor"
     doc = Document(text)
     found = complete(doc, offset, ctx)
     assert found is not None, "no completion"

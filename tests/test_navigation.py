@@ -23,19 +23,7 @@ from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
-from tests.marks import unmark
-
-CURSOR = "‸"
-
-
-def parse(marked: str) -> tuple[str, int, list[tuple[int, int]]]:
-    """The text, the cursor offset (``‸``; -1 without one) and the marked spans."""
-    at = marked.find(CURSOR)
-    offset = -1
-    if at != -1:
-        offset = at - sum(marked[:at].count(c) for c in "⟦⟧")
-    text, spans = unmark(marked.replace(CURSOR, ""))
-    return text, offset, spans
+from tests.marks import cursor
 
 
 def spans_of(places: list[Place], path: str | None = None) -> list[tuple[int, int]]:
@@ -86,7 +74,7 @@ def doc_with(**marks: str) -> str:
 
 
 def at(marked: str) -> tuple[Document, int, list[tuple[int, int]]]:
-    text, offset, spans = parse(marked)
+    text, offset, spans = cursor(marked)
     return Document(text), offset, spans
 
 
