@@ -58,6 +58,7 @@ class Options:
     progress: bool = True
     max_bytes: int = DEFAULT_MAX_BYTES
     cpp: bool = True  # learn the node catalog from the C++ of the files' packages
+    models: tuple[str, ...] = ()  # authoritative node catalogs (--models)
 
 
 def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
@@ -215,7 +216,8 @@ def run(
     # The folders named on the command line are the workspace: includes resolve as
     # BehaviorTree.CPP resolves them, and every file's models and trees are known.
     project = ProjectIndex(
-        [p for p in paths if os.path.isdir(p)], Settings(max_document_bytes=options.max_bytes)
+        [p for p in paths if os.path.isdir(p)],
+        Settings(max_document_bytes=options.max_bytes, models=tuple(map(Path, options.models))),
     )
     if options.cpp:
         project.cpp = CppModels(project.roots, project.packages)

@@ -83,6 +83,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="override a code's severity: error, warning, information, hint or off "
         "(repeatable; several may be joined with commas)",
     )
+    check.add_argument(
+        "--models",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a node catalog (TreeNodesModel XML that BehaviorTree.CPP exported) to trust as "
+        "what the application registers (repeatable)",
+    )
     check.add_argument("--no-progress", action="store_true", help="never show the progress bar")
     check.add_argument(
         "--no-cpp",
@@ -168,6 +176,7 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         progress=not args.no_progress,
         max_bytes=args.max_file_size,
         cpp=not args.no_cpp,
+        models=tuple(os.path.abspath(m) for m in args.models),
     )
     return check.run(args.paths, options)
 
