@@ -78,7 +78,7 @@ def test_after_lt_in_a_tree_offers_node_types_with_required_ports() -> None:
     assert move.snippet == 'MoveBase goal="${1}" result="{${2:result}}"/>'
     # Plain text has no tab stops: no empty value (never right), only the output's key.
     assert move.insert == 'MoveBase result="{result}"/>'
-    assert "\n- `goal`: input, `Pose`, required; Where to go\n" in move.documentation
+    assert "\n- `goal`: input, `Pose`, no default; Where to go\n" in move.documentation
     seq = item(found, "Sequence")
     assert seq.snippet == "Sequence>\n\t$0\n</Sequence>"
     assert seq.detail == "Control (built-in)" and BUILTINS["Sequence"].description in (

@@ -783,7 +783,7 @@ async def test_hover_shows_the_ports_of_a_model_declared_in_another_file(lsp: Na
     md = got.contents.value
     assert "Action declared in the TreeNodesModel of" in md and "b.xml" in md
     # A list, one port a line, narrow enough for any hover (a wide table is cut off).
-    assert "\n- `goal`: input, `Pose`, required; Where to go\n" in md
+    assert "\n- `goal`: input, `Pose`, no default; Where to go\n" in md
     assert md.endswith("\n- `speed`: input, `double`, default `0.5`; How & fast")
     assert "|" not in md
     assert got.range == rng(lsp, A_XML, span(A_XML, "MoveBase"))

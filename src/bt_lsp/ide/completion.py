@@ -26,7 +26,7 @@ from enum import StrEnum
 from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_uses
 from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
-from bt_lsp.rules.context import Context
+from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
@@ -98,7 +98,7 @@ def ports_markdown(ports: Sequence[PortModel]) -> str:
         return "No ports."
     rows = ["Ports:", ""]
     for p in ports:
-        default = "required" if p.default is None else f"default {_code(p.default)}"
+        default = "no default" if p.default is None else f"default {_code(p.default)}"
         ptype = f", {_code(p.type)}" if p.type else ""
         desc = " ".join(p.description.split())
         rows.append(
@@ -108,7 +108,7 @@ def ports_markdown(ports: Sequence[PortModel]) -> str:
 
 
 def _port_doc(p: PortModel) -> str:
-    default = "required" if p.default is None else f"default {_code(p.default)}"
+    default = "no default" if p.default is None else f"default {_code(p.default)}"
     ptype = f", type {_code(p.type)}" if p.type else ""
     out = f"{p.direction} port{ptype}, {default}."
     return f"{out}\n\n{p.description}" if p.description else out
@@ -370,15 +370,18 @@ def _node_items(ctx: Context, bare: bool, current_tree: str | None) -> Iterable[
         leaf = decl.category in ("Action", "Condition")
         plain, snip = _with_ports(mid, decl.ports, leaf)
         where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
+        cpp = where.endswith(_CPP)
+        origin = "C++" if cpp else ("node catalog" if decl.authoritative else "TreeNodesModel")
         yield Item(
             mid,
             ItemKind.NODE,
-            detail=f"{decl.category} ({'C++' if where.endswith(_CPP) else 'TreeNodesModel'})",
+            detail=f"{decl.category} ({origin})",
             documentation=(
                 f"{decl.category} registered in the C++ of {where}.\n\n"
-                if where.endswith(_CPP)
+                if cpp
                 else f"{decl.category} declared in the TreeNodesModel of {where}.\n\n"
             )
+            + f"Model from {source_label(decl.source)}.\n\n"
             + ports_markdown(decl.ports),
             insert=plain if bare else mid,
             snippet=snip if bare else None,

@@ -16,7 +16,7 @@ from bt_lsp.ide.name_edits import elsewhere, occurrences
 from bt_lsp.ide.name_fixes import preferred_renaming
 from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
-from bt_lsp.rules.context import Context
+from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.diagnostics import name_violations
 from bt_lsp.rules.names import RULES
 from bt_lsp.syntax.document import Document
@@ -101,7 +101,7 @@ def _what(w: _Writer, ref: NameRef) -> str:
 
 
 def _port_item(w: _Writer, p: PortModel) -> str:
-    default = "required" if p.default is None else f"default {w.code(p.default)}"
+    default = "no default" if p.default is None else f"default {w.code(p.default)}"
     item = f"{w.code(p.name)}: {p.direction}, {w.code(p.type)}, {default}"
     desc = w.prose(" ".join(p.description.split()))
     return f"{item}; {desc}" if desc else item
@@ -136,6 +136,7 @@ def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
         if where.endswith(_CPP_SUFFIXES)  # learned from C++ (the server says where)
         else f"{decl.category} declared in the TreeNodesModel of {where}."
     )
+    w.para(f"Model from {source_label(decl.source)}.")
     _ports(w, decl.ports)
 
 
@@ -151,7 +152,7 @@ def _port_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
         port = decl.port(sym[3]) if decl is not None else None
     if port is None:
         return
-    default = "required" if port.default is None else f"default {w.code(port.default)}"
+    default = "no default" if port.default is None else f"default {w.code(port.default)}"
     w.para(f"{port.direction} port, type {w.code(port.type)}, {default}.")
     if port.description:
         w.para(w.prose(port.description))

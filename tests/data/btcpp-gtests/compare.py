@@ -41,6 +41,7 @@ import subprocess
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -48,7 +49,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 EMPTY_CATALOG = '<root BTCPP_format="4">\n  <TreeNodesModel/>\n</root>\n'
 
 
-def run_case(exe: str, folder: str, models: str | None = None) -> list[dict] | str:
+def run_case(exe: str, folder: str, models: str | None = None) -> list[dict[str, Any]] | str:
     """bt-lsp's diagnostics for one case folder, or a string saying why there are none.
     ``models`` is the catalog to give a case that has no models.xml."""
     argv = [*shlex.split(exe), "check", folder, "--format", "json", "--no-progress"]
@@ -73,7 +74,7 @@ def run_case(exe: str, folder: str, models: str | None = None) -> list[dict] | s
     return diags
 
 
-def describe(d: dict, folder: str) -> str:
+def describe(d: dict[str, Any], folder: str) -> str:
     rel = os.path.relpath(d.get("path", "?"), folder)
     msg = " ".join(str(d.get("message", "")).split())
     if len(msg) > 140:

@@ -49,8 +49,10 @@ class Resolved:
     """The model of a node type as the checks need it.
 
     ``origin`` says where it comes from: a built-in of BehaviorTree.CPP (exact), a custom
-    ``<TreeNodesModel>`` entry (what the author declared; BehaviorTree.CPP itself reads the
-    C++ registration), or the ``<SubTree>`` model of a tree.
+    ``<TreeNodesModel>`` entry, or the ``<SubTree>`` model of a tree.  A custom entry is
+    exact when its source is authoritative (a catalog of what BehaviorTree.CPP registers,
+    ``decl``'s source), else it is what an author declared while BehaviorTree.CPP itself
+    reads the C++ registration.
     """
 
     id: str
@@ -60,11 +62,12 @@ class Resolved:
     min_children: int
     max_children: int | None
     required: tuple[str, ...] = ()  # ports that must be given (see ports.py)
+    authoritative: bool = False  # a custom model from an authoritative source
 
     @property
     def exact(self) -> bool:
         """Whether BehaviorTree.CPP is known to use exactly this model."""
-        return self.origin != "custom"
+        return self.origin != "custom" or self.authoritative
 
 
 def resolve_builtin(type_id: str) -> Resolved | None:
@@ -152,7 +155,14 @@ class State:
                 p.name for p in decl.ports if p.default is None and p.direction != "output"
             )
             res = Resolved(
-                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
+                decl.id,
+                "custom",
+                decl.category,
+                {p.name: p for p in decl.ports},
+                lo,
+                hi,
+                required,
+                decl.authoritative,
             )
             self.made["model", type_id] = (decl, res)
         self._types[type_id] = res
