@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import TYPE_CHECKING, Final, Literal
 
-from bt_lsp.rules.builtins import BUILTINS, Category, PortModel
+from bt_lsp.rules.builtins import BUILTINS, Category, NodeModel, PortModel
+from bt_lsp.rules.builtins_v3 import V3_BUILTINS, V3_OPTIONAL_PORTS
 from bt_lsp.rules.codes import BT, FixData, Severity, define, defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -90,6 +91,22 @@ _BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
 }
 
 
+def _resolve_v3(m: NodeModel) -> Resolved:
+    required = tuple(
+        p.name
+        for p in m.ports
+        if p.default is None and p.direction != "output" and (m.id, p.name) not in V3_OPTIONAL_PORTS
+    )
+    ports = {p.name: p for p in m.ports}
+    return Resolved(m.id, "builtin", m.category, ports, m.min_children, m.max_children, required)
+
+
+#: The built-ins of a BehaviorTree.CPP 3.8 factory (see :mod:`bt_lsp.rules.builtins_v3`).
+_BUILTIN_RESOLVED_V3: Final[dict[str, Resolved]] = {
+    k: _resolve_v3(m) for k, m in V3_BUILTINS.items()
+}
+
+
 def is_compact(el: Element) -> bool:
     return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
 
@@ -104,6 +121,7 @@ class State:
     text: str
     out: list[Diagnostic] = field(default_factory=list)
     v4: bool = False  # <root> declares BTCPP_format
+    v3: bool = False  # the project builds against BehaviorTree.CPP 3 (ctx.btcpp_version)
     _types: dict[str, Resolved | None] = field(default_factory=dict)
     _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
     # Models resolved from declarations, shared by the runs over the sections of one check:
@@ -134,12 +152,18 @@ class State:
         sev = defined(code).severity if severity is None else severity
         if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
             sev = Severity.WARNING
-            message += " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
+            if self.v3:
+                message += " (a check BehaviorTree.CPP 4 makes; this project builds against 3)"
+            else:
+                message += (
+                    " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
+                )
         self.out.append(Diagnostic(start, end, code, message, sev, data))
 
     def resolve(self, type_id: str) -> Resolved | None:
-        """The model of node type ``type_id``: built-in first, then a custom declaration."""
-        r = _BUILTIN_RESOLVED.get(type_id)
+        """The model of node type ``type_id``: built-in first (of the project's
+        BehaviorTree.CPP version), then a custom declaration."""
+        r = (_BUILTIN_RESOLVED_V3 if self.v3 else _BUILTIN_RESOLVED).get(type_id)
         if r is not None:
             return r
         if type_id in self._types:

@@ -96,6 +96,7 @@ def check_root(st: State) -> None:
         declared = root.attr("BTCPP_format") is not None
         version = st.ctx.btcpp_version
         st.v4 = declared or version == "4"
+        st.v3 = version == "3"
         # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only.
         if not declared and version != "3":
             st.add(

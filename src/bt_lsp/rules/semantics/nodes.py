@@ -127,7 +127,7 @@ V3_ONLY: Final[dict[str, str]] = {
 def check_node(st: State, el: Element) -> Resolved | None:
     """The checks of one node element; returns its model when known."""
     name = el.name
-    if name == "SubTree":
+    if name == "SubTree" or (st.v3 and name == "SubTreePlus"):
         if el.children:
             st.add(
                 el.name_start,
@@ -203,6 +203,17 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             "unknown-node",
             f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}",
             Severity.ERROR if st.v4 else Severity.WARNING,
+            data,
+        )
+        return
+    if st.v3 and type_id in BUILTINS:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"{quoted(type_id)} is a built-in node of BehaviorTree.CPP 4; this project builds "
+            "against BehaviorTree.CPP 3, which does not register it (register it in C++)",
+            Severity.WARNING,
             data,
         )
         return

@@ -225,7 +225,8 @@ def check_attributes(
         if an in CONDITION_ATTRS:
             scripts.check(st, el, a)
             continue
-        if an == "_autoremap":
+        if an == "_autoremap" or (st.v3 and is_subtree and an in V3_ATTRIBUTES):
+            # Version 3 spells it __shared_blackboard (SubTree) or __autoremap (SubTreePlus).
             if is_subtree:
                 autoremap = _check_autoremap(st, el, a, value)
             continue
@@ -273,7 +274,7 @@ def _check_autoremap(st: State, el: Element, a: Attr, value: str) -> bool:
             s,
             e,
             "invalid-port-value",
-            f"_autoremap must be a bool literal (true/false, 1/0), not {quoted(value)}; "
+            f"{a.name} must be a bool literal (true/false, 1/0), not {quoted(value)}; "
             "BehaviorTree.CPP fails with 'invalid bool conversion'",
         )
         return False
@@ -346,8 +347,8 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
 
 
 def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: bool) -> None:
-    if not res.required or (autoremap and res.origin == "subtree"):
-        return
+    if not res.required or (res.origin == "subtree" and (autoremap or st.v3)):
+        return  # BehaviorTree.CPP 3 does not check a SubTree model's ports
     missing = [p for p in res.required if p not in given]
     if not missing:
         return

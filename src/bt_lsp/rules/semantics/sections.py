@@ -130,7 +130,10 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         ctx.workspace_has_custom_models,
         tuple(sorted(ctx.ros_pkg_paths.items())),
         ctx.included_by,
+        ctx.included,
+        ctx.workspace_files,
         st.v4,
+        st.v3,
         root is not None and len(root.children) > 1,
     )
     memo: dict[Dep, object] = {}
@@ -304,6 +307,7 @@ def _run(
         local,
         st.text[origin : origin + sec.length],
         v4=st.v4,
+        v3=st.v3,
         origin=origin,
         made=st.made,
     )
