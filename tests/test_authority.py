@@ -189,9 +189,9 @@ def test_hover_and_completion_say_where_a_model_came_from() -> None:
     ctx = Context.combine(doc, [], path="/w/tree.xml", model_files=[catalog()])
     h = hover_at(doc, text.index("MoveBase") + 2, ctx)
     assert h is not None
-    assert "a node catalog named in the settings (authoritative)" in h.markdown
-    assert "| `goal` | input | `Pose` | no default |" in h.markdown
-    assert "required" not in h.markdown
+    assert "a node catalog named in the settings (authoritative)" in h.text
+    assert "- `goal`: input, `Pose`, no default" in h.text
+    assert "required" not in h.text
     offset = text.index("<MoveBase") + 1
     completions = complete(doc, offset, ctx)
     assert completions is not None
