@@ -50,6 +50,29 @@ class BtProtocol(LanguageServerProtocol):
                 stream.flush()
         os._exit(0 if self._shutdown else 1)
 
+    def _execute_handler(
+        self,
+        msg_id: Any,
+        handler: Any,
+        callback: Any,
+        args: tuple[Any, ...] | None = None,
+        kwargs: dict[str, Any] | None = None,
+    ) -> None:
+        """Forget a handler's future once it is done.  pygls files the future of every
+        notification handler and of every step of a generator handler under a fresh id
+        in ``_request_futures`` and removes only those of requests: the sync handlers of
+        didOpen/didChange/didClose left one future (with its params, the changed text)
+        per notification, a few KiB each, for the life of the process."""
+
+        def done(future: Any) -> None:
+            try:
+                callback(future)
+            finally:
+                if self._request_futures.get(msg_id) is future:
+                    del self._request_futures[msg_id]
+
+        super()._execute_handler(msg_id, handler, done, args, kwargs)
+
     def handle_message(self, message: Any) -> None:
         """After ``shutdown``, answer requests with InvalidRequest as LSP asks (pygls drops
         them silently, which leaves a client waiting); notifications other than ``exit``
