@@ -73,6 +73,19 @@ class BtProtocol(LanguageServerProtocol):
 
         super()._execute_handler(msg_id, handler, done, args, kwargs)
 
+    @lsp_method(types.SHUTDOWN)
+    def lsp_shutdown(self, *args: Any) -> Generator[Any, Any, None]:
+        """pygls's shutdown, over a copy of the in-flight futures: cancelling one runs
+        its done callback at once, which forgets it (see :meth:`_execute_handler`)."""
+        handler = self.fm.features.get(types.SHUTDOWN)
+        if handler is not None:
+            yield handler, args, None
+        current = self.msg_id
+        for msg_id, future in list(self._request_futures.items()):
+            if msg_id != current and not future.done():
+                future.cancel()
+        self._shutdown = True
+
     def handle_message(self, message: Any) -> None:
         """After ``shutdown``, answer requests with InvalidRequest as LSP asks (pygls drops
         them silently, which leaves a client waiting); notifications other than ``exit``
