@@ -10,7 +10,7 @@ import asyncio
 import logging
 import traceback
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, BinaryIO
 
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException, JsonRpcInternalError, JsonRpcMethodNotFound
@@ -24,6 +24,7 @@ from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
+from bt_lsp.server import transport
 from bt_lsp.server.convert import diagnostic_at, to_diagnostic
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
@@ -70,6 +71,17 @@ class BtServer(LanguageServer):
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
         self.cpp = CppService(self)
+
+    @property
+    def bt_protocol(self) -> BtProtocol:
+        assert isinstance(self.protocol, BtProtocol)
+        return self.protocol
+
+    def start_io(self, stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> None:
+        transport.start_io(self, stdin, stdout)
+
+    def start_tcp(self, host: str, port: int) -> None:
+        transport.start_tcp(self, host, port)
 
     # -- state ----------------------------------------------------------------------------
 

@@ -19,8 +19,48 @@ from lsprotocol import types
 from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams, JsonRpcInvalidRequest
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
+from bt_lsp.server import jsonrpc
+from bt_lsp.server.framing import Body
+
 
 class BtProtocol(LanguageServerProtocol):
+    _initialize_seen = False
+
+    def receive(self, body: Body) -> None:
+        """One message body from the framing: answered with the JSON-RPC error it
+        deserves, or structured and handled.  Nothing here may end the read loop."""
+        if body.error is not None:
+            self.log(f"bt-lsp: parse error: {body.error}")
+            self._send_error(None, jsonrpc.PARSE_ERROR, f"Parse error: {body.error}")
+            return
+        bad = jsonrpc.problem(body.value)
+        if bad is not None:
+            msg_id, why = bad
+            self.log(f"bt-lsp: invalid request: {why}")
+            self._send_error(msg_id, jsonrpc.INVALID_REQUEST, f"Invalid request: {why}")
+            return
+        try:
+            message = self.structure_message(body.value)  # type: ignore[arg-type]
+        except Exception as exc:  # a request among them is already answered (InvalidParams)
+            self._server._report_server_error(exc, JsonRpcException)
+            return
+        try:
+            self.handle_message(message)
+        except Exception as exc:  # a bug must not end the read loop
+            self.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    def log(self, message: str) -> None:
+        self.notify(
+            types.WINDOW_LOG_MESSAGE,
+            types.LogMessageParams(type=types.MessageType.Warning, message=message),
+        )
+
+    def _send_error(self, msg_id: Any, code: int, message: str) -> None:
+        """An error response; ``id: null`` is written out (the converter drops None)."""
+        self._send_data(
+            {"jsonrpc": "2.0", "id": msg_id, "error": {"code": code, "message": message}}
+        )
+
     def structure_message(self, data: dict[str, Any]) -> Any:
         """A request whose params do not have its method's shape is answered with an
         InvalidParams error; pygls only logs it, and the client would wait forever."""
@@ -87,9 +127,24 @@ class BtProtocol(LanguageServerProtocol):
         self._shutdown = True
 
     def handle_message(self, message: Any) -> None:
-        """After ``shutdown``, answer requests with InvalidRequest as LSP asks (pygls drops
-        them silently, which leaves a client waiting); notifications other than ``exit``
-        are ignored."""
+        """Before ``initialize``, requests get ServerNotInitialized and notifications other
+        than ``exit`` are dropped; a second ``initialize`` is refused (LSP).  After
+        ``shutdown``, requests get InvalidRequest as LSP asks (pygls drops them silently,
+        which leaves a client waiting); notifications other than ``exit`` are ignored."""
+        method = getattr(message, "method", None)
+        msg_id = getattr(message, "id", None)
+        is_request = method is not None and hasattr(message, "id")
+        if method == types.INITIALIZE and is_request:
+            if self._initialize_seen:
+                self._send_error(msg_id, jsonrpc.INVALID_REQUEST, "initialize was already received")
+                return
+            self._initialize_seen = True
+        elif not self._initialize_seen and method is not None and method != types.EXIT:
+            if is_request:
+                self._send_error(
+                    msg_id, jsonrpc.SERVER_NOT_INITIALIZED, f"{method} before initialize"
+                )
+            return
         if (
             self._shutdown
             and getattr(message, "method", types.EXIT) != types.EXIT
