@@ -112,3 +112,26 @@ async def test_thousands_of_edits_leave_nothing_behind() -> None:
     published = [m for m in sink.messages if m.get("method") == "textDocument/publishDiagnostics"]
     assert len(published) >= 4000
     assert any(m.get("id") == 2 for m in sink.messages)
+
+
+async def test_an_answer_that_cannot_be_written_is_an_error() -> None:
+    """A result the serialiser fails on (here nested far beyond the recursion limit)
+    still answers its request, with InternalError, and the server serves on."""
+    server = create_server()
+    sink = Sink()
+    server.protocol.set_writer(sink)
+
+    @server.feature("bt-lsp/deep")
+    def too_deep(ls: BtServer, params: Any) -> Any:
+        nested: list[Any] = []
+        for _ in range(100_000):
+            nested = [nested]
+        return nested
+
+    feed(server, {"id": 1, "method": "initialize", "params": {"capabilities": {}}})
+    feed(server, {"id": 2, "method": "bt-lsp/deep", "params": {}})
+    feed(server, {"id": 3, "method": "shutdown", "params": None})
+    await asyncio.sleep(0.05)
+    answers = {m["id"]: m for m in sink.messages if "id" in m and "method" not in m}
+    assert answers[2]["error"]["code"] == -32603
+    assert "result" in answers[3]

@@ -12,6 +12,7 @@ from typing import Any
 PARSE_ERROR = -32700
 INVALID_REQUEST = -32600
 SERVER_NOT_INITIALIZED = -32002
+INTERNAL_ERROR = -32603
 
 
 def valid_id(value: object) -> bool:

@@ -148,15 +148,39 @@ def rename_edit(
     return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
 
 
-def _document_symbol(lines: LineIndex, s: DocSymbol, enc: Encoding) -> types.DocumentSymbol:
-    return types.DocumentSymbol(
-        name=s.name,
-        detail=s.detail or None,
-        kind=_SYMBOL_KINDS[s.kind],
-        range=to_range(lines, s.start, s.end, enc),
-        selection_range=to_range(lines, s.sel_start, s.sel_end, enc),
-        children=[_document_symbol(lines, c, enc) for c in s.children],
-    )
+# The outline's nesting depth.  BehaviorTree.CPP allows trees 256 levels deep; a symbol
+# deeper than this is listed after its ancestor at this depth, in document order (its
+# range stays inside the ancestor's parent), so that no nesting of the answer, in the
+# server or in the client, has to recurse hundreds of levels deep.
+MAX_SYMBOL_DEPTH = 64
+
+
+def document_symbols_lsp(
+    lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding
+) -> list[types.DocumentSymbol]:
+    """The outline as LSP DocumentSymbols, built without recursion."""
+    out: list[types.DocumentSymbol] = []
+    stack: list[tuple[DocSymbol, list[types.DocumentSymbol], int]] = [
+        (s, out, 1) for s in reversed(top)
+    ]
+    while stack:
+        s, siblings, depth = stack.pop()
+        kids: list[types.DocumentSymbol] = []
+        sym = types.DocumentSymbol(
+            name=s.name,
+            detail=s.detail or None,
+            kind=_SYMBOL_KINDS[s.kind],
+            range=to_range(lines, s.start, s.end, enc),
+            selection_range=to_range(lines, s.sel_start, s.sel_end, enc),
+            children=kids,
+        )
+        siblings.append(sym)
+        if depth < MAX_SYMBOL_DEPTH:
+            into, below = kids, depth + 1
+        else:
+            into, below = siblings, depth
+        stack.extend((c, into, below) for c in reversed(s.children))
+    return out
 
 
 # --- features -----------------------------------------------------------------------------
@@ -262,7 +286,7 @@ def register(server: BtServer) -> None:
             return None
         enc = ls.encoding
         symbols = document_symbols(od.doc, context_of(ls, od))
-        return [_document_symbol(od.doc.lines, s, enc) for s in symbols]
+        return document_symbols_lsp(od.doc.lines, symbols, enc)
 
     @server.feature(types.WORKSPACE_SYMBOL)
     def workspace_symbol(

@@ -8,7 +8,10 @@ notification on to ours.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import inspect
+import json
 import os
 import sys
 from collections.abc import Generator
@@ -16,7 +19,12 @@ from typing import Any
 
 from cattrs import ClassValidationError, transform_error
 from lsprotocol import types
-from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams, JsonRpcInvalidRequest
+from pygls.exceptions import (
+    JsonRpcException,
+    JsonRpcInternalError,
+    JsonRpcInvalidParams,
+    JsonRpcInvalidRequest,
+)
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
 from bt_lsp.server import jsonrpc
@@ -24,7 +32,10 @@ from bt_lsp.server.framing import Body
 
 
 class BtProtocol(LanguageServerProtocol):
-    _initialize_seen = False
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._initialize_seen = False
+        self._writes: set[asyncio.Future[Any]] = set()  # writes in flight (websockets)
 
     def receive(self, body: Body) -> None:
         """One message body from the framing: answered with the JSON-RPC error it
@@ -54,6 +65,51 @@ class BtProtocol(LanguageServerProtocol):
             types.WINDOW_LOG_MESSAGE,
             types.LogMessageParams(type=types.MessageType.Warning, message=message),
         )
+
+    def _send_data(self, data: Any) -> None:
+        """pygls's writer, except that a response whose result cannot be serialised (a
+        RecursionError, a bug) becomes an InternalError answer to the same id: pygls only
+        logged it, and the request was never answered."""
+        if not data or self.writer is None:
+            super()._send_data(data)
+            return
+        try:
+            body = json.dumps(data, default=self._serialize_message)
+        except Exception as exc:
+            msg_id = getattr(data, "id", None) if not isinstance(data, dict) else data.get("id")
+            is_response = hasattr(data, "result") or hasattr(data, "error")
+            self.log(f"bt-lsp: internal error serialising a message: {exc!r}")
+            if is_response and jsonrpc.valid_id(msg_id):
+                body = json.dumps(
+                    {
+                        "jsonrpc": "2.0",
+                        "id": msg_id,
+                        "error": {
+                            "code": jsonrpc.INTERNAL_ERROR,
+                            "message": f"the answer could not be written: {exc!r}",
+                        },
+                    }
+                )
+            else:
+                return
+        self._write(body)
+
+    def _write(self, body: str) -> None:
+        data = body.encode(self.CHARSET)
+        header = (
+            f"Content-Length: {len(data)}\r\n"
+            f"Content-Type: {self.CONTENT_TYPE}; charset={self.CHARSET}\r\n\r\n"
+        ).encode("ascii")
+        assert self.writer is not None
+        try:
+            res = self.writer.write(header + data if self._include_headers else data)
+            if inspect.isawaitable(res):
+                self._writes.add(task := asyncio.ensure_future(res))
+                task.add_done_callback(self._writes.discard)
+        except BrokenPipeError:
+            raise
+        except Exception as error:
+            self._server._report_server_error(error, JsonRpcInternalError)
 
     def _send_error(self, msg_id: Any, code: int, message: str) -> None:
         """An error response; ``id: null`` is written out (the converter drops None)."""
