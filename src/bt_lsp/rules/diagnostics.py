@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Final
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.syntax.elements import NameRef, Role
+from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
@@ -236,8 +237,10 @@ def own_diagnostics(doc: Document) -> list[Diagnostic]:
 
 def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
     """What a document larger than ``max_bytes`` (UTF-8) gets: its own diagnostics (XML and
-    names, which stay cheap) and ``document-too-large`` saying the rest does not run."""
-    out = list(own_diagnostics(doc))
+    names, which stay cheap) and ``document-too-large`` saying the rest does not run.
+    Capped like every other path, and found with the cyclic collector paused: hostile
+    input has the most problems."""
+    out = list(limited(with_gc_paused(own_diagnostics)(doc)))
     out.append(
         make(
             0,

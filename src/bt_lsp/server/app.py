@@ -7,6 +7,7 @@ core; this module owns the open documents and when diagnostics are published.
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
 import traceback
 from collections.abc import Mapping
@@ -25,7 +26,7 @@ from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
 from bt_lsp.server import transport
-from bt_lsp.server.convert import diagnostic_at, to_diagnostic
+from bt_lsp.server.convert import diagnostic_at
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
 from bt_lsp.server.protocol import BtProtocol
@@ -115,9 +116,16 @@ class BtServer(LanguageServer):
         return result
 
     def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
-        enc = self.encoding
-        described = self.code_descriptions
-        return [to_diagnostic(od.doc.lines, d, enc, described) for d in self.diagnostics_of(od)]
+        diags = self.diagnostics_of(od)
+        at = od.doc.lines.positions([o for d in diags for o in (d.start, d.end)], self.encoding)
+        return [
+            diagnostic_at(
+                types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
+                d,
+                self.code_descriptions,
+            )
+            for d in diags
+        ]
 
     # -- publishing -------------------------------------------------------------------------
 
@@ -179,12 +187,16 @@ class BtServer(LanguageServer):
         if od is None:
             return
         try:
-            diags = self.lsp_diagnostics(od)
+            array = od.published.array(
+                od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
+            )
         except Exception:  # a bug must not stop the server; say so in its log
             self.log_error(f"computing diagnostics for {uri}")
             return
-        self.text_document_publish_diagnostics(
-            types.PublishDiagnosticsParams(uri=uri, diagnostics=diags, version=od.version)
+        version = "" if od.version is None else f', "version": {int(od.version)}'
+        self.bt_protocol.notify_json(
+            types.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS,
+            f'{{"uri": {json.dumps(uri)}, "diagnostics": {array}{version}}}',
         )
 
     def clear(self, uri: str) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 from lsprotocol import types
 
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -100,3 +102,57 @@ def workspace_edit(
             else None,
         )
     return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
+
+
+class DiagnosticJson:
+    """LSP diagnostics written as JSON text directly, for publication.
+
+    Converting every diagnostic to lsprotocol objects and unstructuring them again on each
+    edit cost most of a publication (2,000 diagnostics of a 200 KB document: 157 ms).
+    The part of a diagnostic that does not move with edits (message, code, severity,
+    data) is written once and kept for as long as the core keeps the same
+    :class:`Diagnostic` object (an unchanged section keeps its diagnostics); the range is
+    written each time, its positions found in one pass (:meth:`LineIndex.positions`)."""
+
+    def __init__(self) -> None:
+        self._tails: dict[int, tuple[Diagnostic, str]] = {}
+        self.described = True  # with codeDescription links (the client shows them)
+
+    def tail(self, d: Diagnostic) -> str:
+        kept = self._tails.get(id(d))
+        if kept is not None and kept[0] is d:
+            return kept[1]
+        info = CODES.get(d.code) if self.described else None
+        fields: dict[str, object] = {
+            "message": d.message,
+            "severity": int(d.severity),
+            "code": d.code,
+            "source": "bt-lsp",
+        }
+        if info:
+            fields["codeDescription"] = {"href": info.url}
+        if d.data is not None:
+            fields["data"] = dict(d.data)
+        text = json.dumps(fields)[1:]  # without its "{": it follows the range
+        self._tails[id(d)] = (d, text)
+        return text
+
+    def array(
+        self, lines: LineIndex, diags: list[Diagnostic], enc: Encoding, described: bool = True
+    ) -> str:
+        """The JSON array of ``diags``; forgets the tails of diagnostics not among them."""
+        if described != self.described:
+            self._tails.clear()
+            self.described = described
+        at = lines.positions([o for d in diags for o in (d.start, d.end)], enc)
+        parts = []
+        for d in diags:
+            (sl, sc), (el, ec) = at[d.start], at[d.end]
+            parts.append(
+                f'{{"range": {{"start": {{"line": {sl}, "character": {sc}}}, '
+                f'"end": {{"line": {el}, "character": {ec}}}}}, {self.tail(d)}'
+            )
+        if len(self._tails) > len(diags):
+            keep = {id(d) for d in diags}
+            self._tails = {k: v for k, v in self._tails.items() if k in keep}
+        return "[" + ", ".join(parts) + "]"

@@ -94,6 +94,11 @@ class BtProtocol(LanguageServerProtocol):
                 return
         self._write(body)
 
+    def notify_json(self, method: str, params: str) -> None:
+        """A notification whose params are already JSON text."""
+        if self.writer is not None:
+            self._write(f'{{"jsonrpc": "2.0", "method": {json.dumps(method)}, "params": {params}}}')
+
     def _write(self, body: str) -> None:
         data = body.encode(self.CHARSET)
         header = (
