@@ -14,7 +14,12 @@ Output formats:
   (``%SRCROOT%``).
 
 Exit status: 0 without errors, 1 with at least one error-severity diagnostic, 2 when a file
-cannot be read or decoded (the others are still checked).
+cannot be read or decoded, is not a regular file (a FIFO would block), or its fix cannot be
+written (the others are still checked).
+
+``--fix`` removes the temporary files an interrupted ``--fix`` left
+(``.NAME.bt-lsp-XXXXXXXX.tmp``, older than the run), and does not rewrite a file that a
+checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ import json
 import os
 import shutil
 import sys
+import time
 import traceback
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -37,7 +43,13 @@ from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
-from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
+from bt_lsp.project.fileio import (
+    DEFAULT_MAX_BYTES,
+    FileError,
+    read_text,
+    stale_temporaries,
+    write_text_atomic,
+)
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
@@ -59,6 +71,8 @@ class Options:
     max_bytes: int = DEFAULT_MAX_BYTES
     cpp: bool = True  # learn the node catalog from the C++ of the files' packages
     models: tuple[str, ...] = ()  # authoritative node catalogs (--models)
+    follow_symlinks: bool = False  # --fix rewrites files linked from outside the folder
+    started: float = field(default_factory=time.time)  # older temporaries are stale
 
 
 def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
@@ -90,9 +104,11 @@ def check_file(
     options: Options,
     project: ProjectIndex | None = None,
     before: Mapping[Path, Document] | None = None,
+    keep: str | None = None,
 ) -> FileResult:
     """Read, analyze and (with ``options.fix``) fix one file, in ``project`` if given;
-    ``before`` are the workspace's documents before any file was fixed."""
+    ``before`` are the workspace's documents before any file was fixed; ``keep`` says why
+    the file must not be rewritten, if it must not."""
     result = FileResult(path)
     try:
         decoded = read_text(path, options.max_bytes)
@@ -114,6 +130,8 @@ def check_file(
             outcome = fix_document(decoded, doc, raw, diags, project, others)
             if isinstance(outcome, str):
                 result.not_fixed = outcome
+            elif outcome is not None and keep is not None:
+                result.not_fixed = keep
             elif outcome is not None:
                 write_text_atomic(
                     path, outcome.doc.text, decoded.encoding, decoded.bom, expect=decoded.stamp
@@ -127,6 +145,7 @@ def check_file(
         result.findings = findings_of(path, doc, diags)
     except FileError as e:
         result.not_fixed = e.message
+        result.unwritten = True
         result.findings = findings_of(path, doc, diags)
     except Exception as e:
         result.detail = traceback.format_exc()
@@ -137,6 +156,38 @@ def check_file(
 
 
 # -- running -----------------------------------------------------------------------------
+
+
+def _remove_stale_temporaries(files: Sequence[str], before: float) -> list[str]:
+    """Remove the temporary files an interrupted ``--fix`` left beside ``files`` (those
+    older than this run); returns them."""
+    removed: list[str] = []
+    for directory in sorted({os.path.dirname(os.path.realpath(f)) for f in files}):
+        for tmp in stale_temporaries(directory, before):
+            try:
+                os.unlink(tmp)
+            except OSError:
+                continue
+            removed.append(tmp)
+    return removed
+
+
+def _linked_from_outside(path: str, roots: Sequence[str]) -> str | None:
+    """Why ``path``, found in one of the folders ``roots``, is not rewritten: it leads
+    through a symbolic link to a file outside that folder (``None`` if it does not)."""
+    here = os.path.abspath(path)
+    real = os.path.realpath(path)
+    for root in roots:
+        top = os.path.abspath(root)
+        if os.path.commonpath([here, top]) != top:
+            continue
+        real_top = os.path.realpath(root)
+        if os.path.commonpath([real, real_top]) != real_top:
+            return (
+                f"it is a symbolic link to {real}, outside {root} "
+                "(--follow-symlinks rewrites such files)"
+            )
+    return None
 
 
 def write(stream: TextIO, text: str) -> None:
@@ -224,9 +275,14 @@ def run(
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
     # What fixes see of the other files: the workspace before any file is fixed.
     before = dict(project.bt_documents()) if options.fix else None
+    roots = [p for p in paths if os.path.isdir(p)]
+    if options.fix:
+        for tmp in _remove_stale_temporaries(files, options.started):
+            say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        r = check_file(path, options, project, before)
+        keep = None if options.follow_symlinks else _linked_from_outside(path, roots)
+        r = check_file(path, options, project, before, keep)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

@@ -104,6 +104,11 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SIZE",
         help="refuse files larger than this (e.g. 64M; default: 64M)",
     )
+    check.add_argument(
+        "--follow-symlinks",
+        action="store_true",
+        help="with --fix, also rewrite files that a folder links to from outside it",
+    )
     check.set_defaults(subparser=check)
 
     models = sub.add_parser(
@@ -177,6 +182,7 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         max_bytes=args.max_file_size,
         cpp=not args.no_cpp,
         models=tuple(os.path.abspath(m) for m in args.models),
+        follow_symlinks=args.follow_symlinks,
     )
     return check.run(args.paths, options)
 

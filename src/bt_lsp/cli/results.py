@@ -49,6 +49,7 @@ class FileResult:
     not_fixed: str | None = None  # why a file with fixes was left unchanged
     notes: list[str] = field(default_factory=list)  # what the applied fixes left as it was
     detail: str = ""  # the traceback of an internal error
+    unwritten: bool = False  # --fix could not write the fixed file (exit status 2)
 
 
 def analyze(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
@@ -111,7 +112,7 @@ def summary(results: Sequence[FileResult]) -> str:
 def exit_code(results: Iterable[FileResult]) -> int:
     code = 0
     for r in results:
-        if r.error is not None:
+        if r.error is not None or r.unwritten:
             return 2
         if any(f.severity == Severity.ERROR for f in r.findings):
             code = 1
