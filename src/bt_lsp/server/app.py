@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import time
 import traceback
 from collections.abc import Mapping
 from typing import Any, BinaryIO
@@ -43,6 +44,10 @@ SECTION = "btLsp"
 # in less time than an editor takes to notice.
 EARLY_NAMES_CHARS = 256 * 1024
 
+# How often, at most, files read from disk are compared with the disk again, for clients
+# that do not send workspace/didChangeWatchedFiles.
+DISK_CHECK_SECONDS = 1.0
+
 
 class BtServer(LanguageServer):
     def __init__(self) -> None:
@@ -72,6 +77,7 @@ class BtServer(LanguageServer):
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
         self.cpp = CppService(self)
+        self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
 
     @property
     def bt_protocol(self) -> BtProtocol:
@@ -96,8 +102,22 @@ class BtServer(LanguageServer):
     def get(self, uri: str) -> OpenDocument | None:
         return self.docs.get(uri)
 
+    def check_disk(self) -> None:
+        """Without watched-file notifications, notice files changed on disk by their
+        modification time and size (at most once a second): they are read again, and
+        every document's diagnostics are due."""
+        if self.watch_files:
+            return
+        now = time.monotonic()
+        if now - self._disk_checked < DISK_CHECK_SECONDS:
+            return
+        self._disk_checked = now
+        if self.project.revalidate():
+            self.refresh_all()
+
     def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
         """The document's diagnostics after severity settings, cached per version."""
+        self.check_disk()
         key = (od.version, self.generation, self.project.generation + self.edits)
         if od.cache_key == key:
             return od.cached

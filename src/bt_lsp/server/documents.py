@@ -66,9 +66,18 @@ def register(server: BtServer) -> None:
         od = ls.docs.pop(uri, None)
         if od is not None:
             if od.path is not None:
-                ls.project.close(od.path)
+                ls.project.close(od.path)  # from now on the file on disk counts
             ls.cpp.document_changed(od, closed=True)
             ls.clear(uri)
+            ls.schedule_all(uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
+    def did_save(ls: BtServer, params: types.DidSaveTextDocumentParams) -> None:
+        """A save writes the file the other documents may read from disk."""
+        path = to_fs_path(params.text_document.uri)
+        if path:
+            ls.project.file_changed(path)
+        ls.refresh_all()
 
     @server.feature(
         types.TEXT_DOCUMENT_DIAGNOSTIC,
