@@ -104,6 +104,11 @@ def workspace_edit(
     return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
 
 
+class RawJson(str):
+    """A result that is already JSON text: written into the response as it is (see
+    :meth:`bt_lsp.server.protocol.BtProtocol._send_data`)."""
+
+
 class DiagnosticJson:
     """LSP diagnostics written as JSON text directly, for publication.
 

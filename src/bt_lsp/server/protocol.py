@@ -28,6 +28,7 @@ from pygls.exceptions import (
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
 from bt_lsp.server import jsonrpc
+from bt_lsp.server.convert import RawJson
 from bt_lsp.server.framing import Body
 
 
@@ -74,7 +75,11 @@ class BtProtocol(LanguageServerProtocol):
             super()._send_data(data)
             return
         try:
-            body = json.dumps(data, default=self._serialize_message)
+            result = getattr(data, "result", None)
+            if isinstance(result, RawJson) and getattr(data, "error", None) is None:
+                body = f'{{"jsonrpc": "2.0", "id": {json.dumps(data.id)}, "result": {result}}}'
+            else:
+                body = json.dumps(data, default=self._serialize_message)
         except Exception as exc:
             msg_id = getattr(data, "id", None) if not isinstance(data, dict) else data.get("id")
             is_response = hasattr(data, "result") or hasattr(data, "error")
