@@ -11,19 +11,19 @@ from tests.server.conftest import PROFILES, BtClient, Profile, clients
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 PROFILES["small-limit"] = Profile(
-    "visual-studio-code", init_options={"debounceMs": 0, "maxDocumentBytes": 50_000}
+    "visual-studio-code", init_options={"debounceMs": 0, "maxDocumentBytes": 10_000}
 )
 PROFILES["small-limit-pull"] = Profile(
-    "neovim@v0.11.0", init_options={"debounceMs": 0, "maxDocumentBytes": 50_000}
+    "neovim@v0.11.0", init_options={"debounceMs": 0, "maxDocumentBytes": 10_000}
 )
 
 
 @clients("small-limit", "small-limit-pull")
 async def test_a_too_large_document_is_capped(client: BtClient) -> None:
-    # One line of 5,000 bad node and port names: 10,000 name problems, 85 KB.
+    # One line of 1,200 bad node and port names: 2,400 name problems, 20 KB.
     text = (
         '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
-        + '<Do.It x.y="1"/>' * 5000
+        + '<Do.It x.y="1"/>' * 1200
         + "</Sequence></BehaviorTree></root>"
     )
     uri = client.open(text)
