@@ -168,7 +168,7 @@ def test_runner_checks_a_corpus(tmp_path: Path) -> None:
 
 
 def test_soak_runs_a_short_session(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    import soak as bench_soak
+    import soak as bench_soak  # type: ignore[import-not-found]
 
     out = tmp_path / "soak.json"
     assert bench_soak.main(["--size", "4K", "--edits", "10", "--json", str(out)]) == 0

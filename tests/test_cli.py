@@ -879,17 +879,16 @@ def test_stale_temporaries_of_an_interrupted_fix_are_removed(
 
 
 def test_the_temporary_file_has_our_mark(work: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from bt_lsp.project import fileio
 
     names: list[str] = []
-    real = fileio.os.replace
+    real = os.replace
 
     def spy(src: str, dst: str) -> None:
         names.append(os.path.basename(src))
         real(src, dst)
 
     _put(work / "a.xml", FIXABLE)
-    monkeypatch.setattr(fileio.os, "replace", spy)
+    monkeypatch.setattr(os, "replace", spy)
     assert main(["check", "--fix", "a.xml"]) == 0
     assert len(names) == 1 and re.fullmatch(r"\.a\.xml\.bt-lsp-[a-z0-9_]{8}\.tmp", names[0])
 
@@ -897,13 +896,12 @@ def test_the_temporary_file_has_our_mark(work: Path, monkeypatch: pytest.MonkeyP
 def test_a_failed_write_under_fix_exits_2(
     work: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from bt_lsp.project import fileio
 
     def full(src: str, dst: str) -> None:
         raise OSError(28, "No space left on device")
 
     path = _put(work / "a.xml", FIXABLE)
-    monkeypatch.setattr(fileio.os, "replace", full)
+    monkeypatch.setattr(os, "replace", full)
     assert main(["check", "--fix", "a.xml"]) == 2
     err = capsys.readouterr().err
     assert "bt-lsp: not fixing a.xml: cannot write a.xml: No space left on device" in err

@@ -150,7 +150,7 @@ def deny_access(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
         return real_mkstemp(*args, dir=dir, **kwargs)
 
     monkeypatch.setattr(fileio, "open", guarded_open, raising=False)
-    monkeypatch.setattr(fileio.os, "open", guarded_os_open)
+    monkeypatch.setattr(os, "open", guarded_os_open)
     monkeypatch.setattr(tempfile, "mkstemp", guarded_mkstemp)
 
 

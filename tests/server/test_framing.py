@@ -19,7 +19,7 @@ import pytest
 
 SERVER = [sys.executable, "-m", "bt_lsp", "serve"]
 TIMEOUT = 60.0  # generous: the server may start slowly on a busy machine
-INIT_PARAMS = {"capabilities": {}, "processId": None, "rootUri": None}
+INIT_PARAMS: dict[str, Any] = {"capabilities": {}, "processId": None, "rootUri": None}
 DOC = '<root BTCPP_format="4"><BehaviorTree ID="Main"><AlwaysSuccess/></BehaviorTree></root>'
 
 

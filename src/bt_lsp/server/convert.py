@@ -137,7 +137,7 @@ class DiagnosticJson:
         if info:
             fields["codeDescription"] = {"href": info.url}
         if d.data is not None:
-            fields["data"] = dict(d.data)
+            fields["data"] = d.data.as_json()
         text = json.dumps(fields)[1:]  # without its "{": it follows the range
         self._tails[id(d)] = (d, text)
         return text
