@@ -401,13 +401,13 @@ def phase_seconds(text: str, path: Path) -> dict[str, float]:
     protocol (reading the JSON, converting positions, writing the diagnostics).  The
     first phase is the pass whose name diagnostics a large document's open publishes
     first (:mod:`bt_lsp.rules.early_names`); the others make the complete set."""
-    from bt_lsp.project.workspace import Workspace
+    from bt_lsp.project.index import ProjectIndex
     from bt_lsp.rules import semantics
     from bt_lsp.rules.diagnostics import own_diagnostics
     from bt_lsp.rules.early_names import early_name_diagnostics
     from bt_lsp.syntax.document import Document
 
-    ws = Workspace([str(path.parent)])
+    ws = ProjectIndex([str(path.parent)])
     gc.collect()
     gc.disable()  # as the server does for these phases (bt_lsp.syntax.gcpause)
     try:

@@ -12,7 +12,7 @@ from collections import Counter
 from pathlib import Path
 
 from bt_lsp.project.fileio import FileError, read_text
-from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules.codes import Severity
 
 
@@ -21,7 +21,7 @@ def main() -> int:
     rows = []
     total: Counter[str] = Counter()
     for project in sorted(p for p in root.iterdir() if p.is_dir()):
-        ws = Workspace([project])
+        ws = ProjectIndex([project])
         sev: Counter[Severity] = Counter()
         codes: Counter[str] = Counter()
         files = sorted(project.glob("*.xml"))

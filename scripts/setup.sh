@@ -16,6 +16,9 @@ fi
 need_apt=()
 command -v nvim >/dev/null 2>&1 || need_apt+=(neovim)
 command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
+# Emacs 28 with eglot 1.9 (tests/e2e/test_emacs.py).
+command -v emacs >/dev/null 2>&1 || need_apt+=(emacs-nox)
+[ -d /usr/share/emacs/site-lisp/elpa/eglot-1.9 ] || need_apt+=(elpa-eglot)
 if [ ${#need_apt[@]} -gt 0 ]; then
   as_root apt-get update -qq
   DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${need_apt[@]}" >/dev/null

@@ -40,8 +40,8 @@ from bt_lsp.ide.fix import Fix
 from bt_lsp.ide.name_fixes import fixes_for_name
 from bt_lsp.ide.semantic_fixes import fixes_for_rule
 from bt_lsp.project.config import CONFIG_NAMES, ConfigError
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic, limited, size_limited
@@ -177,7 +177,7 @@ def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[E
             target = root / f.path
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_bytes(f.text.replace("\n", newline).encode("utf-8"))
-        ws = Workspace([root], Settings())
+        ws = ProjectIndex([root], Settings())
         for f in files:
             path = normalize(root / f.path)
             if path.name in CONFIG_NAMES:  # a configuration file: its error, if any
@@ -189,7 +189,7 @@ def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[E
     return out
 
 
-def _config_found(ws: Workspace, path: Path, text: str) -> list[Expected]:
+def _config_found(ws: ProjectIndex, path: Path, text: str) -> list[Expected]:
     """The ``config-error`` of a configuration file, where the server shows it."""
     loaded = ws.configs.load(path)
     if not isinstance(loaded, ConfigError):

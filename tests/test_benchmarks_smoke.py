@@ -165,3 +165,16 @@ def test_runner_checks_a_corpus(tmp_path: Path) -> None:
     assert len(files) == 1
     assert bench_run.lxml_corpus_seconds(files) > 0
     assert bench_run.check_seconds(tmp_path) > 0
+
+
+def test_soak_runs_a_short_session(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import soak as bench_soak  # type: ignore[import-not-found]
+
+    out = tmp_path / "soak.json"
+    assert bench_soak.main(["--size", "4K", "--edits", "10", "--json", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "10 edits and 12 requests" in printed and "server RSS:" in printed
+    result = json.loads(out.read_text(encoding="utf-8"))
+    assert result["edits"] == 10 and result["rss_start_kib"] > 0 and result["rss_end_kib"] > 0
+    assert set(result["request_ms"]) == set(bench_soak.REQUESTS)
+    assert all(s["p50"] > 0 for s in result["request_ms"].values())

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.packages import Packages, cmake_btcpp, read_manifest
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
 from bt_lsp.syntax.document import Document
 
 TREE = '<root main_tree_to_execute="T"><BehaviorTree ID="T"><AlwaysSuccess/></BehaviorTree></root>'
@@ -56,7 +56,7 @@ def test_v3_and_v4_packages_in_one_workspace(tmp_path: Path) -> None:
     )
     old = write(tmp_path / "src" / "old" / "trees" / "a.xml", TREE)
     new = write(tmp_path / "src" / "new" / "behavior_trees" / "b.xml", TREE)
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     d = ws.btcpp_for(old)
     assert d.version == "3" and "behaviortree_cpp_v3" in d.source and "package.xml" in d.source
     assert ws.btcpp_for(new).version == "4"
@@ -72,7 +72,7 @@ def test_package_without_btcpp_dependency_uses_its_cmake(tmp_path: Path) -> None
     # A CMakeLists.txt above the package does not decide for it.
     write(tmp_path / "CMakeLists.txt", "find_package(behaviortree_cpp)\n")
     f = write(tmp_path / "p" / "t.xml", TREE)
-    d = Workspace([tmp_path]).btcpp_for(f)
+    d = ProjectIndex([tmp_path]).btcpp_for(f)
     assert d.version == "3" and "CMakeLists.txt" in d.source
 
 
@@ -80,33 +80,33 @@ def test_package_boundary_stops_the_search(tmp_path: Path) -> None:
     write(tmp_path / "CMakeLists.txt", "find_package(behaviortree_cpp)\n")
     write(tmp_path / "p" / "package.xml", manifest("p", "rclcpp"))
     f = write(tmp_path / "p" / "t.xml", TREE)
-    assert Workspace([tmp_path]).btcpp_for(f).version is None
+    assert ProjectIndex([tmp_path]).btcpp_for(f).version is None
     g = write(tmp_path / "plain" / "t.xml", TREE)
-    assert Workspace([tmp_path]).btcpp_for(g).version == "4"
+    assert ProjectIndex([tmp_path]).btcpp_for(g).version == "4"
 
 
 def test_btcpp_format_when_nothing_else_says(tmp_path: Path) -> None:
     f = write(tmp_path / "t.xml", TREE.replace("<root ", '<root BTCPP_format="3" '))
-    d = Workspace([tmp_path]).btcpp_for(f)
+    d = ProjectIndex([tmp_path]).btcpp_for(f)
     assert d.version == "3" and "BTCPP_format" in d.source
-    assert Workspace([tmp_path]).btcpp_for(write(tmp_path / "u.xml", TREE)).version is None
+    assert ProjectIndex([tmp_path]).btcpp_for(write(tmp_path / "u.xml", TREE)).version is None
 
 
 def test_configuration_wins(tmp_path: Path) -> None:
     write(tmp_path / "package.xml", manifest("p", "behaviortree_cpp"))
     f = write(tmp_path / "t.xml", TREE)
     write(tmp_path / "bt-lsp.toml", 'btcpp = "3"\n')
-    d = Workspace([tmp_path]).btcpp_for(f)
+    d = ProjectIndex([tmp_path]).btcpp_for(f)
     assert d.version == "3" and d.source == "the btcpp setting"
-    assert Workspace([tmp_path], Settings(btcpp="3")).btcpp_for(f).version == "3"
+    assert ProjectIndex([tmp_path], Settings(btcpp="3")).btcpp_for(f).version == "3"
     write(tmp_path / "bt-lsp.toml", 'btcpp = "auto"\n')
-    assert Workspace([tmp_path], Settings(btcpp="3")).btcpp_for(f).version == "4"
+    assert ProjectIndex([tmp_path], Settings(btcpp="3")).btcpp_for(f).version == "4"
 
 
 def test_manifest_change_is_heard(tmp_path: Path) -> None:
     pkg = write(tmp_path / "package.xml", manifest("p", "behaviortree_cpp_v3"))
     f = write(tmp_path / "t.xml", TREE)
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert ws.btcpp_for(f).version == "3"
     write(pkg, manifest("p", "behaviortree_cpp"))
     ws.file_changed(pkg)

@@ -6,10 +6,12 @@ from __future__ import annotations
 import codecs
 import json
 import os
+import re
 import shutil
 import stat
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -742,7 +744,7 @@ def _patch_fix_all(monkeypatch: pytest.MonkeyPatch, bad: TextEdit) -> None:
     """The real fixes, with ``bad`` instead of any edit at the same place."""
     real = fixes.fix_all
 
-    def fake(doc: Any, diags: Any) -> fixes.FixAll:
+    def fake(doc: Any, diags: Any, others: Any = None) -> fixes.FixAll:
         edits = [e for e in real(doc, diags).edits if e.start != bad.start]
         return fixes.FixAll([*edits, bad])
 
@@ -834,3 +836,92 @@ def test_internal_error_names_the_file_and_goes_on(
     out, err = capsys.readouterr()
     _assert_lines(out, CRLF_LINES)
     assert "bt-lsp: internal error while checking boom.xml: RuntimeError: kaboom\n" in err
+
+
+# -- --fix corners: FIFOs, interrupted runs, failed writes, links out of the folder ----------
+
+
+def test_a_fifo_named_explicitly_is_skipped(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A FIFO with no writer would block open() forever: it is refused at once."""
+    os.mkfifo(work / "pipe.xml")
+    _put(work / "a.xml", FIXABLE)
+    assert main(["check", "--fix", "pipe.xml", "a.xml"]) == 2
+    err = capsys.readouterr().err
+    assert "bt-lsp: skipping pipe.xml: not a regular file (a FIFO)" in err
+    assert (work / "a.xml").read_text(encoding="utf-8") == _fixed(FIXABLE)  # the rest goes on
+
+
+def test_stale_temporaries_of_an_interrupted_fix_are_removed(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _put(work / "d" / "a.xml", FIXABLE)
+    ours = _put(work / "d" / ".a.xml.bt-lsp-k3j_9x0q.tmp", "<root")
+    os.utime(ours, (1_000_000_000, 1_000_000_000))
+    fresh = _put(work / "d" / ".a.xml.bt-lsp-zzzzzzzz.tmp", "<root")  # a run going on now
+    os.utime(fresh, (time.time() + 60, time.time() + 60))
+    others = [
+        _put(work / "d" / ".a.xml.k3j_9x0q.tmp", "x"),  # not our name
+        _put(work / "d" / ".a.xml.bt-lsp-k3j_9x0q.tmp~", "x"),
+        _put(work / "d" / "notes.bt-lsp-k3j_9x0q.tmp", "x"),
+    ]
+    for p in others:
+        os.utime(p, (1_000_000_000, 1_000_000_000))
+    assert main(["check", "--fix", "d"]) == 0
+    err = capsys.readouterr().err
+    assert not ours.exists()
+    assert "removed" in err and ".a.xml.bt-lsp-k3j_9x0q.tmp" in err
+    assert fresh.exists() and all(p.exists() for p in others)
+    # Without --fix nothing is touched.
+    ours = _put(ours, "<root")
+    os.utime(ours, (1_000_000_000, 1_000_000_000))
+    main(["check", "d"])
+    assert ours.exists()
+
+
+def test_the_temporary_file_has_our_mark(work: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+
+    names: list[str] = []
+    real = os.replace
+
+    def spy(src: str, dst: str) -> None:
+        names.append(os.path.basename(src))
+        real(src, dst)
+
+    _put(work / "a.xml", FIXABLE)
+    monkeypatch.setattr(os, "replace", spy)
+    assert main(["check", "--fix", "a.xml"]) == 0
+    assert len(names) == 1 and re.fullmatch(r"\.a\.xml\.bt-lsp-[a-z0-9_]{8}\.tmp", names[0])
+
+
+def test_a_failed_write_under_fix_exits_2(
+    work: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+
+    def full(src: str, dst: str) -> None:
+        raise OSError(28, "No space left on device")
+
+    path = _put(work / "a.xml", FIXABLE)
+    monkeypatch.setattr(os, "replace", full)
+    assert main(["check", "--fix", "a.xml"]) == 2
+    err = capsys.readouterr().err
+    assert "bt-lsp: not fixing a.xml: cannot write a.xml: No space left on device" in err
+    assert path.read_text(encoding="utf-8") == FIXABLE
+    assert [p.name for p in work.iterdir()] == ["a.xml"]  # no temporary file left
+
+
+def test_a_link_out_of_the_folder_is_not_rewritten(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    outside = _put(work / "elsewhere" / "shared.xml", FIXABLE)
+    inside = _put(work / "d" / "real.xml", FIXABLE)
+    (work / "d" / "link.xml").symlink_to(outside)
+    (work / "d" / "near.xml").symlink_to(inside)  # a link within the folder: fixed
+    assert main(["check", "--fix", "d"]) == 1  # the link's problems remain
+    err = capsys.readouterr().err
+    assert "not fixing d/link.xml: it is a symbolic link to" in err
+    assert "--follow-symlinks" in err
+    assert outside.read_text(encoding="utf-8") == FIXABLE
+    assert inside.read_text(encoding="utf-8") != FIXABLE  # fixed
+    assert main(["check", "--fix", "--follow-symlinks", "d"]) == 0
+    assert outside.read_text(encoding="utf-8") != FIXABLE  # fixed through the link
+    assert (work / "d" / "link.xml").is_symlink()

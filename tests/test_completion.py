@@ -9,9 +9,7 @@ from bt_lsp.ide.completion import Completions, Item, ItemKind, complete
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
-from tests.marks import unmark
-
-CURSOR = "‸"
+from tests.marks import CURSOR, cursor
 
 DOC = """\
 <root BTCPP_format="4">
@@ -41,9 +39,8 @@ DOC = """\
 
 
 def run(marked: str, ctx: Context | None = None) -> tuple[Completions, str, list[tuple[int, int]]]:
-    at = marked.index(CURSOR)
-    offset = at - sum(marked[:at].count(c) for c in "⟦⟧")
-    text, spans = unmark(marked.replace(CURSOR, ""))
+    text, offset, spans = cursor(marked)
+    assert offset >= 0, "no cursor"
     doc = Document(text)
     found = complete(doc, offset, ctx)
     assert found is not None, "no completion"
@@ -76,17 +73,19 @@ def test_after_lt_in_a_tree_offers_node_types_with_required_ports() -> None:
     assert found.context == "tag"
     move = item(found, "MoveBase")
     assert move.kind == ItemKind.NODE and move.detail == "Action (TreeNodesModel)"
-    # Required ports only: goal (input) and result (output, as a {key}); speed has a default.
-    assert move.snippet == 'MoveBase goal="$1" result="{${2:result}}"/>'
-    assert move.insert == 'MoveBase goal="" result="{}"/>'
-    assert "| `goal` | input | `Pose` | required | Where to go |" in move.documentation
+    # The ports without a default only, as tab stops: goal (input) and result (output, as
+    # the key named like it); speed and careful have defaults, which BehaviorTree.CPP uses.
+    assert move.snippet == 'MoveBase goal="${1}" result="{${2:result}}"/>'
+    # Plain text has no tab stops: no empty value (never right), only the output's key.
+    assert move.insert == 'MoveBase result="{result}"/>'
+    assert "\n- `goal`: input, `Pose`, no default; Where to go\n" in move.documentation
     seq = item(found, "Sequence")
     assert seq.snippet == "Sequence>\n\t$0\n</Sequence>"
     assert seq.detail == "Control (built-in)" and BUILTINS["Sequence"].description in (
         seq.documentation
     )
     assert item(found, "Retry3").snippet == "Retry3>\n\t$0\n</Retry3>"
-    assert item(found, "Sleep").snippet == 'Sleep msec="$1"/>'
+    assert item(found, "Sleep").snippet == 'Sleep msec="${1}"/>'
     assert set(BUILTINS) - {"SubTree"} <= set(labels(found))
     assert labels(found).count("SubTree") == 1
 
@@ -95,8 +94,8 @@ def test_subtree_calls_of_each_other_tree_with_their_ports() -> None:
     found, _, _ = run(here("<‸"))
     dock = item(found, "SubTree Dock")
     assert dock.kind == ItemKind.SUBTREE
-    assert dock.snippet == 'SubTree ID="Dock" pose="$1"/>'  # done has a default
-    assert dock.insert == 'SubTree ID="Dock" pose=""/>'
+    assert dock.snippet == 'SubTree ID="Dock" pose="${1}"/>'  # done has a default
+    assert dock.insert == 'SubTree ID="Dock"/>'
     assert "SubTree Main" not in labels(found)  # a tree calling itself never ends
 
 
@@ -143,7 +142,10 @@ def test_ports_of_the_node_then_reserved_attributes() -> None:
     assert {"name", "_skipIf", "_while", "_onSuccess", "_post", "_description"} <= set(got)
     assert "_autoremap" not in got and "ID" not in got
     assert item(found, "result").snippet == 'result="{${1:result}}"'
-    assert item(found, "speed").snippet == 'speed="$1"'
+    # A port with a default gets it, to accept or overwrite; one without, a tab stop.
+    assert item(found, "speed").snippet == 'speed="${1:0.5}"'
+    assert item(found, "speed").insert == 'speed="0.5"'
+    assert item(found, "careful").snippet == 'careful="${1:false}"'
     assert item(found, "speed").detail == "input port: double"
     assert "default `0.5`" in item(found, "speed").documentation
     # Required ports sort first.
@@ -152,7 +154,7 @@ def test_ports_of_the_node_then_reserved_attributes() -> None:
 
 def test_a_half_typed_attribute_name_is_replaced() -> None:
     found, _, _ = run(here("<MoveBase ⟦sp‸⟧"))
-    assert item(found, "speed").insert == 'speed=""'
+    assert item(found, "speed").insert == 'speed="0.5"'
     # Renaming an attribute that has a value inserts the name only.
     found, _, _ = run(here('<MoveBase ⟦sp‸eed⟧="1"/>'))
     assert item(found, "speed").insert == "speed" and item(found, "speed").snippet is None
@@ -160,7 +162,7 @@ def test_a_half_typed_attribute_name_is_replaced() -> None:
 
 def test_attribute_inserted_before_another_gets_a_space() -> None:
     found, _, _ = run(here('<MoveBase ‸goal="1"/>'))
-    assert item(found, "speed").insert == 'speed="" '
+    assert item(found, "speed").insert == 'speed="0.5" '
 
 
 def test_subtree_and_explicit_nodes() -> None:
@@ -286,8 +288,9 @@ def test_no_keys_in_names_and_ids() -> None:
     "text",
     [
         "‸",
-        "<root>‸</root>",
         "<root>text ‸</root>",
+        "<root><BehaviorTree ID='T'><AlwaysSuccess/>‸</BehaviorTree></root>",
+        "<root><BehaviorTree ID='T'><Inverter><X/>‸</Inverter></BehaviorTree></root>",
         "<root><!-- <‸ --></root>",
         '<root BTCPP_format="4"‸>',
         "<root/>‸",
@@ -295,7 +298,50 @@ def test_no_keys_in_names_and_ids() -> None:
 )
 def test_nothing_outside_a_context(text: str) -> None:
     at = text.index(CURSOR)
+    found = complete(Document(text.replace(CURSOR, "")), at)
+    assert found is None or found.items == []  # (a full tree or decorator: nothing fits)
+
+
+# --- no '<' typed: an empty line, between tags -----------------------------------------------
+
+
+def test_an_empty_line_in_a_control_node_offers_node_types_with_their_lt() -> None:
+    found, _, _ = run(here("⟦⟧‸"))
+    assert found.context == "text"
+    move = item(found, "MoveBase")
+    assert move.snippet == '<MoveBase goal="${1}" result="{${2:result}}"/>'
+    assert move.insert == '<MoveBase result="{result}"/>'
+    assert move.filter == "MoveBase"  # what the client matches the typed word against
+    assert item(found, "Sequence").snippet == "<Sequence>\n\t$0\n</Sequence>"
+    assert item(found, "SubTree Dock").insert == '<SubTree ID="Dock"/>'
+    assert set(BUILTINS) - {"SubTree"} <= set(labels(found))
+
+
+def test_a_word_typed_between_tags_is_replaced() -> None:
+    found, _, _ = run(here("⟦Mo‸⟧"))
+    assert item(found, "MoveBase").insert.startswith("<MoveBase ")
+    text = DOC.format(here="").replace("<Sequence>\n", "<Sequence>⟦⟧‸")
+    found, _, _ = run(text)  # right after a start tag's '>'
+    assert "Fallback" in labels(found)
+    # Not in the indentation before a tag, where no new element goes.
+    text = here("").replace("      <MoveBase goal", "  ‸    <MoveBase goal")
+    at = text.index(CURSOR)
     assert complete(Document(text.replace(CURSOR, "")), at) is None
+
+
+def test_between_tags_elsewhere_offers_what_fits_there() -> None:
+    found, _, _ = run("<root>⟦⟧‸</root>")
+    assert labels(found) == ["BehaviorTree", "TreeNodesModel", "include"]
+    assert item(found, "include").snippet == '<include path="$1"/>'
+    found, _, _ = run("<root><TreeNodesModel>\n  ⟦⟧‸\n</TreeNodesModel></root>")
+    assert labels(found) == ["Action", "Condition", "Control", "Decorator", "SubTree"]
+    # An empty tree takes one child; a control node any number.
+    found, _, _ = run("<root><BehaviorTree ID='T'>⟦⟧‸</BehaviorTree></root>")
+    assert "Sequence" in labels(found)
+    found, _, _ = run(
+        "<root><BehaviorTree ID='T'><Sequence><X/>⟦⟧‸</Sequence></BehaviorTree></root>"
+    )
+    assert "Sequence" in labels(found)
 
 
 def test_every_prefix_and_offset_is_safe() -> None:

@@ -14,8 +14,8 @@ from bt_lsp.project.config import (
     find_config,
     load_config,
 )
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
 from bt_lsp.rules.codes import Severity
 
 
@@ -158,21 +158,21 @@ def test_layer_precedence_flags_over_file_over_editor(tmp_path: Path) -> None:
         btcpp="4",
         debounce_ms=7,
     )
-    ws = Workspace([tmp_path], editor)
+    ws = ProjectIndex([tmp_path], editor)
     s = ws.settings_for(tmp_path / "t.xml")
     assert s.btcpp == "3"  # the file over the editor
     assert s.models == (tmp_path / "cat.xml",)
     # Severities merge code by code: the editor's other codes stay.
     assert s.severity == {"unknown-node": Severity.WARNING, "missing-format": None}
     assert s.debounce_ms == 7  # what the file leaves unset
-    flags = Workspace([tmp_path], editor, overrides=Layer(btcpp="4", models=(Path("/m.xml"),)))
+    flags = ProjectIndex([tmp_path], editor, overrides=Layer(btcpp="4", models=(Path("/m.xml"),)))
     s = flags.settings_for(tmp_path / "t.xml")
     assert s.btcpp == "4" and s.models == (Path("/m.xml"),)
 
 
 def test_broken_file_is_an_error_and_the_editor_settings_stay(tmp_path: Path) -> None:
     write(tmp_path / "bt-lsp.toml", "btcpp = [\n")
-    ws = Workspace([tmp_path], Settings(btcpp="4"))
+    ws = ProjectIndex([tmp_path], Settings(btcpp="4"))
     assert ws.settings_for(tmp_path / "t.xml").btcpp == "4"
     [err] = ws.config_errors()
     assert err.path == tmp_path / "bt-lsp.toml"
@@ -188,7 +188,7 @@ def test_explicit_file_applies_everywhere(tmp_path: Path) -> None:
     explicit = write(tmp_path / "elsewhere.toml", 'btcpp = "3"\n')
     configs = Configs(explicit)
     assert configs.path_for(tmp_path / "near" / "t.xml") == explicit
-    ws = Workspace([tmp_path], configs=configs)
+    ws = ProjectIndex([tmp_path], configs=configs)
     assert ws.settings_for(tmp_path / "near" / "t.xml").btcpp == "3"
 
 

@@ -135,14 +135,22 @@ def deny_access(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
             raise PermissionError(13, "Permission denied", os.fspath(target))
 
     def guarded_open(file: Any, *args: Any, **kwargs: Any) -> Any:
-        refuse(file)
+        if not isinstance(file, int):  # a descriptor was checked when it was opened
+            refuse(file)
         return real_open(file, *args, **kwargs)
+
+    real_os_open = os.open
+
+    def guarded_os_open(file: Any, *args: Any, **kwargs: Any) -> int:
+        refuse(file)
+        return real_os_open(file, *args, **kwargs)
 
     def guarded_mkstemp(*args: Any, dir: Any = None, **kwargs: Any) -> Any:
         refuse(os.path.join(dir or os.getcwd(), "x"))
         return real_mkstemp(*args, dir=dir, **kwargs)
 
     monkeypatch.setattr(fileio, "open", guarded_open, raising=False)
+    monkeypatch.setattr(os, "open", guarded_os_open)
     monkeypatch.setattr(tempfile, "mkstemp", guarded_mkstemp)
 
 

@@ -367,15 +367,15 @@ def test_hover_tells_what_the_fix_renames_and_leaves() -> None:
     doc = Document(AUTOREMAP)
     found = hover_at(doc, _diag_at(doc, "bad.port", 2).start)
     assert found is not None
-    assert "Suggested replacement: `bad_port` (the quick fix renames 1 place)" in found.markdown
+    assert "Suggested replacement: `bad_port` (the quick fix renames 1 place)" in found.text
     assert (
         f"The quick fix leaves the key 'bad.port' in tree 'Sub' as it is: {AUTOREMAP_WHY}"
-        in found.markdown
+        in found.text
     )
     doc = Document(PORTS)
     found = hover_at(doc, _diag_at(doc, 'name="bad.port"').start + len('name="'))
     assert found is not None
-    assert "Suggested replacement: `bad_port` (the quick fix renames 4 places)" in found.markdown
+    assert "Suggested replacement: `bad_port` (the quick fix renames 4 places)" in found.text
 
 
 def test_a_new_name_that_would_merge_two_keys_is_passed_over() -> None:
@@ -428,5 +428,17 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
     assert apply_edits(tree.text, fix.other_edits["/ws/sub.xml"]) == tree.text.replace(
         "{bad.port}", "{bad_port}"
     )
-    # fix_all changes its own document only.
-    assert fix_all(models, own_diagnostics(models)).edits == list(fix.edits)
+    # fix_all makes the same edits, in both documents.
+    both = fix_all(models, own_diagnostics(models), {"/ws/sub.xml": tree})
+    assert both.edits == list(fix.edits)
+    assert both.other_edits == fix.other_edits
+    # Without the document defining the tree, the port is left as it is: renaming the
+    # declaration alone would disconnect it from the tree's key.
+    alone = fix_all(models, own_diagnostics(models))
+    assert alone.edits == [] and alone.other_edits == {}
+    assert alone.notes == [
+        "left 'bad.port' as it is: the tree 'Sub' is not defined in the workspace (it comes "
+        "from elsewhere, such as an installed package, and keeps its ID there); rename it "
+        "where it is defined first, then this reference"
+    ]
+    assert fixes_for_name(models, _diag_at(models, "bad.port")) == []

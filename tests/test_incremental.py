@@ -17,7 +17,7 @@ from typing import Any
 
 import pytest
 
-from bt_lsp.project.workspace import Workspace
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import facts_of
 from bt_lsp.rules.diagnostics import own_diagnostics
@@ -125,14 +125,14 @@ def test_workspace_diagnostics_after_edits_equal_fresh_ones(seed: int, tmp_path:
     main, models = tmp_path / "main.xml", tmp_path / "models.xml"
     main.write_text(MAIN, encoding="utf-8")
     models.write_text(MODELS, encoding="utf-8")
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     docs = {main: Document(MAIN, str(main)), models: Document(MODELS, str(models))}
     for path, doc in docs.items():
         ws.open(path, doc)
         ws.diagnostics(path, doc)
     for _ in range(15):
         _edit(rng, docs[rng.choice((main, models))])
-        fresh_ws = Workspace([tmp_path])
+        fresh_ws = ProjectIndex([tmp_path])
         fresh = {p: Document(d.text, str(p)) for p, d in docs.items()}
         for p, d in fresh.items():
             fresh_ws.open(p, d)

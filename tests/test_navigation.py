@@ -17,25 +17,13 @@ from bt_lsp.ide.places import Place
 from bt_lsp.ide.references import highlights, references
 from bt_lsp.ide.rename import RenameRefused, prepare_rename, rename
 from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
-from bt_lsp.project.workspace import Workspace, links, normalize
+from bt_lsp.project.index import ProjectIndex, links, normalize
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
-from tests.marks import unmark
-
-CURSOR = "‸"
-
-
-def parse(marked: str) -> tuple[str, int, list[tuple[int, int]]]:
-    """The text, the cursor offset (``‸``; -1 without one) and the marked spans."""
-    at = marked.find(CURSOR)
-    offset = -1
-    if at != -1:
-        offset = at - sum(marked[:at].count(c) for c in "⟦⟧")
-    text, spans = unmark(marked.replace(CURSOR, ""))
-    return text, offset, spans
+from tests.marks import cursor
 
 
 def spans_of(places: list[Place], path: str | None = None) -> list[tuple[int, int]]:
@@ -86,7 +74,7 @@ def doc_with(**marks: str) -> str:
 
 
 def at(marked: str) -> tuple[Document, int, list[tuple[int, int]]]:
-    text, offset, spans = parse(marked)
+    text, offset, spans = cursor(marked)
     return Document(text), offset, spans
 
 
@@ -180,7 +168,7 @@ def test_definition_across_files_prefers_the_include_closure(tmp_path: Path) -> 
         tmp_path / "a_other.xml",
         '<root BTCPP_format="4"><BehaviorTree ID="Dock"><Nav/></BehaviorTree></root>',
     )
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     doc = ws.document(main)
     assert doc is not None
     others = {str(p): d for p, d in ws.bt_documents() if p != main}

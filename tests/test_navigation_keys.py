@@ -12,7 +12,8 @@ from bt_lsp.ide.references import highlights, references
 from bt_lsp.ide.rename import RenamePlan, RenameRefused, prepare_rename, rename
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
-from tests.test_navigation import at, parse
+from tests.marks import cursor
+from tests.test_navigation import at
 
 # Tree "Main" uses the key "target" in port values and in every kind of script; tree
 # "Other" uses a key of the same name in its own blackboard.
@@ -67,7 +68,7 @@ def refused(doc: Document, off: int, new: str, reason: str) -> str:
 
 
 def test_a_key_is_a_whole_port_value_or_a_script_identifier() -> None:
-    text, _, spans = parse(KEYS)
+    text, _, spans = cursor(KEYS)
     doc = Document(text)
     main = next(i for i, el in enumerate(doc.model.elements) if el.value("ID") == "Main")
     uses = [k for k in key_uses(doc, main) if k.key == "target"]
@@ -105,7 +106,7 @@ def test_same_key_as_the_port() -> None:
     ("needle", "into"), [("{ ⟦target", 4), ('if="⟦target', 10), ("{⟦target⟧}", 8)]
 )
 def test_prepare_rename_of_a_key_gives_its_span_and_text(needle: str, into: int) -> None:
-    text, off, _ = parse(marked_at(KEYS, needle, into))
+    text, off, _ = cursor(marked_at(KEYS, needle, into))
     target = prepare_rename(Document(text), off)
     assert target is not None and target.key is not None and target.ref is None
     assert text[target.start : target.end] == target.placeholder == "target"
@@ -126,7 +127,7 @@ def test_no_key_in_strings_literal_texts_or_models() -> None:
         ('{target}" _while', 3),  # a literal text with braces
         ("done := true", 10),  # the literal true
     ]:
-        text, off, _ = parse(marked_at(KEYS, needle, into))
+        text, off, _ = cursor(marked_at(KEYS, needle, into))
         doc = Document(text)
         assert key_at(doc, off) is None, needle
         assert prepare_rename(doc, off) is None, needle
@@ -138,7 +139,7 @@ def test_no_key_in_strings_literal_texts_or_models() -> None:
     )
     assert key_at(doc, off) is None and prepare_rename(doc, off) is None
     # An identifier that starts like the key is another key.
-    text, off, _ = parse(marked_at(KEYS, "target_2", 6))
+    text, off, _ = cursor(marked_at(KEYS, "target_2", 6))
     found = key_at(Document(text), off)
     assert found is not None and found.key == "target_2"
 
@@ -170,7 +171,7 @@ def test_a_port_with_a_bad_name_gives_a_key_and_ignored_attributes_do_not() -> N
 def test_rename_changes_the_key_in_ports_and_scripts_of_its_tree_only(
     needle: str, into: int
 ) -> None:
-    text, off, spans = parse(marked_at(KEYS, needle, into))
+    text, off, spans = cursor(marked_at(KEYS, needle, into))
     doc = Document(text)
     plan = rename(doc, off, "goal_pose")
     assert edit_spans(plan, "goal_pose") == spans
@@ -193,7 +194,7 @@ def test_rename_changes_the_key_in_ports_and_scripts_of_its_tree_only(
     ("needle", "into"), [("{⟦target", 4), ('_successIf="⟦target', 15), ("⟦target⟧=0", 2)]
 )
 def test_references_and_highlights_are_what_rename_changes(needle: str, into: int) -> None:
-    text, off, spans = parse(marked_at(KEYS, needle, into))
+    text, off, spans = cursor(marked_at(KEYS, needle, into))
     doc = Document(text)
     assert edit_spans(rename(doc, off, "t2"), "t2") == spans
     assert place_spans(references(doc, off)) == spans
@@ -239,7 +240,7 @@ def test_rename_writes_out_a_same_key() -> None:
 
 
 def test_rename_of_a_key_to_the_same_name_changes_nothing() -> None:
-    text, off, _ = parse(marked_at(KEYS, "{⟦target", 4))
+    text, off, _ = cursor(marked_at(KEYS, "{⟦target", 4))
     doc = Document(text)
     plan = rename(doc, off, "target")
     assert plan is not None and apply_edits(text, plan.edits) == text
@@ -269,7 +270,7 @@ def test_rename_of_a_key_to_the_same_name_changes_nothing() -> None:
     ],
 )
 def test_rename_of_a_key_refuses_a_bad_new_name(new: str, reason: str) -> None:
-    text, off, _ = parse(marked_at(KEYS, "{⟦target", 4))
+    text, off, _ = cursor(marked_at(KEYS, "{⟦target", 4))
     message = refused(Document(text), off, new, reason)
     assert message.startswith("Cannot rename to '")
 
@@ -454,8 +455,8 @@ def test_a_key_that_is_a_port_of_its_tree_is_renamed_with_the_port(
 ) -> None:
     dock_marked = marked_at(DOCK, needle, into) if where == "dock" else DOCK
     caller_marked = marked_at(CALLER, needle, into) if where == "caller" else CALLER
-    dock_text, dock_off, dock_spans = parse(dock_marked)
-    caller_text, caller_off, caller_spans = parse(caller_marked)
+    dock_text, dock_off, dock_spans = cursor(dock_marked)
+    caller_text, caller_off, caller_spans = cursor(caller_marked)
     dock, caller = Document(dock_text), Document(caller_text)
     if where == "dock":
         doc, off, spans, other, other_path, other_spans = (
@@ -497,13 +498,13 @@ def test_a_key_that_is_a_port_of_its_tree_is_renamed_with_the_port(
 
 
 def test_a_key_that_is_a_port_follows_the_port_rules() -> None:
-    text, off, _ = parse(marked_at(DOCK, "{⟦pose", 4))
+    text, off, _ = cursor(marked_at(DOCK, "{⟦pose", 4))
     doc = Document(text)
     refused(doc, off, "_pose", "must start with an ASCII letter")
     refused(doc, off, "speed", "already has a port with that name")
     # Renaming the port to a key the subtree already uses would merge the two.
     text = DOCK.replace("{speed}", "{mine}")
-    text, off, _ = parse(marked_at(text, 'name="⟦pose', 9))
+    text, off, _ = cursor(marked_at(text, 'name="⟦pose', 9))
     refused(Document(text), off, "mine", "tree 'Dock' already uses a key 'mine'")
 
 

@@ -184,6 +184,20 @@ def test_ports_on_request() -> None:
     assert [(p.name, p.is_key) for p in retry.ports] == [("num_attempts", False)]
 
 
+def test_unclosed_elements_end_at_the_text_end() -> None:
+    text = '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence><AlwaysSuccess/>'
+    doc = Document(text)
+    tree = main_tree(doc.model)
+    assert tree is not None
+    pic = build_picture(doc.model, tree, diagnostics=analyze(doc), text_length=len(text))
+    assert [(n.type, n.start, n.end) for n in pic.nodes] == [
+        ("T", text.index("<BehaviorTree"), len(text)),
+        ("Sequence", text.index("<Sequence"), len(text)),
+        ("AlwaysSuccess", text.index("<AlwaysSuccess"), len(text)),
+    ]
+    assert pic.nodes[1].severity == Severity.ERROR  # the unclosed tag is its problem
+
+
 def test_tree_at_and_main_tree() -> None:
     doc = Document(SAMPLE)
     walk_at = SAMPLE.index('<Action ID="Move"')

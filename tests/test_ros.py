@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from bt_lsp.project.index import ProjectIndex as Workspace
 from bt_lsp.project.ros import is_catalog
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
 from bt_lsp.syntax.document import Document
 
 CATALOG = (

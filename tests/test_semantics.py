@@ -166,6 +166,13 @@ CASES: list[tuple[str, str, Expected]] = [
         [("unknown-subtree", E)],
     ),
     (
+        "SubTree ID breaking a name rule and naming no tree: one problem",
+        T('<SubTree ID="No where"/>'),
+        [],
+    ),
+    ("root with nothing in it", '<⟦root⟧ BTCPP_format="4"></root>', [("no-tree", W)]),
+    ("root with only an include", R('<include path="other.xml"/>'), []),
+    (
         "several trees, no main_tree_to_execute",
         '<⟦root⟧ BTCPP_format="4">\n'
         '<BehaviorTree ID="A"><SubTree ID="B"/></BehaviorTree>\n'
@@ -493,7 +500,7 @@ CASES: list[tuple[str, str, Expected]] = [
         [("missing-required-port", E)],
     ),
     ("output ports are not required", T('<LoopInt queue="1;2;3"><AlwaysSuccess/></LoopInt>'), []),
-    ("required declared port missing", TM("<⟦Say⟧/>"), [("missing-required-port", W)]),
+    ("required declared port missing", TM("<⟦Say⟧/>"), [("missing-required-port", H)]),
     (
         "attribute neither port nor reserved",
         T('<AlwaysSuccess ⟦_skipif⟧="x"/>'),
@@ -503,7 +510,7 @@ CASES: list[tuple[str, str, Expected]] = [
     (
         "unknown underscore attribute without suggestion",
         T('<AlwaysSuccess ⟦_color⟧="red"/>'),
-        [("unknown-attribute", W)],
+        [("unknown-attribute", H)],
     ),
     (
         "attribute with a non-ASCII first letter",
@@ -656,8 +663,9 @@ def test_unknown_node_is_an_error_with_a_catalog() -> None:
 
 def test_models_of_other_workspace_files_count() -> None:
     doc = Document(T('<MoveBase goal="{g}"/>'))
-    other = Document(
+    other = Document(  # a tree file with its <TreeNodesModel>: advisory
         R(
+            '<BehaviorTree ID="Other"><AlwaysSuccess/></BehaviorTree>'
             '<TreeNodesModel><Action ID="MoveBase"><input_port name="goal"/>'
             "</Action></TreeNodesModel>"
         )
@@ -667,7 +675,7 @@ def test_models_of_other_workspace_files_count() -> None:
     assert semantic(doc, ctx) == []
     doc2, want = expect(
         T('<MoveBase ⟦gaol⟧="{g}"/>').replace("<MoveBase", "<⟦MoveBase⟧"),
-        [("missing-required-port", W), ("undeclared-port", W)],
+        [("missing-required-port", H), ("undeclared-port", W)],
     )
     assert semantic(doc2, Context.combine(doc2, [("/w/other.xml", other, False)])) == want
 

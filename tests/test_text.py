@@ -433,3 +433,16 @@ def test_positions_of_count_lines_without_an_index() -> None:
         12: (4, 0),
     }
     assert positions_of(text, [8], "utf-8") == {8: (3, 3)}
+
+
+@settings(max_examples=500)
+@given(
+    st.text(st.sampled_from(list("ab\r\n\t😋é\u2028")), max_size=40),
+    st.lists(st.integers(-3, 45), max_size=20),
+    st.sampled_from(["utf-8", "utf-16", "utf-32"]),
+)
+def test_positions_in_one_pass_are_position_of_each(
+    text: str, offsets: list[int], encoding: Encoding
+) -> None:
+    lines = LineIndex(text)
+    assert lines.positions(offsets, encoding) == {o: lines.position(o, encoding) for o in offsets}

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.syntax.document import Document
 
 
@@ -20,7 +20,7 @@ def write(path: Path, text: str) -> Path:
     return normalize(path)
 
 
-def diags(ws: Workspace, path: Path) -> list[tuple[str, str]]:
+def diags(ws: ProjectIndex, path: Path) -> list[tuple[str, str]]:
     doc = ws.document(path)
     assert doc is not None
     return [(d.code, doc.text[d.start : d.end]) for d in ws.include_diagnostics(path, doc)]
@@ -30,20 +30,20 @@ def test_include_resolved_relative_to_the_including_file(tmp_path: Path) -> None
     a = write(tmp_path / "a.xml", tree(includes=("trees/b.xml",)))
     b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
     c = write(tmp_path / "trees" / "c.xml", tree())
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert ws.include_closure(a) == [b, c]
     assert diags(ws, a) == []
 
 
 def test_missing_include_is_flagged_at_its_path(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", tree(includes=("nope.xml",)))
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert diags(ws, a) == [("include-not-found", "nope.xml")]
 
 
 def test_self_include_by_bare_name_is_a_cycle(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", tree(includes=("a.xml",)))
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert diags(ws, a) == [("include-cycle", "a.xml")]
 
 
@@ -51,7 +51,7 @@ def test_every_file_of_a_cycle_is_flagged_at_its_include(tmp_path: Path) -> None
     a = write(tmp_path / "a.xml", tree(includes=("trees/b.xml",)))
     b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
     c = write(tmp_path / "trees" / "c.xml", tree(includes=("../a.xml",)))
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert diags(ws, a) == [("include-cycle", "trees/b.xml")]
     assert diags(ws, b) == [("include-cycle", "c.xml")]
     assert diags(ws, c) == [("include-cycle", "../a.xml")]
@@ -64,7 +64,7 @@ def test_every_file_of_a_cycle_is_flagged_at_its_include(tmp_path: Path) -> None
 def test_open_document_overrides_disk_and_dependents(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", tree(includes=("b.xml",)))
     b = write(tmp_path / "b.xml", tree())
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     ws.open(a, Document(tree(includes=("missing.xml",)), str(a)))
     assert diags(ws, a) == [("include-not-found", "missing.xml")]
     ws.open(a, Document(tree(includes=("b.xml",)), str(a)))
@@ -74,7 +74,7 @@ def test_open_document_overrides_disk_and_dependents(tmp_path: Path) -> None:
 
 def test_file_changed_invalidates_cache(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", tree(includes=("b.xml",)))
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert diags(ws, a) == [("include-not-found", "b.xml")]
     write(tmp_path / "b.xml", tree())
     ws.file_changed(tmp_path / "b.xml")
@@ -84,9 +84,9 @@ def test_file_changed_invalidates_cache(tmp_path: Path) -> None:
 def test_ros_pkg_resolved_through_settings(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", '<root><include ros_pkg="pkg" path="t/b.xml"/></root>')
     write(tmp_path / "share" / "pkg" / "t" / "b.xml", tree())
-    ws = Workspace([tmp_path], Settings(ros_packages={"pkg": str(tmp_path / "share" / "pkg")}))
+    ws = ProjectIndex([tmp_path], Settings(ros_packages={"pkg": str(tmp_path / "share" / "pkg")}))
     assert len(ws.include_closure(a)) == 1
-    ws2 = Workspace([tmp_path])
+    ws2 = ProjectIndex([tmp_path])
     assert ws2.include_closure(a) == []  # unmapped: the include-ros-pkg rule reports it
 
 
@@ -95,7 +95,7 @@ def test_workspace_files_skip_build_and_hidden_dirs_and_non_bt(tmp_path: Path) -
     write(tmp_path / "build" / "x.xml", tree())
     write(tmp_path / ".git" / "y.xml", tree())
     write(tmp_path / "package.xml", "<package><name>x</name></package>")
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert [p for p, _ in ws.bt_documents()] == [a]
 
 
@@ -104,5 +104,5 @@ def test_include_closure_is_bounded_and_iterative(tmp_path: Path) -> None:
     for i in range(n):
         write(tmp_path / f"f{i}.xml", tree(includes=(f"f{i + 1}.xml",)))
     write(tmp_path / f"f{n}.xml", tree())
-    ws = Workspace([tmp_path])
+    ws = ProjectIndex([tmp_path])
     assert len(ws.include_closure(normalize(tmp_path / "f0.xml"))) == n

@@ -37,16 +37,16 @@ TREE = """<root BTCPP_format="4" main_tree_to_execute="Main Tree">
   </BehaviorTree>
 </root>
 """
-REL = "src/robot_nodes/trees/mission.xml"
 
 
 def test_vscode_hover_of_a_node_learned_from_cpp(tmp_path: Path) -> None:
     missing = _missing_setup()
     if missing:
         pytest.fail(f"the VS Code e2e setup is missing: {', '.join(missing)}. Run `bash {SETUP}`.")
-    with _code_server(tmp_path, {"README.md": "C++ nodes\n"}) as cs:
+    with _code_server(tmp_path, {"mission.xml": TREE}) as cs:
+        # The tree is at the top (the driver opens it from the Explorer), in no package:
+        # it sees the C++ of the whole workspace.
         shutil.copytree(PROJECT / "src", cs.workspace / "src")
-        (cs.workspace / REL).write_text(TREE, encoding="utf-8")
         shots = tmp_path / "shots"
         shots.mkdir()
         line = 5

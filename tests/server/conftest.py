@@ -530,6 +530,17 @@ def apply_changes(
     return text
 
 
+def plain(
+    e: types.TextEdit | types.AnnotatedTextEdit | types.SnippetTextEdit,
+) -> types.TextEdit:
+    """A text edit of a ``documentChanges`` entry as a plain one (an annotated edit of
+    another file is applied the same way once confirmed)."""
+    if isinstance(e, types.TextEdit):
+        return e
+    assert isinstance(e, types.AnnotatedTextEdit), e
+    return types.TextEdit(range=e.range, new_text=e.new_text)
+
+
 def workspace_edits(edit: types.WorkspaceEdit, uri: str) -> list[types.TextEdit]:
     """The text edits of ``uri`` in a WorkspaceEdit (``changes`` or ``documentChanges``)."""
     out: list[types.TextEdit] = []
@@ -538,7 +549,7 @@ def workspace_edits(edit: types.WorkspaceEdit, uri: str) -> list[types.TextEdit]
     for dc in edit.document_changes or []:
         assert isinstance(dc, types.TextDocumentEdit), dc
         if dc.text_document.uri == uri:
-            out.extend(e for e in dc.edits if isinstance(e, types.TextEdit))
+            out.extend(plain(e) for e in dc.edits)
     return out
 
 

@@ -342,6 +342,11 @@ MANY = (
 )
 
 
+def _names(diags: list[types.Diagnostic]) -> list[str]:
+    """The names that the name diagnostics are about, in order."""
+    return [str(d.data["name"]) for d in names_only(diags) if isinstance(d.data, dict)]
+
+
 def _ids(text: str) -> tuple[set[str], set[str]]:
     """Tree IDs, and IDs of explicit Action/Condition nodes and models."""
     root = etree.fromstring(text.encode("utf-8"))
@@ -372,9 +377,11 @@ async def test_fix_all(client: BtClient, only: list[str] | None) -> None:
     root = etree.fromstring(new.encode("utf-8"))
     assert root.get("main_tree_to_execute") in trees
     fixed = client.open(new, name="fixed")
-    assert names_only(await client.diags(fixed, 1)) == []
+    # Left as it is: the node type that no <TreeNodesModel> declares (registered in code
+    # bt-lsp cannot see, under its old name).
+    assert _names(await client.diags(fixed, 1)) == ["Wait.For"]
     # The same through the server's own copy, as one didChange.
-    assert names_only(await _send_edits(client, uri, 2, text, fix_all[0])) == []
+    assert _names(await _send_edits(client, uri, 2, text, fix_all[0])) == ["Wait.For"]
 
 
 async def test_quickfix_only_excludes_fix_all(client: BtClient) -> None:
@@ -396,7 +403,7 @@ async def test_fix_all_on_a_document_that_is_not_well_formed(client: BtClient) -
     assert len(actions) == 1
     new = await _apply(client, uri, text, actions[0])
     fixed = client.open(new, name="fixed")
-    assert names_only(await client.diags(fixed, 1)) == []
+    assert _names(await client.diags(fixed, 1)) == ["Check&#x3F;", "Wait.For"]
 
 
 @clients("vscode", "nvim-0.11")

@@ -65,9 +65,10 @@ def _text(hover: types.Hover) -> str:
 
 
 def _row(md: str, column: int) -> str:
-    """The table row of the offending character at (1-based) ``column`` of the name."""
-    rows = [line for line in md.splitlines() if re.match(rf"\|\s*{column}\s*\|", line)]
+    """The list item of the offending character at (1-based) ``column`` of the name."""
+    rows = [line for line in md.splitlines() if re.match(rf"- column {column} \(", line)]
     assert len(rows) == 1, md
+    assert not any(line.startswith("|") for line in md.splitlines())  # no table
     return rows[0]
 
 

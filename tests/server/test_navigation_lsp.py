@@ -25,6 +25,8 @@ from pygls.uris import from_fs_path, to_fs_path
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
+from tests.server.conftest import plain
+
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 # The built-in catalog is written to the cache folder: keep it out of the user's.
@@ -201,9 +203,7 @@ def edits_by_uri(edit: types.WorkspaceEdit) -> dict[str, list[types.TextEdit]]:
         out.setdefault(uri, []).extend(edits)
     for dc in edit.document_changes or []:
         assert isinstance(dc, types.TextDocumentEdit)
-        out.setdefault(dc.text_document.uri, []).extend(
-            e for e in dc.edits if isinstance(e, types.TextEdit)
-        )
+        out.setdefault(dc.text_document.uri, []).extend(plain(e) for e in dc.edits)
     return out
 
 
@@ -689,10 +689,10 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         assert move.text_edit.range == rng(lsp, C_XML, (at, at))
         if lsp.snippets:
             assert move.insert_text_format == types.InsertTextFormat.Snippet
-            assert move.text_edit.new_text == 'MoveBase goal="$1"/>'
-        else:
+            assert move.text_edit.new_text == 'MoveBase goal="${1}"/>'
+        else:  # no tab stops, so no empty value: the missing port is then reported
             assert move.insert_text_format == types.InsertTextFormat.PlainText
-            assert move.text_edit.new_text == 'MoveBase goal=""/>'
+            assert move.text_edit.new_text == "MoveBase/>"
         assert {"Sequence", "Fallback", "SubTree", "SubTree Dock", "SubTree Main"} <= set(items)
         doc = move.documentation
         if lsp.markdown:
@@ -705,6 +705,9 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         assert {"goal", "speed", "name", "_skipIf", "_onSuccess"} <= set(items)
         assert items["speed"].detail == "input port: double"
+        speed = items["speed"].text_edit
+        assert isinstance(speed, types.TextEdit)  # its default, to accept or overwrite
+        assert speed.new_text == ('speed="${1:0.5}"' if lsp.snippets else 'speed="0.5"')
         # Tree IDs in SubTree ID (not the tree itself) and main_tree_to_execute.
         at = C_XML.index('<SubTree ID=""') + 13
         got = await complete_at(lsp, uri, C_XML, at)
@@ -717,10 +720,17 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         items = by_label(await complete_at(lsp, uri, C_XML, at))
         assert set(items) == {"here"}
         assert items["here"].text_edit.new_text == "here}"  # type: ignore[union-attr]
-        # Between elements: nothing.
-        at = C_XML.index("      <\n")
-        got = await complete_at(lsp, uri, C_XML, at)
-        assert not got.items
+        # Between elements, no '<' typed (Ctrl+Space at the end of a line): the node
+        # types, each with its '<', inserted at the cursor.
+        at = C_XML.index('<SubTree ID=""/>') + len('<SubTree ID=""/>')
+        items = by_label(await complete_at(lsp, uri, C_XML, at))
+        move = items["MoveBase"]
+        assert isinstance(move.text_edit, types.TextEdit)
+        assert move.text_edit.range == rng(lsp, C_XML, (at, at))
+        assert move.filter_text == "MoveBase"
+        expected = '<MoveBase goal="${1}"/>' if lsp.snippets else "<MoveBase/>"
+        assert move.text_edit.new_text == expected
+        assert {"Sequence", "Fallback", "SubTree Dock"} <= set(items)
     finally:
         close_doc(lsp, uri)
 
@@ -772,6 +782,8 @@ async def test_hover_shows_the_ports_of_a_model_declared_in_another_file(lsp: Na
     assert got is not None and isinstance(got.contents, types.MarkupContent)
     md = got.contents.value
     assert "Action declared in the TreeNodesModel of" in md and "b.xml" in md
-    assert "| `goal` | input | `Pose` | required | Where to go |" in md
-    assert "| `speed` | input | `double` | `0.5` | How & fast |" in md
+    # A list, one port a line, narrow enough for any hover (a wide table is cut off).
+    assert "\n- `goal`: input, `Pose`, no default; Where to go\n" in md
+    assert md.endswith("\n- `speed`: input, `double`, default `0.5`; How & fast")
+    assert "|" not in md
     assert got.range == rng(lsp, A_XML, span(A_XML, "MoveBase"))

@@ -22,15 +22,35 @@ let client: LanguageClient | undefined;
 let queue: Promise<void> = Promise.resolve();
 
 /**
- * A LanguageClient that, until the server has started, only logs its errors: if the start fails,
- * one notification that says how to install the server replaces the client's own three or four.
+ * A LanguageClient whose errors go to the output with their details, and to a notification
+ * only as one sentence. Until the server has started it only logs them: if the start fails, one
+ * notification that says how to install the server replaces the client's own three or four. A
+ * notification that could not be sent (the connection is down) is only logged: the client says
+ * itself when the server stopped, and a stack trace would stay on screen after it recovered.
  */
 class BtLspClient extends LanguageClient {
   starting = true;
 
   override error(message: string, data?: unknown, showNotification: boolean | 'force' = true): void {
-    super.error(message, data, this.starting ? false : showNotification);
+    super.error(message, data, false);
+    if (this.starting || showNotification === false || /^Sending notification /.test(message)) {
+      return;
+    }
+    const showOutput = 'Show Output';
+    const restartServer = 'Restart server';
+    void vscode.window.showErrorMessage(`bt-lsp: ${firstLine(message)}`, showOutput, restartServer).then((choice) => {
+      if (choice === showOutput) {
+        log.show();
+      } else if (choice === restartServer) {
+        void vscode.commands.executeCommand('btLsp.restartServer');
+      }
+    });
   }
+}
+
+/** The first line of a message, without what a stack trace or JSON dump adds below it. */
+function firstLine(message: string): string {
+  return message.split('\n', 1)[0].trim();
 }
 
 function enqueue(work: () => Promise<void>): Promise<void> {
@@ -141,7 +161,7 @@ async function startClient(): Promise<void> {
     // knows that its pending request was dropped; what the process said is in the log.
     const why = /connection got disposed/.test(errorText(error))
       ? 'the server process exited before it answered (its messages are in the bt-lsp output)'
-      : errorText(error);
+      : firstLine(errorText(error));
     showInstallHelp(`could not start ${JSON.stringify(argv)} (${server.origin}): ${why}`, []);
   }
 }
@@ -183,12 +203,17 @@ function showInstallHelp(reason: string, tried: string[]): void {
   }
   const openSettings = 'Open Settings';
   const showOutput = 'Show Output';
+  const restartServer = 'Restart server';
   // Not awaited: the notification stays until the user closes it, and a restart must not wait for that.
-  void vscode.window.showErrorMessage(`bt-lsp: ${reason}. ${help}`, openSettings, showOutput).then((choice) => {
-    if (choice === openSettings) {
-      void openServerCommandSetting();
-    } else if (choice === showOutput) {
-      log.show();
-    }
-  });
+  void vscode.window
+    .showErrorMessage(`bt-lsp: ${reason}. ${help}`, openSettings, showOutput, restartServer)
+    .then((choice) => {
+      if (choice === openSettings) {
+        void openServerCommandSetting();
+      } else if (choice === showOutput) {
+        log.show();
+      } else if (choice === restartServer) {
+        void vscode.commands.executeCommand('btLsp.restartServer');
+      }
+    });
 }

@@ -14,7 +14,12 @@ Output formats:
   (``%SRCROOT%``).
 
 Exit status: 0 without errors, 1 with at least one error-severity diagnostic, 2 when a file
-cannot be read or decoded (the others are still checked).
+cannot be read or decoded, is not a regular file (a FIFO would block), or its fix cannot be
+written (the others are still checked).
+
+``--fix`` removes the temporary files an interrupted ``--fix`` left
+(``.NAME.bt-lsp-XXXXXXXX.tmp``, older than the run), and does not rewrite a file that a
+checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ import json
 import os
 import shutil
 import sys
+import time
 import traceback
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
@@ -45,9 +51,15 @@ from bt_lsp.cli.project import (
 from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
-from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text, write_text_atomic
+from bt_lsp.project.fileio import (
+    DEFAULT_MAX_BYTES,
+    FileError,
+    read_text,
+    stale_temporaries,
+    write_text_atomic,
+)
 from bt_lsp.project.files import collect_files
-from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
@@ -66,9 +78,11 @@ class Options:
     max_bytes: int = DEFAULT_MAX_BYTES
     cpp: bool = True  # learn the node catalog from the C++ of the files' packages
     config: str | None = None  # --config: one configuration file for every file
-    models: tuple[str, ...] = ()  # --models
+    models: tuple[str, ...] = ()  # authoritative node catalogs (--models)
     btcpp: str | None = None  # --btcpp
     verbose: bool = False
+    follow_symlinks: bool = False  # --fix rewrites files linked from outside the folder
+    started: float = field(default_factory=time.time)  # older temporaries are stale
 
 
 def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
@@ -95,8 +109,16 @@ def parse_severities(specs: Iterable[str]) -> dict[str, Severity | None]:
     return out
 
 
-def check_file(path: str, options: Options, workspace: Workspace | None = None) -> FileResult:
-    """Read, analyze and (with ``options.fix``) fix one file, in ``workspace`` if given."""
+def check_file(
+    path: str,
+    options: Options,
+    project: ProjectIndex | None = None,
+    before: Mapping[Path, Document] | None = None,
+    keep: str | None = None,
+) -> FileResult:
+    """Read, analyze and (with ``options.fix``) fix one file, in ``project`` if given;
+    ``before`` are the workspace's documents before any file was fixed; ``keep`` says why
+    the file must not be rewritten, if it must not."""
     result = FileResult(path)
     try:
         decoded = read_text(path, options.max_bytes)
@@ -110,25 +132,29 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
             diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
             result.findings = findings_of(path, doc, diags)
             return result
-        raw = analyze(doc, workspace)
+        raw = analyze(doc, project)
         # The workspace's settings for the file hold the flags' severities over its
         # configuration file's.
         severities = (
             options.severities
-            if workspace is None
-            else workspace.settings_for(normalize(path)).severity
+            if project is None
+            else project.settings_for(normalize(path)).severity
         )
         diags = with_severities(raw, severities)
         if options.fix:
-            outcome = fix_document(decoded, doc, raw, diags, workspace)
+            me = normalize(path)
+            others = {str(p): d for p, d in (before or {}).items() if p != me}
+            outcome = fix_document(decoded, doc, raw, diags, project, others)
             if isinstance(outcome, str):
                 result.not_fixed = outcome
+            elif outcome is not None and keep is not None:
+                result.not_fixed = keep
             elif outcome is not None:
                 write_text_atomic(
                     path, outcome.doc.text, decoded.encoding, decoded.bom, expect=decoded.stamp
                 )
-                if workspace is not None:
-                    workspace.file_changed(path)
+                if project is not None:
+                    project.file_changed(path)
                 fixed_diags = with_severities(outcome.raw, severities)
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
                 result.notes = outcome.notes
@@ -136,6 +162,7 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
         result.findings = findings_of(path, doc, diags)
     except FileError as e:
         result.not_fixed = e.message
+        result.unwritten = True
         result.findings = findings_of(path, doc, diags)
     except Exception as e:
         result.detail = traceback.format_exc()
@@ -146,6 +173,38 @@ def check_file(path: str, options: Options, workspace: Workspace | None = None) 
 
 
 # -- running -----------------------------------------------------------------------------
+
+
+def _remove_stale_temporaries(files: Sequence[str], before: float) -> list[str]:
+    """Remove the temporary files an interrupted ``--fix`` left beside ``files`` (those
+    older than this run); returns them."""
+    removed: list[str] = []
+    for directory in sorted({os.path.dirname(os.path.realpath(f)) for f in files}):
+        for tmp in stale_temporaries(directory, before):
+            try:
+                os.unlink(tmp)
+            except OSError:
+                continue
+            removed.append(tmp)
+    return removed
+
+
+def _linked_from_outside(path: str, roots: Sequence[str]) -> str | None:
+    """Why ``path``, found in one of the folders ``roots``, is not rewritten: it leads
+    through a symbolic link to a file outside that folder (``None`` if it does not)."""
+    here = os.path.abspath(path)
+    real = os.path.realpath(path)
+    for root in roots:
+        top = os.path.abspath(root)
+        if os.path.commonpath([here, top]) != top:
+            continue
+        real_top = os.path.realpath(root)
+        if os.path.commonpath([real, real_top]) != real_top:
+            return (
+                f"it is a symbolic link to {real}, outside {root} "
+                "(--follow-symlinks rewrites such files)"
+            )
+    return None
 
 
 def write(stream: TextIO, text: str) -> None:
@@ -208,13 +267,13 @@ def run(
     err = err if err is not None else sys.stderr
     # The folders named on the command line are the workspace: includes resolve as
     # BehaviorTree.CPP resolves them, and every file's models and trees are known.
-    workspace = project_workspace(paths, options)
+    project = project_workspace(paths, options)
     if options.cpp:
-        workspace.cpp = CppModels(workspace.roots, workspace.packages)
+        project.cpp = CppModels(project.roots, project.packages)
     skipped: Counter[str] = Counter()
 
     def skip(path: str, is_dir: bool) -> bool:
-        why = skip_reason(workspace, path, is_dir)
+        why = skip_reason(project, path, is_dir)
         if why is not None:
             skipped[why] += 1
         return why is not None
@@ -229,7 +288,7 @@ def run(
         write(stream, text)
         stream.flush()
 
-    broken = config_errors(workspace, files)
+    broken = config_errors(project, files)
     if broken:
         for ce in broken:
             where = f"{visible(str(ce.path))}:{ce.line}:{ce.column}"
@@ -246,12 +305,19 @@ def run(
         for why, n in sorted(skipped.items()):
             what = "folder" if why == BUILD_FOLDER else "file"
             say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
-        for line in version_lines(workspace, [f for f in files if f.endswith(".xml")]):
+        for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
+    # What fixes see of the other files: the workspace before any file is fixed.
+    before = dict(project.bt_documents()) if options.fix else None
+    roots = [p for p in paths if os.path.isdir(p)]
+    if options.fix:
+        for tmp in _remove_stale_temporaries(files, options.started):
+            say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        r = check_file(path, options, workspace)
+        keep = None if options.follow_symlinks else _linked_from_outside(path, roots)
+        r = check_file(path, options, project, before, keep)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

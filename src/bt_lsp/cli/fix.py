@@ -8,13 +8,13 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from bt_lsp.cli.results import analyze
 from bt_lsp.ide import name_fixes as fixes
 from bt_lsp.project.fileio import Decoded
-from bt_lsp.project.workspace import Workspace
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules.codes import XML, defined
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
@@ -73,11 +73,14 @@ def fix_document(
     doc: Document,
     raw: list[Diagnostic],
     diags: list[Diagnostic],
-    workspace: Workspace | None = None,
+    project: ProjectIndex | None = None,
+    others: Mapping[str, Document] | None = None,
 ) -> Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
-    fix)."""
-    fix_all = fixes.fix_all(doc, diags)
+    fix).  ``others`` are the other files of the workspace as they were before any was
+    fixed: a name is renamed only with its target, and every file's fixes give a symbol
+    the same new name."""
+    fix_all = fixes.fix_all(doc, diags, others)
     edits = fix_all.edits
     if not edits:
         return None
@@ -95,7 +98,7 @@ def fix_document(
         char = e.object[e.start]
         return f"U+{ord(char):04X} cannot be written in {decoded.encoding.upper()}"
     new_doc = Document(new_text, doc.path)
-    new_raw = analyze(new_doc, workspace)
+    new_raw = analyze(new_doc, project)
     before, after = _xml_counts(raw), _xml_counts(new_raw)
     worse = sorted(code for code in after if after[code] > before[code])
     if worse:

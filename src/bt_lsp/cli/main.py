@@ -83,6 +83,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="override a code's severity: error, warning, information, hint or off "
         "(repeatable; several may be joined with commas)",
     )
+    check.add_argument(
+        "--models",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a node catalog (TreeNodesModel XML that BehaviorTree.CPP exported) to trust as "
+        "what the application registers (repeatable; replaces the configuration's models)",
+    )
     check.add_argument("--no-progress", action="store_true", help="never show the progress bar")
     check.add_argument(
         "--no-cpp",
@@ -103,15 +111,6 @@ def build_parser() -> argparse.ArgumentParser:
         "bt-lsp.toml or pyproject.toml with [tool.bt-lsp] above each file)",
     )
     check.add_argument(
-        "--models",
-        action="append",
-        default=[],
-        metavar="FILE",
-        help="a node catalog: a TreeNodesModel XML (e.g. written by "
-        "writeTreeNodesModelXML) or a Groot2 .btproj (repeatable; replaces the "
-        "configuration's models)",
-    )
-    check.add_argument(
         "--btcpp",
         choices=("auto", "3", "4"),
         help="the BehaviorTree.CPP major version (default: the configuration's, else "
@@ -122,6 +121,11 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="say which files were skipped and which BehaviorTree.CPP version each is "
         "checked against",
+    )
+    check.add_argument(
+        "--follow-symlinks",
+        action="store_true",
+        help="with --fix, also rewrite files that a folder links to from outside it",
     )
     check.set_defaults(subparser=check)
 
@@ -196,9 +200,10 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         max_bytes=args.max_file_size,
         cpp=not args.no_cpp,
         config=args.config,
-        models=tuple(args.models),
+        models=tuple(os.path.abspath(m) for m in args.models),
         btcpp=args.btcpp,
         verbose=args.verbose,
+        follow_symlinks=args.follow_symlinks,
     )
     return check.run(args.paths, options)
 

@@ -9,9 +9,9 @@ from collections.abc import Mapping, Sequence
 from typing import Final, Protocol
 
 from bt_lsp.project.config import ConfigError, Configs, Layer, excluded
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.sniff import is_bt_file
-from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.rules.codes import Severity
 
 __all__ = [
@@ -44,7 +44,7 @@ class ProjectOptions(Protocol):
     def max_bytes(self) -> int: ...
 
 
-def project_workspace(paths: Sequence[str], options: ProjectOptions) -> Workspace:
+def project_workspace(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex:
     """The folders named on the command line as one workspace, each file with its
     configuration file's settings and the flags over them."""
     overrides = Layer(
@@ -52,7 +52,7 @@ def project_workspace(paths: Sequence[str], options: ProjectOptions) -> Workspac
         btcpp=options.btcpp,
         severity=dict(options.severities) or None,
     )
-    return Workspace(
+    return ProjectIndex(
         [p for p in paths if os.path.isdir(p)],
         Settings(max_document_bytes=options.max_bytes),
         configs=Configs(normalize(options.config) if options.config else None),
@@ -60,7 +60,7 @@ def project_workspace(paths: Sequence[str], options: ProjectOptions) -> Workspac
     )
 
 
-def config_errors(workspace: Workspace, files: Sequence[str]) -> list[ConfigError]:
+def config_errors(workspace: ProjectIndex, files: Sequence[str]) -> list[ConfigError]:
     """The errors of the configuration files that the checked files use (and of the one
     given with ``--config``, which must hold settings)."""
     explicit = workspace.configs.explicit
@@ -71,7 +71,7 @@ def config_errors(workspace: Workspace, files: Sequence[str]) -> list[ConfigErro
     return sorted(workspace.config_errors(), key=lambda e: str(e.path))
 
 
-def version_lines(workspace: Workspace, files: Sequence[str]) -> list[str]:
+def version_lines(workspace: ProjectIndex, files: Sequence[str]) -> list[str]:
     """For ``--verbose``: which BehaviorTree.CPP version how many files are checked as,
     and why."""
     counts: Counter[tuple[str, str]] = Counter()
@@ -87,7 +87,7 @@ def version_lines(workspace: Workspace, files: Sequence[str]) -> list[str]:
     ]
 
 
-def skip_reason(workspace: Workspace, path: str, is_dir: bool) -> str | None:
+def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     """Why a walk over a folder leaves ``path`` out (``None``: it is checked): a build or
     VCS folder, an ``exclude`` glob of its configuration, or a file whose top element is
     not ``<root>`` (``package.xml``, launch files, URDF, pluginlib descriptions)."""

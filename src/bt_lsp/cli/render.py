@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from typing import TextIO
 
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_text
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.pictures import draw
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace, normalize
 from bt_lsp.render import Format, document_trees, find_tree, main_tree, tree_id_of
 from bt_lsp.syntax.document import Document
 
@@ -57,7 +57,7 @@ def run(path: str, options: Options, out: TextIO | None = None, err: TextIO | No
         tree = main_tree(doc.model)
         assert tree is not None
     root = options.workspace or os.path.dirname(os.path.abspath(path))
-    workspace = Workspace([root], Settings(max_document_bytes=options.max_bytes))
+    workspace = ProjectIndex([root], Settings(max_document_bytes=options.max_bytes))
     text, _ = draw(
         workspace,
         normalize(path),

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from typing import Final
 
 from bt_lsp.project.fileio import FileError
-from bt_lsp.project.workspace import Workspace, normalize
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules import analysis
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -49,14 +49,15 @@ class FileResult:
     not_fixed: str | None = None  # why a file with fixes was left unchanged
     notes: list[str] = field(default_factory=list)  # what the applied fixes left as it was
     detail: str = ""  # the traceback of an internal error
+    unwritten: bool = False  # --fix could not write the fixed file (exit status 2)
 
 
-def analyze(doc: Document, workspace: Workspace | None = None) -> list[Diagnostic]:
-    """Every diagnostic of ``doc``, before severity settings; with a workspace, its
+def analyze(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
+    """Every diagnostic of ``doc``, before severity settings; with a project index, its
     includes, models and trees count too."""
-    if workspace is None or doc.path is None:
+    if project is None or doc.path is None:
         return analysis.analyze(doc)
-    return workspace.diagnostics(normalize(doc.path), doc)
+    return project.diagnostics(normalize(doc.path), doc)
 
 
 def findings_of(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[Finding]:
@@ -111,7 +112,7 @@ def summary(results: Sequence[FileResult]) -> str:
 def exit_code(results: Iterable[FileResult]) -> int:
     code = 0
     for r in results:
-        if r.error is not None:
+        if r.error is not None or r.unwritten:
             return 2
         if any(f.severity == Severity.ERROR for f in r.findings):
             code = 1

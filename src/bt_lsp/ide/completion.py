@@ -5,6 +5,9 @@ and returns plain items with the span they replace (code-point offsets).  Contex
 
 * a start tag's name after ``<``: the elements allowed there (in a tree, the built-in and
   declared node types, with their required ports, and a ``<SubTree>`` call of each tree);
+* an empty line or the space between tags (Ctrl+Space with no ``<`` typed): the same
+  elements, the ``<`` included, where one fits (not in a leaf, a full decorator or a tree
+  that has its child);
 * an end tag's name after ``</``: the element it closes;
 * an attribute name in a start tag: the ports of the node and the reserved attributes;
 * an attribute value: tree IDs in ``<SubTree ID>`` and ``main_tree_to_execute``, node types
@@ -15,6 +18,7 @@ and returns plain items with the span they replace (code-point offsets).  Contex
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -22,7 +26,7 @@ from enum import StrEnum
 from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_uses
 from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
-from bt_lsp.rules.context import Context
+from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
@@ -30,6 +34,9 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Attr, Kind, Token
 
 __all__ = ["Completions", "Item", "ItemKind", "complete", "ports_markdown"]
+
+# Models learned from C++ (bt_lsp.project.cpp_models) are declared in a C++ file.
+_CPP = (".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp")
 
 
 class ItemKind(StrEnum):
@@ -85,45 +92,60 @@ def _code(text: str) -> str:
 
 
 def ports_markdown(ports: Sequence[PortModel]) -> str:
-    """A Markdown table of ports: name, direction, type, default, description."""
+    """The ports as a Markdown list, one a line (a table is cut off in a narrow popup):
+    name, direction, type, default, description."""
     if not ports:
         return "No ports."
-    rows = ["| port | direction | type | default | description |", "|---|---|---|---|---|"]
+    rows = ["Ports:", ""]
     for p in ports:
-        default = "required" if p.default is None else _code(p.default)
-        desc = " ".join(p.description.split()).replace("|", "\\|")
-        ptype = _code(p.type) if p.type else ""
-        rows.append(f"| {_code(p.name)} | {p.direction} | {ptype} | {default} | {desc} |")
+        default = "no default" if p.default is None else f"default {_code(p.default)}"
+        ptype = f", {_code(p.type)}" if p.type else ""
+        desc = " ".join(p.description.split())
+        rows.append(
+            f"- {_code(p.name)}: {p.direction}{ptype}, {default}" + (f"; {desc}" if desc else "")
+        )
     return "\n".join(rows)
 
 
 def _port_doc(p: PortModel) -> str:
-    default = "required" if p.default is None else f"default {_code(p.default)}"
+    default = "no default" if p.default is None else f"default {_code(p.default)}"
     ptype = f", type {_code(p.type)}" if p.type else ""
     out = f"{p.direction} port{ptype}, {default}."
     return f"{out}\n\n{p.description}" if p.description else out
 
 
 def _attr_insert(name: str, ports: Sequence[PortModel], n: int = 1) -> tuple[str, str]:
-    """``name="…"`` for a port (outputs get ``{…}``): (plain, snippet)."""
+    """``name="…"`` for a port: (plain, snippet).  A port with a default gets it (in the
+    snippet as the placeholder's text, to accept or overwrite); an output or inout port
+    without one gets the key named like it, ``{name}``; any other an empty value (in the
+    snippet a tab stop)."""
     port = next((p for p in ports if p.name == name), None)
+    if port is not None and port.default is not None:
+        value = _attr_text(port.default)
+        return f'{name}="{value}"', f'{_snip(name)}="${{{n}:{_snip(value)}}}"'
     if port is not None and port.direction != "input":
-        return f'{name}="{{}}"', f'{_snip(name)}="{{${{{n}:{_snip(name)}}}}}"'
-    return f'{name}=""', f'{_snip(name)}="${n}"'
+        return f'{name}="{{{name}}}"', f'{_snip(name)}="{{${{{n}:{_snip(name)}}}}}"'
+    return f'{name}=""', f'{_snip(name)}="${{{n}}}"'
 
 
 def _with_ports(
     name: str, ports: Sequence[PortModel], leaf: bool, attrs: tuple[str, str] = ("", "")
 ) -> tuple[str, str]:
-    """A start tag's text after ``<``: the name, ``attrs`` (plain, snippet), the required
-    ports, the tag's end: (plain, snippet)."""
+    """A start tag's text after ``<``: the name, ``attrs`` (plain, snippet), the ports
+    without a default, the tag's end: (plain, snippet).
+
+    Ports with a default are left out (BehaviorTree.CPP uses the default).  The snippet
+    writes each port without a default as a tab stop to fill in (an output as the key
+    named like it); the plain text, which has no tab stops, writes only the outputs'
+    keys, since an empty value is never right (the missing ports are then reported)."""
     plain = [name, attrs[0]] if attrs[0] else [name]
     snip = [_snip(name), attrs[1]] if attrs[1] else [_snip(name)]
     n = 1
     for p in ports:
         if p.default is None:
             a, s = _attr_insert(p.name, ports, n)
-            plain.append(a)
+            if p.direction != "input":
+                plain.append(a)
             snip.append(s)
             n += 1
     if leaf:
@@ -176,6 +198,10 @@ def complete(doc: Document, offset: int, ctx: Context | None = None) -> Completi
         return _tag(doc, ctx, offset, offset, parent, bare=True)
     if tok.kind == Kind.END and 2 <= rel <= tok.name_end:
         return _end_tag(doc, tstart, tok, offset)
+    if tok.kind == Kind.TEXT or (
+        tok.kind in (Kind.START, Kind.END, Kind.COMMENT) and tok.closed and rel >= tok.length
+    ):
+        return _between_tags(doc, ctx, offset, tstart if tok.kind == Kind.TEXT else offset)
     if tok.kind != Kind.START:
         return None
     hit = _element_at(model, tstart)
@@ -242,6 +268,81 @@ def _tag(
     return Completions(start, end, "tag", items)
 
 
+def _is_name_char(c: str) -> bool:
+    return c.isalnum() or c in "_-.:" or ord(c) > 127
+
+
+def _at_line_end(text: str, offset: int) -> bool:
+    """Whether only white space follows ``offset`` on its line."""
+    m = _REST_OF_LINE_RE.match(text, offset)
+    return m is not None and (m.end() == len(text) or text[m.end()] in "\r\n")
+
+
+_REST_OF_LINE_RE = re.compile(r"[ \t]*")
+
+
+def _fits(doc: Document, ctx: Context, parent: int) -> bool:
+    """Whether another element fits in the element ``parent``: not in a leaf node, a
+    decorator that has its child, or a tree that has its one child."""
+    model = doc.model
+    el = model.elements[parent]
+    if el.zone not in (Zone.TREE, Zone.NODE):
+        return True
+    children = sum(
+        1 for c in model.elements[parent + 1 :] if c.parent == parent and c.zone == Zone.NODE
+    )
+    if el.zone == Zone.TREE:
+        return children == 0
+    node_id = el.node_id
+    if el.name == "SubTree" or node_id is None:
+        return el.name != "SubTree"
+    b = BUILTINS.get(node_id)
+    if b is not None:
+        most = b.max_children
+    elif node_id in ctx.models:
+        most = ctx.models[node_id].child_range[1]
+    else:
+        return True  # an unknown node type: it may take children
+    return most is None or children < most
+
+
+def _between_tags(doc: Document, ctx: Context, offset: int, text_start: int) -> Completions | None:
+    """Completions with no ``<`` typed: on an empty line or between tags, the elements
+    that fit there, each written with its ``<``, replacing the name typed so far."""
+    text = doc.text
+    start = offset
+    while start > text_start and _is_name_char(text[start - 1]):
+        start -= 1
+    if text[text_start:start].strip(" \t\r\n"):
+        return None  # after text content (BT elements have none), not between tags
+    if start == offset and not _at_line_end(text, offset) and text[offset - 1] != ">":
+        return None  # in the indentation before a tag: the place of no new element
+    model = doc.model
+    parent = _innermost(model, offset)
+    if parent < 0:
+        return None
+    zone = model.elements[parent].zone
+    if zone not in (Zone.ROOT, Zone.TREE, Zone.NODE, Zone.MODELS, Zone.MODEL_ENTRY):
+        return None
+    if not _fits(doc, ctx, parent):
+        return Completions(start, offset, "text", [])
+    found = _tag(doc, ctx, start, offset, parent, bare=True)
+    items = [
+        Item(
+            it.label,
+            it.kind,
+            it.detail,
+            it.documentation,
+            insert="<" + it.insert,
+            snippet="<" + it.snippet if it.snippet is not None else None,
+            filter=it.filter or it.label,
+            sort=it.sort,
+        )
+        for it in found.items
+    ]
+    return Completions(start, offset, "text", items)
+
+
 def _structural(
     name: str, attrs: str, *, leaf: bool, bare: bool, plain_attrs: str | None = None
 ) -> Item:
@@ -269,11 +370,18 @@ def _node_items(ctx: Context, bare: bool, current_tree: str | None) -> Iterable[
         leaf = decl.category in ("Action", "Condition")
         plain, snip = _with_ports(mid, decl.ports, leaf)
         where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
+        cpp = where.endswith(_CPP)
+        origin = "C++" if cpp else ("node catalog" if decl.authoritative else "TreeNodesModel")
         yield Item(
             mid,
             ItemKind.NODE,
-            detail=f"{decl.category} (TreeNodesModel)",
-            documentation=f"{decl.category} declared in the TreeNodesModel of {where}.\n\n"
+            detail=f"{decl.category} ({origin})",
+            documentation=(
+                f"{decl.category} registered in the C++ of {where}.\n\n"
+                if cpp
+                else f"{decl.category} declared in the TreeNodesModel of {where}.\n\n"
+            )
+            + f"Model from {source_label(decl.source)}.\n\n"
             + ports_markdown(decl.ports),
             insert=plain if bare else mid,
             snippet=snip if bare else None,

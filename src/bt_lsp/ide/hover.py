@@ -1,47 +1,97 @@
-"""Hover text: why a name breaks a rule and what to write instead, or what a name is."""
+"""Hover text: why a name breaks a rule and what to write instead, what a name is, or where
+a blackboard key is written and read.
+
+Written as Markdown or as plain text (for clients that ask for it: no ``**``, no backticks,
+no tables), and narrow either way: lists rather than wide tables, which a hover cuts off.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from bt_lsp.ide.name_edits import occurrences
+from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
+from bt_lsp.ide.name_edits import elsewhere, occurrences
 from bt_lsp.ide.name_fixes import preferred_renaming
+from bt_lsp.ide.ports import ports_of
 from bt_lsp.rules.builtins import BUILTINS, PortModel
-from bt_lsp.rules.context import Context
+from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.diagnostics import name_violations
 from bt_lsp.rules.names import RULES
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import DECLARING_ROLES, NameRef, Role
 
+_CPP_SUFFIXES = (".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp")
+
 
 @dataclass(frozen=True, slots=True)
 class HoverText:
-    markdown: str
+    """The hover's text over ``[start, end)``; Markdown when ``markdown``, else plain."""
+
+    text: str
     start: int
     end: int
+    markdown: bool = True
 
 
 _KIND_TITLE = {"model": "Model name", "port": "Port name", "instance": "Instance name"}
 
 
-def _code(text: str) -> str:
-    """``text`` as inline Markdown code, whatever backticks it holds."""
-    shown = "".join(c if c.isprintable() or c == " " else f"U+{ord(c):04X}" for c in text)
-    if "`" in shown:
-        return f"`` {shown} ``"
-    return f"`{shown}`"
+def _visible(text: str) -> str:
+    return "".join(c if c.isprintable() or c == " " else f"U+{ord(c):04X}" for c in text)
 
 
-def _what(ref: NameRef) -> str:
+_INLINE_CODE_RE = re.compile(r"`+ ?([^`]*?) ?`+")
+
+
+class _Writer:
+    """Markup for one hover: inline code and a title in Markdown, quotes in plain text."""
+
+    def __init__(self, markdown: bool) -> None:
+        self.markdown = markdown
+        self.lines: list[str] = []
+
+    def code(self, text: str) -> str:
+        shown = _visible(text)
+        if not self.markdown:
+            return f"'{shown}'"
+        if "`" in shown:
+            return f"`` {shown} ``"
+        return f"`{shown}`"
+
+    def prose(self, text: str) -> str:
+        """A description written in Markdown (built-in nodes, rules), as the client reads
+        it: inline code becomes quotes in plain text."""
+        if self.markdown:
+            return text
+        return _INLINE_CODE_RE.sub(r"'\1'", text).replace("**", "")
+
+    def title(self, text: str) -> None:
+        self.lines.append(f"**{text}**" if self.markdown else text)
+
+    def para(self, text: str) -> None:
+        if self.lines:
+            self.lines.append("")
+        self.lines.append(text)
+
+    def items(self, items: Sequence[str]) -> None:
+        """A list: each item on its own line, as narrow as its text."""
+        self.lines.extend(f"- {i}" for i in items)
+
+    def text(self) -> str:
+        return "\n".join(self.lines)
+
+
+def _what(w: _Writer, ref: NameRef) -> str:
     sym = ref.symbol
     if ref.role == Role.INSTANCE or sym is None:
         return "Instance name (the node's label; it defaults to the node type)"
     if sym[0] == "port":
-        owner = f"tree {_code(sym[2])}" if sym[1] == "tree" else f"node type {_code(sym[2])}"
+        owner = f"tree {w.code(sym[2])}" if sym[1] == "tree" else f"node type {w.code(sym[2])}"
         what = "Port declaration" if ref.role == Role.PORT_DECL else "Port"
-        return f"{what} {_code(sym[3])} of the {owner}"
-    name = _code(sym[1])
+        return f"{what} {w.code(sym[3])} of the {owner}"
+    name = w.code(sym[1])
     return {
         Role.TREE_DEF: f"Behavior tree {name}",
         Role.SUBTREE_CALL: f"SubTree call of the tree {name}",
@@ -50,52 +100,50 @@ def _what(ref: NameRef) -> str:
     }.get(ref.role, f"Node type {name}")
 
 
-def _cell(text: str) -> str:
-    return text.replace("|", "\\|")
+def _port_item(w: _Writer, p: PortModel) -> str:
+    default = "no default" if p.default is None else f"default {w.code(p.default)}"
+    item = f"{w.code(p.name)}: {p.direction}, {w.code(p.type)}, {default}"
+    desc = w.prose(" ".join(p.description.split()))
+    return f"{item}; {desc}" if desc else item
 
 
-def _ports_table(ports: Sequence[PortModel]) -> list[str]:
+def _ports(w: _Writer, ports: Sequence[PortModel]) -> None:
     if not ports:
-        return ["No ports."]
-    rows = ["| port | direction | type | default | description |", "|---|---|---|---|---|"]
-    for p in ports:
-        default = "required" if p.default is None else _code(p.default)
-        desc = " ".join(p.description.split()).replace("|", "\\|")
-        rows.append(f"| {_code(p.name)} | {p.direction} | {_code(p.type)} | {default} | {desc} |")
-    return rows
+        w.para("No ports.")
+        return
+    w.para("Ports:")
+    w.items([_port_item(w, p) for p in ports])
 
 
-def _node_info(ref: NameRef, ctx: Context | None) -> list[str]:
+def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     """What BehaviorTree.CPP knows of a node type or tree: category, ports, description."""
     sym = ref.symbol
     if sym is None or sym[0] not in ("model", "tree"):
-        return []
+        return
     if sym[0] == "model" and sym[1] in BUILTINS:
         b = BUILTINS[sym[1]]
-        return [
-            "",
-            f"Built-in {b.category} of BehaviorTree.CPP: {b.description}",
-            "",
-            *_ports_table(b.ports),
-        ]
+        w.para(f"Built-in {b.category} of BehaviorTree.CPP: {w.prose(b.description)}")
+        _ports(w, b.ports)
+        return
     if ctx is None:
-        return []
+        return
     decl = ctx.models.get(sym[1]) if sym[0] == "model" else ctx.subtree_models.get(sym[1])
     if decl is None:
-        return []
+        return
     where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
-    return [
-        "",
-        f"{decl.category} declared in the TreeNodesModel of {where}.",
-        "",
-        *_ports_table(decl.ports),
-    ]
+    w.para(
+        f"{decl.category} registered in the C++ of {where}."
+        if where.endswith(_CPP_SUFFIXES)  # learned from C++ (the server says where)
+        else f"{decl.category} declared in the TreeNodesModel of {where}."
+    )
+    w.para(f"Model from {source_label(decl.source)}.")
+    _ports(w, decl.ports)
 
 
-def _port_info(ref: NameRef, ctx: Context | None) -> list[str]:
+def _port_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     sym = ref.symbol
     if sym is None or sym[0] != "port":
-        return []
+        return
     port: PortModel | None = None
     if sym[1] == "model" and sym[2] in BUILTINS:
         port = BUILTINS[sym[2]].port(sym[3])
@@ -103,66 +151,150 @@ def _port_info(ref: NameRef, ctx: Context | None) -> list[str]:
         decl = ctx.models.get(sym[2]) if sym[1] == "model" else ctx.subtree_models.get(sym[2])
         port = decl.port(sym[3]) if decl is not None else None
     if port is None:
-        return []
-    default = "required" if port.default is None else f"default {_code(port.default)}"
-    lines = ["", f"{port.direction} port, type {_code(port.type)}, {default}."]
+        return
+    default = "no default" if port.default is None else f"default {w.code(port.default)}"
+    w.para(f"{port.direction} port, type {w.code(port.type)}, {default}.")
     if port.description:
-        lines += ["", port.description]
-    return lines
+        w.para(w.prose(port.description))
 
 
-def hover_at(doc: Document, offset: int, ctx: Context | None = None) -> HoverText | None:
+def _where_defined(
+    w: _Writer, ref: NameRef, ctx: Context | None, others: Mapping[str, Document]
+) -> None:
+    """Where a name with no declaration in this document comes from: another workspace
+    file, or (said as a fact, not as an error) from outside the workspace."""
+    sym = ref.symbol
+    if sym is None or ref.role == Role.INSTANCE or sym[0] == "port":
+        return
+    if sym[0] == "model" and sym[1] in BUILTINS:
+        return
+    if sym[0] == "tree":
+        found = ctx.workspace_trees.get(sym[1]) if ctx is not None else None
+        if not found and ctx is not None:
+            found = ctx.trees.get(sym[1])
+        if found:
+            w.para(f"Defined in {found[0].path or 'another document'}.")
+            return
+        away = elsewhere(sym, [d.model for d in others.values()])
+        if away is not None:
+            w.para(
+                "No file of the workspace defines this tree: it comes from elsewhere, "
+                "such as an installed package."
+            )
+        return
+    decl = ctx.models.get(sym[1]) if ctx is not None else None
+    if decl is None:
+        w.para(
+            "Registered in code: no TreeNodesModel entry in the workspace declares this node type."
+        )
+
+
+def _bad_name(w: _Writer, doc: Document, ref: NameRef, others: Mapping[str, Document]) -> None:
+    violations = name_violations(ref)
+    assert ref.kind is not None
+    title = _KIND_TITLE[str(ref.kind)]
+    w.title(f"{title} {w.code(ref.text)} breaks the BehaviorTree.CPP naming rules")
+    w.lines.append("")
+    w.items([f"{w.code(v.code)}: {w.prose(RULES.get(v.code, v.rule))}" for v in violations])
+    chars = [c for v in violations for c in v.chars]
+    if chars:
+        w.para("Characters:")
+        items = []
+        for c in chars:
+            line, col = doc.lines.position(_raw_offset(doc, ref, c.offset), "utf-32")
+            items.append(
+                f"column {c.column} (line {line + 1}, col {col + 1}): {c.shown}, "
+                f"{c.category}: {c.reason}"
+            )
+        w.items(items)
+    fix = preferred_renaming(doc, ref, others)
+    if fix is None:
+        away = elsewhere(ref.symbol, [doc.model, *(d.model for d in others.values())])
+        if away is not None and away.refuse:
+            w.para(f"No quick fix renames it: {away.why}.")
+        return
+    if fix.caution is not None:
+        w.para(f"A quick fix can rename it to {w.code(fix.new)} ({fix.where}), but {fix.caution}.")
+    else:
+        w.para(f"Suggested replacement: {w.code(fix.new)} (the quick fix renames {fix.where})")
+    if fix.kept is not None:
+        w.para(f"The quick fix leaves the {fix.kept} as it is: {fix.why}")
+
+
+def _key_hover(w: _Writer, doc: Document, key: KeyRef, ctx: Context | None) -> None:
+    """A blackboard key: the nodes of its tree that write it, read it, or use it in a
+    script, with the types of their ports."""
+    model = doc.model
+    tree_id = model.elements[key.tree].value("ID") or ""
+    w.title(f"Blackboard key {w.code(key.key)} of the tree {w.code(tree_id)}")
+    written: list[str] = []
+    read: list[str] = []
+    scripts: list[str] = []
+    types: list[str] = []
+    for u in key_uses(doc, key.tree):
+        if u.key != key.key:
+            continue
+        el = model.elements[u.element]
+        line = doc.lines.position(u.start, "utf-32")[0] + 1
+        node = el.node_id or el.name
+        if u.form == KeyForm.SCRIPT:
+            scripts.append(f"{w.code(node)} {w.code(u.attr)} (line {line})")
+            continue
+        ports = ports_of(el, ctx)
+        port = next((p for p in ports or () if p.name == u.attr), None)
+        where = f"{w.code(node)} port {w.code(u.attr)} (line {line})"
+        if port is None:
+            # An unknown model: which way the value flows is not known here.
+            read.append(f"{where}, direction unknown")
+            continue
+        where += f", {w.code(port.type)}"
+        if port.type not in types:
+            types.append(port.type)
+        if port.direction in ("output", "inout"):
+            written.append(where)
+        if port.direction in ("input", "inout"):
+            read.append(where)
+    for label, found in (("Written by", written), ("Read by", read), ("In scripts", scripts)):
+        if found:
+            w.para(f"{label}:")
+            w.items(found)
+    if types:
+        w.para(f"Port types: {', '.join(w.code(t) for t in types)}")
+
+
+def hover_at(
+    doc: Document,
+    offset: int,
+    ctx: Context | None = None,
+    others: Mapping[str, Document] | None = None,
+    *,
+    markdown: bool = True,
+) -> HoverText | None:
+    """The hover at ``offset``; ``others`` are the other workspace documents (the quick
+    fix's count of places includes theirs), ``markdown`` chooses Markdown or plain text."""
+    others = others or {}
+    w = _Writer(markdown)
     model = doc.model
     ref = model.ref_at(offset)
     if ref is None:
-        return None
-    lines: list[str] = []
-    violations = name_violations(ref)
-    if violations:
-        assert ref.kind is not None
-        title = _KIND_TITLE[str(ref.kind)]
-        lines.append(f"**{title} {_code(ref.text)} breaks the BehaviorTree.CPP naming rules**")
-        lines.append("")
-        for v in violations:
-            lines.append(f"- `{v.code}`: {RULES.get(v.code, v.rule)}")
-        chars = [c for v in violations for c in v.chars]
-        if chars:
-            lines.append("")
-            lines.append("| column | at | character | category | why |")
-            lines.append("|---|---|---|---|---|")
-            for c in chars:
-                line, col = doc.lines.position(_raw_offset(doc, ref, c.offset), "utf-32")
-                lines.append(
-                    f"| {c.column} | line {line + 1}, col {col + 1} | {_cell(c.shown)} "
-                    f"| {c.category} "
-                    f"| {c.reason} |"
-                )
-        fix = preferred_renaming(doc, ref)
-        if fix is not None:
-            places = fix.plan.places
-            where = "1 place" if places == 1 else f"{places} places"
-            lines.append("")
-            lines.append(f"Suggested replacement: {_code(fix.new)} (the quick fix renames {where})")
-            if fix.kept is not None:
-                lines.append("")
-                lines.append(f"The quick fix leaves the {fix.kept} as it is: {fix.why}")
+        key = key_at(doc, offset)
+        if key is None or key.tree < 0:
+            return None
+        _key_hover(w, doc, key, ctx)
+        return HoverText(w.text(), key.start, key.end, markdown)
+    if name_violations(ref):
+        _bad_name(w, doc, ref, others)
     else:
-        lines.append(f"**{_what(ref)}**")
+        w.title(_what(w, ref))
         decl = [r for r in occurrences(model, ref) if r.role in DECLARING_ROLES]
         if decl:
             line = doc.lines.position(decl[0].start, "utf-32")[0] + 1
-            lines.append("")
-            lines.append(f"Declared at line {line} ({decl[0].role}).")
-        elif (
-            ref.symbol is not None
-            and ref.role != Role.INSTANCE
-            and not (ref.symbol[0] == "model" and ref.symbol[1] in BUILTINS)
-        ):
-            lines.append("")
-            lines.append("Not declared in this document.")
-        lines.extend(_node_info(ref, ctx))
-        lines.extend(_port_info(ref, ctx))
-    return HoverText("\n".join(lines), ref.start, ref.end)
+            w.para(f"Declared at line {line} ({decl[0].role}).")
+        else:
+            _where_defined(w, ref, ctx, others)
+        _node_info(w, ref, ctx)
+        _port_info(w, ref, ctx)
+    return HoverText(w.text(), ref.start, ref.end, markdown)
 
 
 def _raw_offset(doc: Document, ref: NameRef, index: int) -> int:
@@ -182,7 +314,9 @@ def _raw_offset(doc: Document, ref: NameRef, index: int) -> int:
     return ref.start + min(pos, len(raw))
 
 
-def root_hover(doc: Document, offset: int, version: str | None, source: str) -> HoverText | None:
+def root_hover(
+    doc: Document, offset: int, version: str | None, source: str, markdown: bool = True
+) -> HoverText | None:
     """On the ``root`` of ``<root>``: the BehaviorTree.CPP version the document is checked
     against and where that was read (``source``), so that a wrong guess is visible."""
     root = doc.model.root
@@ -197,4 +331,7 @@ def root_hover(doc: Document, offset: int, version: str | None, source: str) -> 
         ]
     else:
         lines = [f"**BehaviorTree.CPP {version}**", "", f"From {source}."]
-    return HoverText("\n".join(lines), root.name_start, root.name_end)
+    text = "\n".join(lines)
+    if not markdown:
+        text = text.replace("**", "").replace("`", "")
+    return HoverText(text, root.name_start, root.name_end, markdown)

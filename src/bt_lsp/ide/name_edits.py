@@ -8,12 +8,15 @@ included) on top of these, and :mod:`bt_lsp.ide.name_fixes` uses those renames.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from typing import NamedTuple
 
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.elements import NameRef, Symbol
+from bt_lsp.syntax.elements import NameRef, Role, Symbol
 from bt_lsp.syntax.model import Model
 
 __all__ = [
+    "Elsewhere",
+    "elsewhere",
     "namespace",
     "occurrences",
     "other_file_edits",
@@ -81,3 +84,58 @@ def other_file_edits(
         if refs:
             out[path] = tuple(rename_edits(refs, new_name))
     return out
+
+
+class Elsewhere(NamedTuple):
+    """A name whose target is not in the workspace: renaming the name here would leave the
+    target with the old one.  ``refuse``: no rename may touch it (a tree's ID stays where
+    the tree is defined, so a call renamed alone calls nothing); otherwise a rename is
+    possible but not safe on its own (a node type's registration in C++ must follow).
+    ``why`` says it, in a sentence that completes "... : why"."""
+
+    what: str
+    why: str
+    refuse: bool
+
+
+def elsewhere(symbol: Symbol | None, models: Iterable[Model]) -> Elsewhere | None:
+    """Whether ``symbol``'s target is outside the documents of ``models`` (the workspace):
+
+    * a tree (``<SubTree ID>``, ``main_tree_to_execute``, a port of a ``<SubTree>`` call)
+      whose ``<BehaviorTree ID>`` none of them defines: it comes from elsewhere (an
+      installed package, a file outside the folder), where its ID stays;
+    * a node type (or a port of one) that no ``<TreeNodesModel>`` entry declares: it is
+      registered in code bt-lsp cannot see, which keeps the old name.
+
+    ``None`` when the target is here, or when there is none: an instance name, and an
+    empty name (nothing is registered or defined under it, so no reference works)."""
+    if symbol is None or not symbol[-1]:
+        return None
+    if symbol[0] == "port":
+        owner: Symbol = (symbol[1], symbol[2])
+        subject = f"the port '{shown(symbol[3])}' of "
+    else:
+        owner = symbol
+        subject = ""
+    models = list(models)
+    if owner[0] == "tree":
+        if any(r.role == Role.TREE_DEF for m in models for r in m.refs_to(owner)):
+            return None
+        return Elsewhere(
+            f"{subject}the tree '{shown(owner[1])}'",
+            f"the tree '{shown(owner[1])}' is not defined in the workspace (it comes from "
+            "elsewhere, such as an installed package, and keeps its ID there); rename it "
+            "where it is defined first, then this reference",
+            refuse=True,
+        )
+    if owner[0] == "model":
+        if any(r.role == Role.MODEL_DEF for m in models for r in m.refs_to(owner)):
+            return None
+        return Elsewhere(
+            f"{subject}the node type '{shown(owner[1])}'",
+            f"the node type '{shown(owner[1])}' is registered in code bt-lsp cannot see (no "
+            "<TreeNodesModel> entry in the workspace declares it); its registration must be "
+            "renamed too",
+            refuse=False,
+        )
+    return None

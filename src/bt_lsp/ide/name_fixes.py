@@ -12,6 +12,13 @@ Where the rename refuses:
   ``@key``, written with references or after a script's syntax error): the fix renames the
   port's own names only, and its title says that the key is left as it is.
 
+A fix never breaks a reference that works.  A name whose target is not in the workspace
+(:func:`~bt_lsp.ide.name_edits.elsewhere`) is renamed only with its target: a call of a tree
+defined elsewhere gets no fix at all (the rename refuses it), and a node type that no
+``<TreeNodesModel>`` of the workspace declares (registered in C++ we cannot see) gets its
+fixes, none preferred, each title saying that the registration must be renamed too; fix-all
+leaves both as they are, with a note.
+
 Pure: these functions return edits; the front ends decide whether to apply them.
 """
 
@@ -69,14 +76,21 @@ class Renaming:
     plan: RenamePlan
     kept: str | None = None
     why: str | None = None
+    caution: str | None = None  # what must be renamed too, outside the workspace
 
     @property
-    def title(self) -> str:
+    def where(self) -> str:
+        """How many places the renaming changes: ``"5 places, 4 other files"``."""
         places = self.plan.places
         where = "1 place" if places == 1 else f"{places} places"
         n = len(self.plan.other_edits)
         if n:
             where += f", {n} other file{'s' if n > 1 else ''}"
+        return where
+
+    @property
+    def title(self) -> str:
+        where = self.where
         old = shown(self.old)
         title = (
             NAME_FIX_TITLES["clear"].format(old=old, where=where)
@@ -85,6 +99,8 @@ class Renaming:
         )
         if self.kept is not None:
             title += f"; {self.kept} left as it is"
+        if self.caution is not None:
+            title += f"; {self.caution}"
         return title
 
     @property
@@ -132,8 +148,14 @@ class _With(AbstractSet[str]):
 
 
 def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str]) -> Renaming | None:
+    away = renamer.elsewhere(ref.symbol)
+    caution = (
+        None
+        if away is None
+        else f"{away.what} is registered outside the workspace: rename it there too"
+    )
     try:
-        return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken))
+        return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken), caution=caution)
     except RenameRefused as e:
         sym = ref.symbol
         if e.new_name or sym is None or sym[:2] != ("port", "tree"):
@@ -144,7 +166,7 @@ def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str])
     except RenameRefused:
         return None
     kept = f"key '{shown(sym[3])}' in tree '{shown(sym[2])}'"
-    return Renaming(ref.text, new, plan, kept, why)
+    return Renaming(ref.text, new, plan, kept, why, caution)
 
 
 def renamings(renamer: Renamer, ref: NameRef, taken: AbstractSet[str]) -> Iterator[Renaming]:
@@ -154,6 +176,9 @@ def renamings(renamer: Renamer, ref: NameRef, taken: AbstractSet[str]) -> Iterat
     namespace that the new name must avoid."""
     kind = ref.kind
     if kind is None:
+        return
+    away = renamer.elsewhere(ref.symbol)
+    if away is not None and away.refuse:
         return
     tried: set[str] = set()
     found = False
@@ -209,35 +234,47 @@ def fixes_for_name(
     others = others or {}
     taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
     return [
-        Fix(r.title, r.plan.edits, i == 0, diag, r.plan.other_edits)
+        Fix(r.title, r.plan.edits, i == 0 and r.caution is None, diag, r.plan.other_edits)
         for i, r in enumerate(renamings(Renamer(doc, others), ref, taken))
     ]
 
 
 @dataclass(frozen=True, slots=True)
 class FixAll:
-    """The edits of every preferred name fix of a document, and a note for each fix that
-    left a key as it is (see :attr:`Renaming.note`)."""
+    """The edits of every preferred name fix of a document (``other_edits``: in the other
+    workspace documents, by path), and a note for each fix that left something as it is
+    (see :attr:`Renaming.note`) and for each name left alone because its target is outside
+    the workspace."""
 
     edits: list[TextEdit]
     notes: list[str] = field(default_factory=list)
+    other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
 
 
-def fix_all(doc: Document, diags: Iterable[Diagnostic]) -> FixAll:
+def fix_all(
+    doc: Document, diags: Iterable[Diagnostic], others: Mapping[str, Document] | None = None
+) -> FixAll:
     """Every preferred name fix at once, consistently: one new name per symbol, all
-    distinct from each other and from the names that stay.  Each symbol is renamed as a
-    rename renames it (its keys included), in the document seen alone: fix-all changes no
-    other file, so it takes no name or key of another file into account either (a file
-    fixed before would otherwise make the next one choose another name for the same
-    symbol, as ``bt-lsp check --fix`` fixes the files of a folder one after the other)."""
+    distinct from each other and from the names that stay in the workspace.  Each symbol
+    is renamed as a rename renames it (its keys included), in the document and in the
+    ``others`` (the other workspace documents, by path), which a tree defined here and
+    called there needs, so that the call follows.  A name whose target is outside the
+    workspace is left as it is, with a note: a call of a tree defined elsewhere, and a node
+    type (or its port) that no ``<TreeNodesModel>`` of the workspace declares.
+
+    ``bt-lsp check --fix`` fixes the files of a folder one after the other, each against
+    ``others`` as they were before any file was fixed: each file's fixes then choose the
+    same new name for a symbol, and each file renames its own occurrences."""
+    others = others or {}
     model = doc.model
-    renamer = Renamer(doc)
+    renamer = Renamer(doc, others)
     done: set[Symbol | tuple[int, int]] = set()
     plans: list[RenamePlan] = []
     notes: list[str] = []
     taken_by_ns: dict[tuple[str, ...], set[str]] = {}
-    for sym in model.by_symbol:
-        taken_by_ns.setdefault(namespace(sym), set()).add(sym[-1])
+    for m in (model, *(d.model for d in others.values())):
+        for sym in m.by_symbol:
+            taken_by_ns.setdefault(namespace(sym), set()).add(sym[-1])
     for diag in diags:
         ref = _name_ref(doc, diag)
         if ref is None:
@@ -248,6 +285,10 @@ def fix_all(doc: Document, diags: Iterable[Diagnostic]) -> FixAll:
         if key in done:
             continue
         done.add(key)
+        away = renamer.elsewhere(ref.symbol)
+        if away is not None:
+            notes.append(f"left '{shown(ref.text)}' as it is: {away.why}")
+            continue
         names: set[str] | None = None
         taken: AbstractSet[str] = frozenset()
         if ref.symbol is not None:
@@ -258,7 +299,8 @@ def fix_all(doc: Document, diags: Iterable[Diagnostic]) -> FixAll:
             continue
         if names is not None:
             names.add(r.new)
-        plans.append(RenamePlan(r.plan.edits, written_out=r.plan.written_out))
+        plans.append(r.plan)
         if r.note is not None:
             notes.append(r.note)
-    return FixAll(list(combined(plans).edits), notes)
+    plan = combined(plans)
+    return FixAll(list(plan.edits), notes, plan.other_edits)

@@ -12,7 +12,14 @@ from typing import NoReturn
 
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, mentions, port_value_key, unread_mentions
 from bt_lsp.ide.keygraph import KeyGraph, KeyTargets, Tree, is_tree_port, key_targets, port_targets
-from bt_lsp.ide.name_edits import other_file_edits, rename_edits, shown, taken_names
+from bt_lsp.ide.name_edits import (
+    Elsewhere,
+    elsewhere,
+    other_file_edits,
+    rename_edits,
+    shown,
+    taken_names,
+)
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.syntax.document import Document
@@ -370,6 +377,21 @@ class Renamer:
 
     def __init__(self, doc: Document, others: Mapping[str, Document] | None = None) -> None:
         self._ws = KeyGraph(doc, others or {})
+        self._elsewhere: dict[Symbol, Elsewhere | None] = {}
+
+    def elsewhere(self, sym: Symbol | None) -> Elsewhere | None:
+        """Whether the target of ``sym`` is outside the workspace (see
+        :func:`~bt_lsp.ide.name_edits.elsewhere`): a rename refuses a tree defined
+        elsewhere, and a name fix is not offered as safe for a node type registered
+        elsewhere."""
+        if sym is None:
+            return None
+        if sym not in self._elsewhere:
+            ws = self._ws
+            self._elsewhere[sym] = elsewhere(
+                sym, [ws.doc.model, *(d.model for d in ws.others.values())]
+            )
+        return self._elsewhere[sym]
 
     def plan(
         self,
@@ -389,6 +411,9 @@ class Renamer:
         names the new one must avoid in its namespace, when the caller knows them already
         (by default they are collected from the documents)."""
         ws = self._ws
+        away = self.elsewhere(ref.symbol)
+        if away is not None and away.refuse:
+            raise RenameRefused(f"Cannot rename {away.what}: {away.why}")
         _check_new_name(ref, new_name, ws.doc.model, ws.others, taken)
         sym = ref.symbol
         if sym is None:

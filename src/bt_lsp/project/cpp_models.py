@@ -205,6 +205,10 @@ class CppModels:
         """The last catalog read for ``path`` (maybe stale), without reading anything."""
         return self._latest(self.files_for(path, sources, exclude))[0]
 
+    def latest(self, files: tuple[Path, ...]) -> Catalog | None:
+        """The last catalog read for ``files`` (maybe stale)."""
+        return self._latest(files)[0]
+
     def _latest(self, files: tuple[Path, ...]) -> tuple[Catalog | None, bool]:
         with self._lock:
             hit = self._catalogs.get(files)

@@ -40,6 +40,9 @@ __all__ = [
 ]
 
 DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
+# In the name of write_text_atomic's temporary files, so that the ones a killed run left
+# can be told from anyone else's (see stale_temporaries).
+TEMP_MARK: Final = ".bt-lsp-"
 
 # Longest first: the UTF-32 LE mark starts with the UTF-16 LE one.
 _BOMS: Final[tuple[tuple[bytes, str], ...]] = (
@@ -190,13 +193,31 @@ def _too_large(path: str, size: int | None, max_bytes: int) -> FileError:
     return FileError(path, f"{path} is too large ({what}the limit is {_size(max_bytes)})")
 
 
+def _kind(st: os.stat_result) -> str:
+    mode = st.st_mode
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "not a file"
+
+
 def read_bytes(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[bytes, Stamp]:
     """The bytes of ``path``, refusing anything larger than ``max_bytes``."""
     try:
-        with open(path, "rb") as f:
+        # Opened without blocking, so that a FIFO with no writer does not hang the open;
+        # anything but a regular file is then refused.
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with open(fd, "rb") as f:
             st = os.fstat(f.fileno())
             if stat.S_ISDIR(st.st_mode):
                 raise FileError(path, f"cannot read {path}: Is a directory")
+            if not stat.S_ISREG(st.st_mode):
+                raise FileError(path, f"skipping {path}: not a regular file ({_kind(st)})")
+            if hasattr(os, "set_blocking"):
+                os.set_blocking(fd, True)
             if st.st_size > max_bytes:
                 raise _too_large(path, st.st_size, max_bytes)
             # A pipe or device reports no size: read one byte past the limit to notice.
@@ -250,7 +271,7 @@ def write_text_atomic(
         raise FileError(path, f"cannot write {path}: it changed on disk while being checked")
     try:
         fd, tmp = tempfile.mkstemp(
-            prefix=f".{os.path.basename(target)}.", suffix=".tmp", dir=directory
+            prefix=f".{os.path.basename(target)}{TEMP_MARK}", suffix=".tmp", dir=directory
         )
     except OSError as e:
         raise FileError(path, f"cannot write {path}: {_reason(e)}") from None
@@ -273,6 +294,31 @@ def write_text_atomic(
             os.unlink(tmp)
         raise
     _sync_directory(directory)
+
+
+def stale_temporaries(directory: str, before: float) -> list[str]:
+    """The temporary files :func:`write_text_atomic` left in ``directory`` when it was
+    killed, older than ``before`` (a time stamp): ``.NAME.bt-lsp-XXXXXXXX.tmp`` regular
+    files of the current user.  Nothing else matches: another program's temporary file
+    is never taken for ours."""
+    pattern = re.compile(r"\..+" + re.escape(TEMP_MARK) + r"[a-z0-9_]{8}\.tmp")
+    found: list[str] = []
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return found
+    uid = os.getuid() if hasattr(os, "getuid") else None
+    for name in names:
+        if not pattern.fullmatch(name):
+            continue
+        full = os.path.join(directory, name)
+        try:
+            st = os.lstat(full)
+        except OSError:
+            continue
+        if stat.S_ISREG(st.st_mode) and st.st_mtime < before and uid in (None, st.st_uid):
+            found.append(full)
+    return sorted(found)
 
 
 def _sync_directory(directory: str) -> None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from bt_lsp.project.workspace import Workspace
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.render import Format, Picture, render, workspace_resolver
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
@@ -15,7 +15,7 @@ from bt_lsp.syntax.model import Model
 
 
 def draw(
-    workspace: Workspace,
+    workspace: ProjectIndex,
     path: Path,
     doc: Document,
     tree: Element,
@@ -48,4 +48,5 @@ def draw(
         ports=ports,
         expand_subtrees=expand_subtrees,
         resolve=workspace_resolver(doc.model, ctx, others),
+        text_length=len(doc.text),
     )

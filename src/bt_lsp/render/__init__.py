@@ -47,6 +47,7 @@ def render(
     ports: bool = False,
     expand_subtrees: bool = False,
     resolve: Resolver | None = None,
+    text_length: int | None = None,
 ) -> tuple[str, Picture]:
     """``tree`` of ``model`` drawn in ``fmt``, and the picture it was drawn from."""
     picture = build_picture(
@@ -57,6 +58,7 @@ def render(
         ports=ports,
         expand_subtrees=expand_subtrees,
         resolve=resolve,
+        text_length=text_length,
     )
     if fmt == "svg":
         return to_svg(picture), picture

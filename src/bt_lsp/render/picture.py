@@ -230,11 +230,14 @@ def build_picture(
     expand_subtrees: bool = False,
     resolve: Resolver | None = None,
     ports: bool = False,
+    text_length: int | None = None,
 ) -> Picture:
     """The picture of ``tree`` (a ``<BehaviorTree>`` element of ``model``).
 
     ``diagnostics`` are the rendered document's (other documents' nodes get none);
     ``resolve`` finds the trees SubTree calls name (default: the document's own).
+    ``text_length``, the document's length, ends the spans of elements never closed
+    (otherwise they reach an arbitrary far offset).
     """
     resolve = resolve or workspace_resolver(model, ctx)
     tid = tree_id_of(tree)
@@ -291,6 +294,10 @@ def build_picture(
         push_children(m, el, node.index, src, path)
 
     _give_problems(nodes, own_spans, diagnostics)
+    if text_length is not None:
+        for node in nodes:
+            if node.source is None and node.end > text_length:
+                node.end = text_length
     return Picture(tid, nodes, truncated)
 
 

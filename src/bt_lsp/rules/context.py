@@ -21,7 +21,7 @@ from functools import partial
 from itertools import chain, compress, count, repeat
 from operator import is_not, itemgetter, ne, or_
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Final, NamedTuple, TypeVar, cast
+from typing import TYPE_CHECKING, Any, Final, Literal, NamedTuple, TypeVar, cast
 
 from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
 from bt_lsp.syntax.elements import Element, Zone
@@ -31,7 +31,43 @@ from bt_lsp.syntax.sections import Section
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
 
-__all__ = ["Context", "DocumentFacts", "ModelDecl", "TreeDecl", "facts_of"]
+__all__ = [
+    "AUTHORITATIVE",
+    "Context",
+    "DocumentFacts",
+    "ModelDecl",
+    "ModelSource",
+    "TreeDecl",
+    "facts_of",
+    "is_generated_catalog",
+    "source_label",
+]
+
+#: Where a node model comes from.  Authoritative sources say what BehaviorTree.CPP
+#: registers: ``catalog`` (a file named in ``models``/``modelFiles``/``--models``),
+#: ``generated`` (a workspace file that is nothing but a ``<TreeNodesModel>``, as
+#: ``writeTreeNodesModelXML`` writes it: see :func:`is_generated_catalog`), ``ros`` (the
+#: shipped model of an installed ROS package) and ``cpp`` (the project's C++
+#: registrations).  Advisory ones say what an author or an editor wrote: ``tree`` (a
+#: ``<TreeNodesModel>`` inside a tree file) and ``palette`` (a Groot2 ``.btproj``).
+ModelSource = Literal["tree", "palette", "generated", "catalog", "ros", "cpp"]
+AUTHORITATIVE: Final[frozenset[str]] = frozenset({"generated", "catalog", "ros", "cpp"})
+_SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        "tree": "the <TreeNodesModel> of a tree file (advisory: BehaviorTree.CPP reads the C++)",
+        "palette": "a Groot2 palette (advisory: BehaviorTree.CPP reads the C++)",
+        "generated": "a catalog exported by BehaviorTree.CPP (authoritative)",
+        "catalog": "a node catalog named in the settings (authoritative)",
+        "ros": "the node catalog an installed ROS package ships (authoritative)",
+        "cpp": "the project's C++ registration (authoritative)",
+    }
+)
+
+
+def source_label(source: str) -> str:
+    """What a model source is, for hovers and completion."""
+    return _SOURCE_LABELS.get(source, source)
+
 
 _EMPTY: Final[Mapping[str, object]] = MappingProxyType({})
 
@@ -53,7 +89,8 @@ class ModelDecl(NamedTuple):
     values; a port's ``default`` is the ``default`` attribute as written, ``None`` when
     absent.  ``path`` is the declaring document (``None`` for an unsaved one) and
     ``start``/``end`` the code-point span of the entry's ``ID`` value (its tag name when it
-    has no ``ID``).
+    has no ``ID``).  ``source`` says where the model comes from and so whether it is
+    authoritative (what BehaviorTree.CPP registers) or advisory (what someone wrote).
     """
 
     id: str
@@ -62,6 +99,12 @@ class ModelDecl(NamedTuple):
     path: str | None
     start: int
     end: int
+    source: ModelSource = "tree"
+
+    @property
+    def authoritative(self) -> bool:
+        """Whether BehaviorTree.CPP is known to register exactly this model."""
+        return self.source in AUTHORITATIVE
 
     def port(self, name: str) -> PortModel | None:
         for p in self.ports:
@@ -147,6 +190,9 @@ class Context:
       not, nodes missing from the models are probably registered in C++ only.
     * ``ros_pkg_paths``: ROS package name -> share directory (settings).
     * ``included_by``: paths of workspace documents that include this one.
+    * ``included``: paths of the documents of this one's include closure, and
+      ``workspace_files`` the number of the other workspace documents (what a message
+      about a missing tree says was searched).
     * ``path``: this document's path; declarations with this path are its own.
     * ``btcpp_version``: the BehaviorTree.CPP major version the document is built for,
       ``"3"`` or ``"4"``, as the project layer detected or configured it (``None`` when
@@ -172,6 +218,8 @@ class Context:
     )
     included_by: tuple[str, ...] = ()
     btcpp_version: str | None = None
+    included: tuple[str, ...] = ()  # the paths of this document's include closure
+    workspace_files: int = 0  # how many other workspace documents were looked at
     # What the context was combined from besides its own document's declarations (the
     # other documents' declarations, by identity, and the settings): equal sources mean
     # that only this document's own declarations can differ (see semantics/sections.py).
@@ -208,6 +256,7 @@ class Context:
         path: str | None = None,
         ros_pkg_paths: Mapping[str, str] | None = None,
         model_files: Iterable[tuple[str, Document]] = (),
+        ros_models: Iterable[tuple[str, Document]] = (),
         included_by: Iterable[str] = (),
         workspace_has_custom_models: bool | None = None,
         btcpp_version: str | None = None,
@@ -218,28 +267,44 @@ class Context:
         its namespace; give them in BehaviorTree.CPP's depth-first load order) and false
         for any other workspace document (only its models count; its trees go to
         ``workspace_trees``).  A document whose path is ``own``'s is skipped.
-        ``model_files`` are the node catalogs named in the settings (``<TreeNodesModel>``
-        files, e.g. exported with BehaviorTree.CPP's ``bt_nodes_model``).
+        ``model_files`` are the node catalogs named in the settings (``models``,
+        ``modelFiles``, ``--models``): authoritative, but for a Groot2 ``.btproj``, which
+        is a palette.  ``ros_models`` are the catalogs shipped by the ROS packages ``own``
+        depends on: authoritative for their nodes.
 
-        ``workspace_has_custom_models`` defaults to whether the model files declare any
-        custom node: ``<TreeNodesModel>`` sections inside tree files are usually partial
-        (editors write the nodes they show), so only a catalog makes a node missing from
-        the models an error.
+        A model from an authoritative source wins over any advisory one (a
+        ``<TreeNodesModel>`` of a tree file); among equals the first wins, this
+        document's first.  ``workspace_has_custom_models`` (whether the catalog is
+        complete: a node it lacks is not registered) defaults to whether a catalog is
+        named: ``<TreeNodesModel>`` sections inside tree files are usually partial (editors
+        write the nodes they show), and a ROS package's catalog holds only its own nodes.
         """
         own_path = path if path is not None else own.path
         own_facts = facts_of(own, own_path)
         # Gathered in the order of precedence, then grouped by ID in C (see _first_by_id).
-        models: list[tuple[ModelDecl, ...]] = [own_facts.models]
+        authoritative: list[tuple[ModelDecl, ...]] = []
+        advisory: list[tuple[ModelDecl, ...]] = [own_facts.models]
         subtree_models: list[tuple[ModelDecl, ...]] = [own_facts.subtree_models]
         trees: list[tuple[TreeDecl, ...]] = []
         workspace_trees: list[tuple[TreeDecl, ...]] = []
         sources: list[object] = [own_path]
+        included: list[str] = []
+        workspace_files = 0
         for other_path, other, in_closure in others:
             if other_path == own_path:
                 continue
+            if in_closure:
+                included.append(other_path or "")
+            else:
+                workspace_files += 1
             f = facts_of(other, other_path)
             sources.append((f, in_closure))
-            models.append(f.models)
+            if other_path is not None and other_path.endswith(".btproj"):
+                advisory.append(_tagged(f, "palette"))
+            elif f.models and is_generated_catalog(other):
+                authoritative.append(_tagged(f, "generated"))
+            else:
+                advisory.append(f.models)
             subtree_models.append(f.subtree_models)
             (trees if in_closure else workspace_trees).append(f.trees)
         trees.append(own_facts.trees)
@@ -247,13 +312,20 @@ class Context:
         for model_path, model_doc in model_files:
             f = facts_of(model_doc, model_path)
             sources.append(f)
-            models.append(f.models)
+            if model_path.endswith(".btproj"):
+                advisory.append(_tagged(f, "palette"))
+            else:
+                authoritative.append(_tagged(f, "catalog"))
+                catalog = True
             subtree_models.append(f.subtree_models)
-            catalog = catalog or any(m.id not in BUILTINS for m in f.models)
+        for model_path, model_doc in ros_models:
+            f = facts_of(model_doc, model_path)
+            sources.append(("ros", f))
+            authoritative.append(_tagged(f, "ros"))
         has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
         return cls(
             path=own_path,
-            models=MappingProxyType(_first_by_id(models, BUILTINS)),
+            models=MappingProxyType(_first_by_id([*authoritative, *advisory], BUILTINS)),
             subtree_models=MappingProxyType(_first_by_id(subtree_models)),
             trees=MappingProxyType(_all_by_id(trees)),
             workspace_trees=MappingProxyType(_all_by_id(workspace_trees)),
@@ -261,8 +333,54 @@ class Context:
             ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
             included_by=tuple(included_by),
             btcpp_version=btcpp_version,
+            included=tuple(included),
+            workspace_files=workspace_files,
             sources=(*sources, workspace_has_custom_models, btcpp_version),
         )
+
+
+# The models of a document with another source, kept per facts object (a catalog is read
+# again only when it changes); bounded, oldest first out.
+_TAGGED: dict[tuple[int, str], tuple[DocumentFacts, tuple[ModelDecl, ...]]] = {}
+_TAGGED_MAX: Final = 256
+
+
+def _tagged(facts: DocumentFacts, source: ModelSource) -> tuple[ModelDecl, ...]:
+    """``facts.models`` with ``source`` as their source."""
+    key = (id(facts), source)
+    hit = _TAGGED.get(key)
+    if hit is not None and hit[0] is facts:
+        return hit[1]
+    tagged = tuple([m._replace(source=source) for m in facts.models])
+    if len(_TAGGED) >= _TAGGED_MAX:
+        del _TAGGED[next(iter(_TAGGED))]
+    _TAGGED[key] = (facts, tagged)
+    return tagged
+
+
+_GENERATED: weakref.WeakKeyDictionary[Document, tuple[Model, bool]] = weakref.WeakKeyDictionary()
+
+
+def is_generated_catalog(doc: Document) -> bool:
+    """Whether ``doc`` reads as a node catalog that BehaviorTree.CPP exported
+    (``writeTreeNodesModelXML``, ``bt-lsp models``): a ``<root>`` with ``BTCPP_format``
+    whose only child is one ``<TreeNodesModel>``, and no comment (tinyxml2's printer
+    writes none; a hand-kept model file usually explains itself in one).  Anything else
+    with a ``<TreeNodesModel>`` is what an author or an editor wrote."""
+    model = doc.model
+    hit = _GENERATED.get(doc)
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    root = model.root
+    found = (
+        root is not None
+        and root.name == "root"
+        and root.attr("BTCPP_format") is not None
+        and list(model.root_child_names()) == ["TreeNodesModel"]
+        and "<!--" not in doc.text
+    )
+    _GENERATED[doc] = (model, found)
+    return found
 
 
 def _first_by_id(
@@ -448,21 +566,22 @@ def _extract_all(
 
 
 _new = tuple.__new__
-_FIELDS = tuple(itemgetter(i) for i in range(6))
+_FIELDS = tuple(itemgetter(i) for i in range(7))
 
 
 class _Mover(NamedTuple):
-    """Moves declarations of one kind: where their path and start are among their six
-    fields (the end follows the start)."""
+    """Moves declarations of one kind: where their path and start are among their
+    ``width`` fields (the end follows the start)."""
 
     make: Callable[[Iterable[object]], Any]
+    width: int
     path_at: int
     start_at: int
 
     def __call__(self, decls: Sequence[D], by: int, path: str | None) -> Iterator[D]:
         """``decls`` moved by ``by`` characters, of ``path``, made by C code alone: a
         megabyte has thousands of trees."""
-        columns: list[Iterator[Any]] = [map(f, decls) for f in _FIELDS]
+        columns: list[Iterator[Any]] = [map(f, decls) for f in _FIELDS[: self.width]]
         columns[self.path_at] = repeat(path)
         add = by.__add__
         s = self.start_at
@@ -470,8 +589,14 @@ class _Mover(NamedTuple):
         return map(self.make, zip(*columns, strict=False))
 
 
-_moved_trees = _Mover(partial(_new, TreeDecl), *map(TreeDecl._fields.index, ("path", "start")))
-_moved_models = _Mover(partial(_new, ModelDecl), *map(ModelDecl._fields.index, ("path", "start")))
+_moved_trees = _Mover(
+    partial(_new, TreeDecl), len(TreeDecl._fields), *map(TreeDecl._fields.index, ("path", "start"))
+)
+_moved_models = _Mover(
+    partial(_new, ModelDecl),
+    len(ModelDecl._fields),
+    *map(ModelDecl._fields.index, ("path", "start")),
+)
 
 
 def _id_span(el: Element) -> tuple[str | None, int, int]:

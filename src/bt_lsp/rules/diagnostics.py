@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Final
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.syntax.elements import NameRef, Role
+from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
@@ -139,9 +140,9 @@ def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
 
 
 # For each document, the sections of its last model and those of them with diagnostics.
-_NOISY: weakref.WeakKeyDictionary[Document, tuple[set[Section], set[Section]]] = (
-    weakref.WeakKeyDictionary()
-)
+_SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
+    Document, tuple[set[Section], set[Section]]
+] = weakref.WeakKeyDictionary()
 
 
 def _own(section: Section) -> list[Diagnostic]:
@@ -168,14 +169,14 @@ def compute(doc: Document) -> list[Diagnostic]:
         out = list(_own(model.head))
         sections = model.sections
         now = set(sections)
-        seen, noisy = _NOISY.get(doc, (set(), set()))
-        noisy = noisy & now
-        noisy.update(sec for sec in now - seen if _own(sec))
-        _NOISY[doc] = (now, noisy)
-        if noisy:
+        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc, (set(), set()))
+        with_diagnostics = with_diagnostics & now
+        with_diagnostics.update(sec for sec in now - seen if _own(sec))
+        _SECTIONS_WITH_DIAGNOSTICS[doc] = (now, with_diagnostics)
+        if with_diagnostics:
             origins = model.origins
             index = dict(zip(sections, range(len(sections)), strict=True))
-            for k in sorted(index[sec] for sec in noisy):
+            for k in sorted(index[sec] for sec in with_diagnostics):
                 o = origins[k]
                 out.extend(
                     Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)
@@ -236,8 +237,10 @@ def own_diagnostics(doc: Document) -> list[Diagnostic]:
 
 def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
     """What a document larger than ``max_bytes`` (UTF-8) gets: its own diagnostics (XML and
-    names, which stay cheap) and ``document-too-large`` saying the rest does not run."""
-    out = list(own_diagnostics(doc))
+    names, which stay cheap) and ``document-too-large`` saying the rest does not run.
+    Capped like every other path, and found with the cyclic collector paused: hostile
+    input has the most problems."""
+    out = list(limited(with_gc_paused(own_diagnostics)(doc)))
     out.append(
         make(
             0,

@@ -25,7 +25,20 @@ def serve(tcp: bool = False, host: str = "127.0.0.1", port: int = 2087) -> None:
     # as warnings; on stderr the editor shows them as errors.  Real problems reach the
     # client through window/logMessage instead.
     logging.getLogger("pygls").setLevel(logging.ERROR)
+    # A deliberate error answer (a refused rename says why) is no failure of the server:
+    # pygls would log it with its traceback, which an editor's log shows as a crash.
+    logging.getLogger("pygls.protocol.json_rpc").addFilter(_deliberate_errors_unlogged)
     if tcp:
         server.start_tcp(host, port)
     else:
         server.start_io()
+
+
+def _deliberate_errors_unlogged(record: object) -> bool:
+    """A logging filter: drop the records of requests answered with a deliberate JSON-RPC
+    error (anything but an internal error), keep everything else."""
+    from pygls.exceptions import JsonRpcException, JsonRpcInternalError
+
+    exc_info = getattr(record, "exc_info", None)
+    error = exc_info[1] if exc_info else None
+    return not (isinstance(error, JsonRpcException) and not isinstance(error, JsonRpcInternalError))

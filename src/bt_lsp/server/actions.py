@@ -16,7 +16,7 @@ from pygls.uris import from_fs_path
 
 from bt_lsp.ide import semantic_fixes
 from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for_name
-from bt_lsp.project.workspace import normalize
+from bt_lsp.project.index import normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit
@@ -58,7 +58,7 @@ def _workspace_edit(
         open_doc = ls.get(uri)
         version = open_doc.version if open_doc is not None else None
         per_uri.append((uri, version, [to_text_edit(doc.lines, e, enc) for e in file_edits]))
-    return workspace_edit(per_uri, ls.versioned_edits)
+    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
 
 
 def _others(ls: BtServer, od: OpenDocument) -> dict[str, Document]:
@@ -77,8 +77,11 @@ def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
     return fixes
 
 
-def _fix_all_edits(ls: BtServer, od: OpenDocument) -> list[TextEdit]:
-    return fix_all(od.doc, ls.diagnostics_of(od)).edits
+def _fix_all_edit(ls: BtServer, od: OpenDocument) -> types.WorkspaceEdit:
+    """Every preferred name fix of the document; a tree defined here is renamed in the
+    other files that call it too (those edits need confirmation where the client can)."""
+    fixed = fix_all(od.doc, ls.diagnostics_of(od), _others(ls, od))
+    return _workspace_edit(ls, od, fixed.edits, fixed.other_edits)
 
 
 def register(server: BtServer) -> None:
@@ -111,9 +114,11 @@ def register(server: BtServer) -> None:
                 for i, fix in enumerate(_all_fixes(ls, od, d)):
                     fixed = same_fix.get((d.start, d.end, fix.title))
                     if fixed is not None:
-                        fixed.append(to_diagnostic(lines, d, enc))
+                        fixed.append(to_diagnostic(lines, d, enc, ls.code_descriptions))
                         continue
-                    fixed = same_fix[(d.start, d.end, fix.title)] = [to_diagnostic(lines, d, enc)]
+                    fixed = same_fix[(d.start, d.end, fix.title)] = [
+                        to_diagnostic(lines, d, enc, ls.code_descriptions)
+                    ]
                     action = types.CodeAction(
                         title=fix.title,
                         kind=types.CodeActionKind.QuickFix,
@@ -137,7 +142,7 @@ def register(server: BtServer) -> None:
             if ls.resolve_edits:
                 action.data = {"uri": od.uri, "version": od.version, "fixAll": True}
             else:
-                action.edit = _workspace_edit(ls, od, _fix_all_edits(ls, od))
+                action.edit = _fix_all_edit(ls, od)
             actions.append(action)
         return actions
 
@@ -150,7 +155,7 @@ def register(server: BtServer) -> None:
         if od is None or od.version != data.get("version"):
             return action  # the document changed; the client asks again
         if data.get("fixAll"):
-            action.edit = _workspace_edit(ls, od, _fix_all_edits(ls, od))
+            action.edit = _fix_all_edit(ls, od)
             return action
         for d in ls.diagnostics_of(od):
             if (d.start, d.end, d.code) == (data.get("start"), data.get("end"), data.get("code")):

@@ -7,11 +7,13 @@ core; this module owns the open documents and when diagnostics are published.
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
+import time
 import traceback
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException, JsonRpcInternalError, JsonRpcMethodNotFound
@@ -19,13 +21,15 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
+from bt_lsp.project.config import CONFIG_NAMES
+from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.settings import Settings
-from bt_lsp.project.workspace import Workspace
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
-from bt_lsp.server.convert import diagnostic_at, to_diagnostic
+from bt_lsp.server import transport
+from bt_lsp.server.convert import diagnostic_at
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
 from bt_lsp.server.project import (
@@ -49,6 +53,10 @@ SECTION = "btLsp"
 # in less time than an editor takes to notice.
 EARLY_NAMES_CHARS = 256 * 1024
 
+# How often, at most, files read from disk are compared with the disk again, for clients
+# that do not send workspace/didChangeWatchedFiles.
+DISK_CHECK_SECONDS = 1.0
+
 
 class BtServer(LanguageServer):
     def __init__(self) -> None:
@@ -69,15 +77,30 @@ class BtServer(LanguageServer):
         self.refresh_support = False
         self.resolve_edits = False
         self.versioned_edits = False
+        self.annotated_edits = False  # change annotations (confirm edits of other files)
+        self.code_descriptions = False  # the client shows a diagnostic's codeDescription
+        self._fetching: asyncio.Future[None] | None = None  # a workspace/configuration
         self.watch_files = False
         self.generation = 0  # bumped when settings change; part of every resultId
-        self.project = Workspace()
+        self.project = ProjectIndex()
         self.edits = 0  # bumped by every change of an open document
         self._timers: dict[str, asyncio.TimerHandle] = {}
         self.cpp = CppService(self)
         # Configuration files' errors as published, by URI (see server/project.py).
         self.config_published: dict[str, tuple[int, int, str]] = {}
         self.versions_logged: set[Path] = set()  # folders whose version was logged
+        self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
+
+    @property
+    def bt_protocol(self) -> BtProtocol:
+        assert isinstance(self.protocol, BtProtocol)
+        return self.protocol
+
+    def start_io(self, stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> None:
+        transport.start_io(self, stdin, stdout)
+
+    def start_tcp(self, host: str, port: int) -> None:
+        transport.start_tcp(self, host, port)
 
     # -- state ----------------------------------------------------------------------------
 
@@ -91,8 +114,22 @@ class BtServer(LanguageServer):
     def get(self, uri: str) -> OpenDocument | None:
         return self.docs.get(uri)
 
+    def check_disk(self) -> None:
+        """Without watched-file notifications, notice files changed on disk by their
+        modification time and size (at most once a second): they are read again, and
+        every document's diagnostics are due."""
+        if self.watch_files:
+            return
+        now = time.monotonic()
+        if now - self._disk_checked < DISK_CHECK_SECONDS:
+            return
+        self._disk_checked = now
+        if self.project.revalidate():
+            self.refresh_all()
+
     def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
         """The document's diagnostics after severity settings, cached per version."""
+        self.check_disk()
         key = (od.version, self.generation, self.project.generation + self.edits)
         if od.cache_key == key:
             return od.cached
@@ -113,11 +150,16 @@ class BtServer(LanguageServer):
         return result
 
     def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
-        enc = self.encoding
-        found = [to_diagnostic(od.doc.lines, d, enc) for d in self.diagnostics_of(od)]
-        if not od.is_bt:
-            found.extend(config_diagnostics(self, od.uri))
-        return found
+        diags = self.diagnostics_of(od)
+        at = od.doc.lines.positions([o for d in diags for o in (d.start, d.end)], self.encoding)
+        return [
+            diagnostic_at(
+                types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
+                d,
+                self.code_descriptions,
+            )
+            for d in diags
+        ] + (config_diagnostics(self, od.uri) if not od.is_bt else [])
 
     # -- publishing -------------------------------------------------------------------------
 
@@ -140,7 +182,9 @@ class BtServer(LanguageServer):
                 uri=uri,
                 diagnostics=[
                     diagnostic_at(
-                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])), d
+                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
+                        d,
+                        self.code_descriptions,
                     )
                     for d in found
                 ],
@@ -176,13 +220,20 @@ class BtServer(LanguageServer):
         od = self.docs.get(uri)
         if od is None:
             return
+        if not od.is_bt and od.path is not None and od.path.name in CONFIG_NAMES:
+            sync_config_diagnostics(self)  # a configuration file's diagnostics are its error
+            return
         try:
-            diags = self.lsp_diagnostics(od)
+            array = od.published.array(
+                od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
+            )
         except Exception:  # a bug must not stop the server; say so in its log
             self.log_error(f"computing diagnostics for {uri}")
             return
-        self.text_document_publish_diagnostics(
-            types.PublishDiagnosticsParams(uri=uri, diagnostics=diags, version=od.version)
+        version = "" if od.version is None else f', "version": {int(od.version)}'
+        self.bt_protocol.notify_json(
+            types.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS,
+            f'{{"uri": {json.dumps(uri)}, "diagnostics": {array}{version}}}',
         )
 
     def clear(self, uri: str) -> None:
@@ -269,8 +320,23 @@ class BtServer(LanguageServer):
         return self._settings_stamps
 
     async def fetch_settings(self) -> None:
+        """Ask for the ``btLsp`` section.  While a request is on its way, a second one is
+        not sent (VS Code sends a didChangeConfiguration right after ``initialized``): the
+        answer to the first one is as new as the change, since the client sent the change
+        before answering it."""
         if not self.configuration_support:
             return
+        pending = self._fetching
+        if pending is not None and not pending.done():
+            await asyncio.shield(pending)
+            return
+        self._fetching = asyncio.get_running_loop().create_future()
+        try:
+            await self._fetch_settings()
+        finally:
+            self._fetching.set_result(None)
+
+    async def _fetch_settings(self) -> None:
         issued = self._next_settings_stamp()
         try:
             result = await self.workspace_configuration_async(
@@ -291,7 +357,7 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 
 def create_server() -> BtServer:
-    from bt_lsp.server import actions, completion, documents, hover, navigation, project
+    from bt_lsp.server import actions, completion, documents, hover, navigation
     from bt_lsp.server import render as render_command
 
     server = BtServer()
@@ -305,6 +371,16 @@ def create_server() -> BtServer:
         ls.configuration_support = bool(ws and ws.configuration)
         ls.refresh_support = bool(ws and ws.diagnostics and ws.diagnostics.refresh_support)
         ls.versioned_edits = bool(ws and ws.workspace_edit and ws.workspace_edit.document_changes)
+        ls.annotated_edits = ls.versioned_edits and bool(
+            ws and ws.workspace_edit and ws.workspace_edit.change_annotation_support
+        )
+        ls.code_descriptions = bool(
+            td
+            and (
+                (td.publish_diagnostics and td.publish_diagnostics.code_description_support)
+                or (td.diagnostic and td.diagnostic.code_description_support)
+            )
+        )
         ca = td.code_action if td else None
         ls.resolve_edits = bool(
             ca and ca.resolve_support and "edit" in ca.resolve_support.properties
@@ -317,7 +393,7 @@ def create_server() -> BtServer:
         if not roots and params.root_uri:
             roots = [params.root_uri]
         paths = [p for p in (to_fs_path(r) for r in roots) if p]
-        ls.project = Workspace(paths, ls.settings)
+        ls.project = ProjectIndex(paths, ls.settings)
         ls.cpp.attach(params)
         ls.watch_files = bool(
             ws and ws.did_change_watched_files and ws.did_change_watched_files.dynamic_registration
@@ -388,7 +464,6 @@ def create_server() -> BtServer:
     navigation.register(server)
     completion.register(server)
     render_command.register(server)
-    project.register(server)
     return server
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 from lsprotocol import types
 
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -22,13 +24,17 @@ def to_offsets(lines: LineIndex, rng: types.Range, enc: Encoding) -> tuple[int, 
     return (start, end) if start <= end else (end, start)
 
 
-def to_diagnostic(lines: LineIndex, d: Diagnostic, enc: Encoding) -> types.Diagnostic:
-    return diagnostic_at(to_range(lines, d.start, d.end, enc), d)
+def to_diagnostic(
+    lines: LineIndex, d: Diagnostic, enc: Encoding, described: bool = True
+) -> types.Diagnostic:
+    return diagnostic_at(to_range(lines, d.start, d.end, enc), d, described)
 
 
-def diagnostic_at(rng: types.Range, d: Diagnostic) -> types.Diagnostic:
-    """``d`` as an LSP diagnostic over ``rng`` (its offsets converted by the caller)."""
-    info = CODES.get(d.code)
+def diagnostic_at(rng: types.Range, d: Diagnostic, described: bool = True) -> types.Diagnostic:
+    """``d`` as an LSP diagnostic over ``rng`` (its offsets converted by the caller), with
+    a link to its code's documentation when ``described`` (the client declared
+    ``codeDescriptionSupport``)."""
+    info = CODES.get(d.code) if described else None
     return types.Diagnostic(
         range=rng,
         message=d.message,
@@ -44,22 +50,114 @@ def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit
     return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)
 
 
+# The change annotation of the edits a fix or rename makes in files other than the one the
+# user is in: clients that support annotations (VS Code) show those edits in a preview to be
+# confirmed before they write the other files.
+OTHER_FILES = "bt-lsp.other-files"
+
+
 def workspace_edit(
-    per_uri: list[tuple[str, int | None, list[types.TextEdit]]], versioned: bool
+    per_uri: list[tuple[str, int | None, list[types.TextEdit]]],
+    versioned: bool,
+    annotated: bool = False,
 ) -> types.WorkspaceEdit:
     """Edits to several documents as one WorkspaceEdit: versioned ``documentChanges`` when
     the client supports them (it then refuses edits to a document that has moved on),
-    else plain ``changes``."""
+    else plain ``changes``.  The first entry is the document the user is in; with
+    ``annotated`` (the client supports change annotations) the edits of the other
+    documents carry an annotation that needs confirmation."""
     if versioned:
-        return types.WorkspaceEdit(
-            document_changes=[
+        changes: list[types.TextDocumentEdit] = []
+        others = False
+        for i, (uri, version, lsp_edits) in enumerate(per_uri):
+            edits: list[types.TextEdit | types.AnnotatedTextEdit | types.SnippetTextEdit]
+            if annotated and i > 0 and lsp_edits:
+                others = True
+                edits = [
+                    types.AnnotatedTextEdit(
+                        range=e.range, new_text=e.new_text, annotation_id=OTHER_FILES
+                    )
+                    for e in lsp_edits
+                ]
+            else:
+                edits = list(lsp_edits)
+            changes.append(
                 types.TextDocumentEdit(
                     text_document=types.OptionalVersionedTextDocumentIdentifier(
                         uri=uri, version=version
                     ),
-                    edits=list(lsp_edits),
+                    edits=edits,
                 )
-                for uri, version, lsp_edits in per_uri
-            ]
+            )
+        return types.WorkspaceEdit(
+            document_changes=list(changes),
+            change_annotations={
+                OTHER_FILES: types.ChangeAnnotation(
+                    label="Other files",
+                    needs_confirmation=True,
+                    description="bt-lsp renames the same name in files other than this one",
+                )
+            }
+            if others
+            else None,
         )
     return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
+
+
+class RawJson(str):
+    """A result that is already JSON text: written into the response as it is (see
+    :meth:`bt_lsp.server.protocol.BtProtocol._send_data`)."""
+
+
+class DiagnosticJson:
+    """LSP diagnostics written as JSON text directly, for publication.
+
+    Converting every diagnostic to lsprotocol objects and unstructuring them again on each
+    edit cost most of a publication (2,000 diagnostics of a 200 KB document: 157 ms).
+    The part of a diagnostic that does not move with edits (message, code, severity,
+    data) is written once and kept for as long as the core keeps the same
+    :class:`Diagnostic` object (an unchanged section keeps its diagnostics); the range is
+    written each time, its positions found in one pass (:meth:`LineIndex.positions`)."""
+
+    def __init__(self) -> None:
+        self._tails: dict[int, tuple[Diagnostic, str]] = {}
+        self.described = True  # with codeDescription links (the client shows them)
+
+    def tail(self, d: Diagnostic) -> str:
+        kept = self._tails.get(id(d))
+        if kept is not None and kept[0] is d:
+            return kept[1]
+        info = CODES.get(d.code) if self.described else None
+        fields: dict[str, object] = {
+            "message": d.message,
+            "severity": int(d.severity),
+            "code": d.code,
+            "source": "bt-lsp",
+        }
+        if info:
+            fields["codeDescription"] = {"href": info.url}
+        if d.data is not None:
+            fields["data"] = d.data.as_json()
+        text = json.dumps(fields)[1:]  # without its "{": it follows the range
+        self._tails[id(d)] = (d, text)
+        return text
+
+    def array(
+        self, lines: LineIndex, diags: list[Diagnostic], enc: Encoding, described: bool = True
+    ) -> str:
+        """The JSON array of ``diags``; forgets the tails of diagnostics not among them."""
+        if described != self.described:
+            self._tails.clear()
+            self.described = described
+        at = lines.positions([o for d in diags for o in (d.start, d.end)], enc)
+        parts = []
+        for d in diags:
+            (sl, sc), (el, ec) = at[d.start], at[d.end]
+            parts.append(
+                f'{{"range": {{"start": {{"line": {sl}, "character": {sc}}}, '
+                f'"end": {{"line": {el}, "character": {ec}}}}}, {self.tail(d)}'
+            )
+        if len(self._tails) > len(diags):
+            keep = {id(d) for d in diags}
+            self._tails = {k: v for k, v in self._tails.items() if k in keep}
+        return "[" + ", ".join(parts) + "]"

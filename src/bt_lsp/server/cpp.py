@@ -88,6 +88,7 @@ class CppService:
             return
         loop = asyncio.get_running_loop()
         token: str | None = None
+        changed = False
         try:
             if self.progress_support:
                 token = f"bt-lsp-cpp-{next(_tokens)}"
@@ -114,7 +115,12 @@ class CppService:
                     scopes.setdefault(models.files_for(p, s.sources, s.exclude), p)
                 for files in scopes:
                     report = self._reporter(loop, token)
-                    await loop.run_in_executor(None, models.catalog, files, report)
+                    before = models.latest(files)
+                    after = await loop.run_in_executor(None, models.catalog, files, report)
+                    # Only a catalog that says something new changes the diagnostics (and
+                    # a pull client's unchanged reports stay unchanged).
+                    if (before is not None or after.nodes) and before != after:
+                        changed = True
         except Exception:
             self.ls.log_error("reading the C++ node registrations")
         finally:
@@ -123,7 +129,8 @@ class CppService:
                     token, types.WorkDoneProgressEnd(message="C++ node catalog read")
                 )
             self._task = None
-        self.ls.refresh_all()  # the documents' contexts now find the catalogs read
+        if changed:
+            self.ls.refresh_all()  # the documents' contexts now find the catalogs read
 
     def _reporter(
         self, loop: asyncio.AbstractEventLoop, token: str | None

@@ -9,7 +9,7 @@ from lsprotocol import types
 from pygls.uris import to_fs_path
 
 from bt_lsp.server.convert import to_offsets
-from bt_lsp.server.project import document_edited
+from bt_lsp.server.project import document_edited, is_project_file, sync_config_diagnostics
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 
@@ -69,10 +69,23 @@ def register(server: BtServer) -> None:
         od = ls.docs.pop(uri, None)
         if od is not None:
             if od.path is not None:
-                ls.project.close(od.path)
+                ls.project.close(od.path)  # from now on the file on disk counts
             ls.cpp.document_changed(od, closed=True)
             ls.clear(uri)
             document_edited(ls, od, closed=True)
+            ls.schedule_all(uri)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
+    def did_save(ls: BtServer, params: types.DidSaveTextDocumentParams) -> None:
+        """A save writes the file the other documents may read from disk (a configuration
+        file, a package.xml or a CMakeLists.txt among them)."""
+        path = to_fs_path(params.text_document.uri)
+        if path:
+            ls.project.file_changed(path)
+        ls.refresh_all()
+        if path and is_project_file(Path(path)):
+            ls.versions_logged.clear()
+            sync_config_diagnostics(ls)
 
     @server.feature(
         types.TEXT_DOCUMENT_DIAGNOSTIC,

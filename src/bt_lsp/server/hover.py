@@ -1,17 +1,33 @@
-"""textDocument/hover: why a name breaks a rule, or what a name is."""
+"""textDocument/hover: why a name breaks a rule, what a name is, or where a blackboard key
+is written and read; in the markup the client asks for first."""
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 from lsprotocol import types
 
 from bt_lsp.ide.hover import hover_at, root_hover
+from bt_lsp.project.index import normalize
 from bt_lsp.server.convert import to_range
 from bt_lsp.server.lookup import context_of, offset_of
 
+# Inline code in the C++ catalog's Markdown, written as quotes for plain-text clients.
+_INLINE_CODE_RE = re.compile(r"`([^`]*)`")
+
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
+
+
+def wants_markdown(caps: types.ClientCapabilities | None) -> bool:
+    """Whether the client's ``textDocument.hover.contentFormat`` puts Markdown first
+    (a client that declares no format gets Markdown, as the protocol's default)."""
+    td = caps.text_document if caps is not None else None
+    formats = td.hover.content_format if td is not None and td.hover is not None else None
+    if not formats:
+        return True
+    return formats[0] == types.MarkupKind.Markdown
 
 
 def register(server: BtServer) -> None:
@@ -23,15 +39,26 @@ def register(server: BtServer) -> None:
         enc = ls.encoding
         lines = od.doc.lines
         offset = offset_of(ls, od, params.position)
-        found = hover_at(od.doc, offset, context_of(ls, od))
+        others = ls.project.other_documents(normalize(od.path)) if od.path is not None else {}
+        try:
+            caps: types.ClientCapabilities | None = ls.client_capabilities
+        except Exception:  # before initialize
+            caps = None
+        markdown = wants_markdown(caps)
+        found = hover_at(od.doc, offset, context_of(ls, od), others, markdown=markdown)
         if found is None and od.path is not None:
             detected = ls.project.btcpp_for(od.path, od.doc)
-            found = root_hover(od.doc, offset, detected.version, detected.source)
+            found = root_hover(od.doc, offset, detected.version, detected.source, markdown)
         if found is None:
             return None
         learned = ls.cpp.hover_markdown(od, offset)  # where the C++ declares it
-        markdown = found.markdown if learned is None else f"{found.markdown}\n\n{learned}"
+        text = found.text
+        if learned is not None:
+            if not found.markdown:
+                learned = _INLINE_CODE_RE.sub(r"'\1'", learned)
+            text = f"{text}\n\n{learned}"
+        kind = types.MarkupKind.Markdown if found.markdown else types.MarkupKind.PlainText
         return types.Hover(
-            contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=markdown),
+            contents=types.MarkupContent(kind=kind, value=text),
             range=to_range(lines, found.start, found.end, enc),
         )

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from lsprotocol import types
 from pygls.uris import from_fs_path, to_fs_path
 
-from bt_lsp.project.workspace import Include, normalize
+from bt_lsp.project.index import Include, normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document

@@ -5,6 +5,7 @@ document's own line index in the negotiated encoding and calls the features of :
 
 from __future__ import annotations
 
+import json
 import os
 import tempfile
 from collections.abc import Sequence
@@ -26,8 +27,8 @@ from bt_lsp.ide.rename import RenameRefused
 from bt_lsp.ide.rename import prepare_rename as rename_target
 from bt_lsp.ide.rename import rename as plan_rename
 from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
-from bt_lsp.project.workspace import links
-from bt_lsp.server.convert import to_range, to_text_edit, workspace_edit
+from bt_lsp.project.index import links
+from bt_lsp.server.convert import RawJson, to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,
     context_of,
@@ -145,18 +146,59 @@ def rename_edit(
         per_uri.append(
             (src.uri, src.version, [to_text_edit(src.doc.lines, e, enc) for e in file_edits])
         )
-    return workspace_edit(per_uri, ls.versioned_edits)
+    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
 
 
-def _document_symbol(lines: LineIndex, s: DocSymbol, enc: Encoding) -> types.DocumentSymbol:
-    return types.DocumentSymbol(
-        name=s.name,
-        detail=s.detail or None,
-        kind=_SYMBOL_KINDS[s.kind],
-        range=to_range(lines, s.start, s.end, enc),
-        selection_range=to_range(lines, s.sel_start, s.sel_end, enc),
-        children=[_document_symbol(lines, c, enc) for c in s.children],
+# The outline's nesting depth.  BehaviorTree.CPP allows trees 256 levels deep; a symbol
+# deeper than this is listed after its ancestor at this depth, in document order (its
+# range stays inside the ancestor's parent), so that no nesting of the answer, in the
+# server or in the client, has to recurse hundreds of levels deep.
+MAX_SYMBOL_DEPTH = 64
+
+
+def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> RawJson:
+    """The outline as the JSON text of LSP DocumentSymbols, written in one pre-order walk
+    without recursion: building lsprotocol objects and unstructuring them cost ten times
+    the outline itself on a large document."""
+    order: list[tuple[DocSymbol, int]] = []
+    stack = [(s, 1) for s in reversed(top)]
+    while stack:
+        s, depth = stack.pop()
+        order.append((s, depth))
+        below = min(depth + 1, MAX_SYMBOL_DEPTH)
+        stack.extend((c, below) for c in reversed(s.children))
+    at = lines.positions(
+        [o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)], enc
     )
+
+    def rng(start: int, end: int) -> str:
+        (sl, sc), (el, ec) = at[start], at[end]
+        return (
+            f'{{"start": {{"line": {sl}, "character": {sc}}}, '
+            f'"end": {{"line": {el}, "character": {ec}}}}}'
+        )
+
+    out = ["["]
+    first = [True] * (MAX_SYMBOL_DEPTH + 2)  # no symbol yet in the open list at a depth
+    open_depth = 0
+    for s, depth in order:
+        while open_depth >= depth:  # close the symbols this one is not inside
+            out.append("]}")
+            open_depth -= 1
+        if not first[depth]:
+            out.append(", ")
+        first[depth] = False
+        detail = f'"detail": {json.dumps(s.detail)}, ' if s.detail else ""
+        out.append(
+            f'{{"name": {json.dumps(s.name)}, {detail}"kind": {int(_SYMBOL_KINDS[s.kind])}, '
+            f'"range": {rng(s.start, s.end)}, '
+            f'"selectionRange": {rng(s.sel_start, s.sel_end)}, "children": ['
+        )
+        first[depth + 1] = True
+        open_depth = depth
+    out.append("]}" * open_depth)
+    out.append("]")
+    return RawJson("".join(out))
 
 
 # --- features -----------------------------------------------------------------------------
@@ -254,15 +296,13 @@ def register(server: BtServer) -> None:
         return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources)
 
     @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
-    def document_symbol(
-        ls: BtServer, params: types.DocumentSymbolParams
-    ) -> list[types.DocumentSymbol] | None:
+    def document_symbol(ls: BtServer, params: types.DocumentSymbolParams) -> RawJson | None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
         enc = ls.encoding
         symbols = document_symbols(od.doc, context_of(ls, od))
-        return [_document_symbol(od.doc.lines, s, enc) for s in symbols]
+        return document_symbols_json(od.doc.lines, symbols, enc)
 
     @server.feature(types.WORKSPACE_SYMBOL)
     def workspace_symbol(

@@ -11,7 +11,7 @@ from lsprotocol import types
 from pygls.uris import from_fs_path, to_fs_path
 
 from bt_lsp.project.config import CONFIG_NAMES, ConfigError
-from bt_lsp.project.workspace import normalize
+from bt_lsp.project.index import normalize
 from bt_lsp.rules.configuration import CONFIG_ERROR
 from bt_lsp.syntax.text import LineIndex
 
@@ -122,17 +122,3 @@ def document_edited(
     else:
         return
     sync_config_diagnostics(ls)
-
-
-def register(server: BtServer) -> None:
-    @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
-    def did_save(ls: BtServer, params: types.DidSaveTextDocumentParams) -> None:
-        fs = to_fs_path(params.text_document.uri)
-        if not fs:
-            return
-        path = normalize(fs)
-        if is_project_file(path):
-            ls.project.file_changed(path)
-            ls.versions_logged.clear()
-            ls.refresh_all()
-            sync_config_diagnostics(ls)

@@ -8,7 +8,10 @@ notification on to ours.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import inspect
+import json
 import os
 import sys
 from collections.abc import Generator
@@ -16,11 +19,114 @@ from typing import Any
 
 from cattrs import ClassValidationError, transform_error
 from lsprotocol import types
-from pygls.exceptions import JsonRpcException, JsonRpcInvalidParams, JsonRpcInvalidRequest
+from pygls.exceptions import (
+    JsonRpcException,
+    JsonRpcInternalError,
+    JsonRpcInvalidParams,
+    JsonRpcInvalidRequest,
+)
 from pygls.protocol import LanguageServerProtocol, lsp_method
+
+from bt_lsp.server import jsonrpc
+from bt_lsp.server.convert import RawJson
+from bt_lsp.server.framing import Body
 
 
 class BtProtocol(LanguageServerProtocol):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._initialize_seen = False
+        self._writes: set[asyncio.Future[Any]] = set()  # writes in flight (websockets)
+
+    def receive(self, body: Body) -> None:
+        """One message body from the framing: answered with the JSON-RPC error it
+        deserves, or structured and handled.  Nothing here may end the read loop."""
+        if body.error is not None:
+            self.log(f"bt-lsp: parse error: {body.error}")
+            self._send_error(None, jsonrpc.PARSE_ERROR, f"Parse error: {body.error}")
+            return
+        bad = jsonrpc.problem(body.value)
+        if bad is not None:
+            msg_id, why = bad
+            self.log(f"bt-lsp: invalid request: {why}")
+            self._send_error(msg_id, jsonrpc.INVALID_REQUEST, f"Invalid request: {why}")
+            return
+        try:
+            message = self.structure_message(body.value)  # type: ignore[arg-type]
+        except Exception as exc:  # a request among them is already answered (InvalidParams)
+            self._server._report_server_error(exc, JsonRpcException)
+            return
+        try:
+            self.handle_message(message)
+        except Exception as exc:  # a bug must not end the read loop
+            self.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    def log(self, message: str) -> None:
+        self.notify(
+            types.WINDOW_LOG_MESSAGE,
+            types.LogMessageParams(type=types.MessageType.Warning, message=message),
+        )
+
+    def _send_data(self, data: Any) -> None:
+        """pygls's writer, except that a response whose result cannot be serialised (a
+        RecursionError, a bug) becomes an InternalError answer to the same id: pygls only
+        logged it, and the request was never answered."""
+        if not data or self.writer is None:
+            super()._send_data(data)
+            return
+        try:
+            result = getattr(data, "result", None)
+            if isinstance(result, RawJson) and getattr(data, "error", None) is None:
+                body = f'{{"jsonrpc": "2.0", "id": {json.dumps(data.id)}, "result": {result}}}'
+            else:
+                body = json.dumps(data, default=self._serialize_message)
+        except Exception as exc:
+            msg_id = getattr(data, "id", None) if not isinstance(data, dict) else data.get("id")
+            is_response = hasattr(data, "result") or hasattr(data, "error")
+            self.log(f"bt-lsp: internal error serialising a message: {exc!r}")
+            if is_response and jsonrpc.valid_id(msg_id):
+                body = json.dumps(
+                    {
+                        "jsonrpc": "2.0",
+                        "id": msg_id,
+                        "error": {
+                            "code": jsonrpc.INTERNAL_ERROR,
+                            "message": f"the answer could not be written: {exc!r}",
+                        },
+                    }
+                )
+            else:
+                return
+        self._write(body)
+
+    def notify_json(self, method: str, params: str) -> None:
+        """A notification whose params are already JSON text."""
+        if self.writer is not None:
+            self._write(f'{{"jsonrpc": "2.0", "method": {json.dumps(method)}, "params": {params}}}')
+
+    def _write(self, body: str) -> None:
+        data = body.encode(self.CHARSET)
+        header = (
+            f"Content-Length: {len(data)}\r\n"
+            f"Content-Type: {self.CONTENT_TYPE}; charset={self.CHARSET}\r\n\r\n"
+        ).encode("ascii")
+        assert self.writer is not None
+        try:
+            res = self.writer.write(header + data if self._include_headers else data)
+            if inspect.isawaitable(res):
+                self._writes.add(task := asyncio.ensure_future(res))
+                task.add_done_callback(self._writes.discard)
+        except BrokenPipeError:
+            raise
+        except Exception as error:
+            self._server._report_server_error(error, JsonRpcInternalError)
+
+    def _send_error(self, msg_id: Any, code: int, message: str) -> None:
+        """An error response; ``id: null`` is written out (the converter drops None)."""
+        self._send_data(
+            {"jsonrpc": "2.0", "id": msg_id, "error": {"code": code, "message": message}}
+        )
+
     def structure_message(self, data: dict[str, Any]) -> Any:
         """A request whose params do not have its method's shape is answered with an
         InvalidParams error; pygls only logs it, and the client would wait forever."""
@@ -50,10 +156,61 @@ class BtProtocol(LanguageServerProtocol):
                 stream.flush()
         os._exit(0 if self._shutdown else 1)
 
+    def _execute_handler(
+        self,
+        msg_id: Any,
+        handler: Any,
+        callback: Any,
+        args: tuple[Any, ...] | None = None,
+        kwargs: dict[str, Any] | None = None,
+    ) -> None:
+        """Forget a handler's future once it is done.  pygls files the future of every
+        notification handler and of every step of a generator handler under a fresh id
+        in ``_request_futures`` and removes only those of requests: the sync handlers of
+        didOpen/didChange/didClose left one future (with its params, the changed text)
+        per notification, a few KiB each, for the life of the process."""
+
+        def done(future: Any) -> None:
+            try:
+                callback(future)
+            finally:
+                if self._request_futures.get(msg_id) is future:
+                    del self._request_futures[msg_id]
+
+        super()._execute_handler(msg_id, handler, done, args, kwargs)
+
+    @lsp_method(types.SHUTDOWN)
+    def lsp_shutdown(self, *args: Any) -> Generator[Any, Any, None]:
+        """pygls's shutdown, over a copy of the in-flight futures: cancelling one runs
+        its done callback at once, which forgets it (see :meth:`_execute_handler`)."""
+        handler = self.fm.features.get(types.SHUTDOWN)
+        if handler is not None:
+            yield handler, args, None
+        current = self.msg_id
+        for msg_id, future in list(self._request_futures.items()):
+            if msg_id != current and not future.done():
+                future.cancel()
+        self._shutdown = True
+
     def handle_message(self, message: Any) -> None:
-        """After ``shutdown``, answer requests with InvalidRequest as LSP asks (pygls drops
-        them silently, which leaves a client waiting); notifications other than ``exit``
-        are ignored."""
+        """Before ``initialize``, requests get ServerNotInitialized and notifications other
+        than ``exit`` are dropped; a second ``initialize`` is refused (LSP).  After
+        ``shutdown``, requests get InvalidRequest as LSP asks (pygls drops them silently,
+        which leaves a client waiting); notifications other than ``exit`` are ignored."""
+        method = getattr(message, "method", None)
+        msg_id = getattr(message, "id", None)
+        is_request = method is not None and hasattr(message, "id")
+        if method == types.INITIALIZE and is_request:
+            if self._initialize_seen:
+                self._send_error(msg_id, jsonrpc.INVALID_REQUEST, "initialize was already received")
+                return
+            self._initialize_seen = True
+        elif not self._initialize_seen and method is not None and method != types.EXIT:
+            if is_request:
+                self._send_error(
+                    msg_id, jsonrpc.SERVER_NOT_INITIALIZED, f"{method} before initialize"
+                )
+            return
         if (
             self._shutdown
             and getattr(message, "method", types.EXIT) != types.EXIT

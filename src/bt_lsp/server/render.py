@@ -187,6 +187,7 @@ def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
             diagnostics=diagnostics,
             ports=ports,
             expand_subtrees=expand,
+            text_length=len(od.doc.text),
         )
         resolve = workspace_resolver(model, ctx)
     # Where each called tree is, for a client to open it.

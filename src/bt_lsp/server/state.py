@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.server.convert import DiagnosticJson
 from bt_lsp.syntax.document import Document
 
 
@@ -20,6 +21,7 @@ class OpenDocument:
     # Diagnostics cached for (version, settings generation, workspace generation).
     cache_key: tuple[int | None, int, int] | None = None
     cached: list[Diagnostic] = field(default_factory=list)
+    published: DiagnosticJson = field(default_factory=DiagnosticJson)  # reused JSON
 
     def refresh_kind(self) -> None:
         self.is_bt = self.doc.is_bt

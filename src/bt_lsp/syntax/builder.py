@@ -17,6 +17,7 @@ from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
 
 _ZONE_OUTSIDE = Zone.OUTSIDE
+_ZONE_TREE = Zone.TREE
 _ZONE_PORT_DECL = Zone.PORT_DECL
 _ZONE_ROOT = Zone.ROOT
 
@@ -93,6 +94,17 @@ class _Builder:
         while i < n:
             tok = tokens[i]
             kind = tok.kind
+            if (
+                kind == start_kind
+                and tok.name == "BehaviorTree"
+                and len(stack) > 1
+                and els[stack[1]].zone == _ZONE_TREE
+            ):
+                # A tree starts while the one above is not closed yet (it is being typed):
+                # a <BehaviorTree> can only be a child of <root>, so the open elements end
+                # here, and it starts the next tree.
+                while len(stack) > 1:
+                    _report_unclosed(els[stack.pop()], problems, before="<BehaviorTree>")
             at_root = len(stack) == 1 and stack[0] == 0
             if at_root and mode != _TAIL:
                 if kind == start_kind and (mode == _HEAD or i != first):
@@ -348,10 +360,17 @@ def _content(tokens: list[Token], starts: Sequence[int], text: str, first: int, 
     return " ".join("".join(parts).split())
 
 
-def _report_unclosed(el: Element, problems: list[StructureProblem], closed_by: str | None) -> None:
+def _report_unclosed(
+    el: Element,
+    problems: list[StructureProblem],
+    closed_by: str | None = None,
+    before: str | None = None,
+) -> None:
     if not el.closed:
         return  # its start tag already has an error; do not cascade
     where = f" before '</{closed_by}>'" if closed_by is not None else ""
+    if before is not None:
+        where = f" before the next '{before}'"
     problems.append(
         StructureProblem(
             el.name_start, el.name_end, XML_SYNTAX, f"Element '<{el.name}>' is not closed{where}"

@@ -127,6 +127,11 @@ def _char_ref(body: str) -> str | None:
     return chr(cp)
 
 
+def _is_nul_ref(body: str) -> bool:
+    digits = body[2:] if body[1:2] == "x" else body[1:]
+    return digits != "" and set(digits) == {"0"}
+
+
 def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
     """Decode references in an attribute value.
 
@@ -186,7 +191,9 @@ def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
                             f"Invalid character reference '{m.group(0)}'",
                         )
                     )
-                out.append(m.group(0))
+                # A reference to NUL stands for that character in the names it is in (so
+                # the name's own rule reports it, as for '&#1;'); others stay as written.
+                out.append("\x00" if _is_nul_ref(body) else m.group(0))
             else:
                 out.append(ch)
         elif body in _PREDEFINED:

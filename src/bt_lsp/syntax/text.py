@@ -326,6 +326,32 @@ class LineIndex:
             offset -= 1  # between "\r" and "\n": the end of the line
         return line, _column(text, start, offset, encoding)
 
+    def positions(self, offsets: Iterable[int], encoding: Encoding) -> dict[int, tuple[int, int]]:
+        """:meth:`position` of each of ``offsets``, in one pass: on one line each column
+        is counted on from the previous offset's, so that many positions on a long line
+        (a minified document) cost the line once, not once each."""
+        text = self._text
+        n = len(text)
+        out: dict[int, tuple[int, int]] = {}
+        line = -1
+        at = column = 0
+        for o in sorted(set(offsets)):
+            clamped = min(max(o, 0), n)
+            if 0 < clamped < n and text[clamped - 1] == "\r" and text[clamped] == "\n":
+                clamped -= 1  # between "\r" and "\n": the end of the line
+            if line < 0 or not (self._starts[line] <= clamped < self._line_limit(line)):
+                line, column = self.position(clamped, encoding)
+            else:
+                column += _column(text, at, clamped, encoding)
+            at = clamped
+            out[o] = (line, column)
+        return out
+
+    def _line_limit(self, line: int) -> int:
+        """The offset where the next line starts (or past the end for the last line)."""
+        starts = self._starts
+        return starts[line + 1] if line + 1 < len(starts) else len(self._text) + 1
+
     def offset(self, line: int, character: int, encoding: Encoding) -> int:
         """The offset of a position; the inverse of :meth:`position`.
 

@@ -61,7 +61,7 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
         if zone == node:
             document.check_depth(st, el, scope.depth_flagged)
             res = nodes.check_node(st, el)
-            is_subtree = el.name == "SubTree"
+            is_subtree = el.name == "SubTree" or (st.v3 and el.name == "SubTreePlus")
             if is_subtree:
                 trees.check_call(st, el, scope)
             ports.check_attributes(st, el, res, scope, is_subtree)

@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import TYPE_CHECKING, Final, Literal
 
-from bt_lsp.rules.builtins import BUILTINS, Category, PortModel
+from bt_lsp.rules.builtins import BUILTINS, Category, NodeModel, PortModel
+from bt_lsp.rules.builtins_v3 import V3_BUILTINS, V3_OPTIONAL_PORTS
 from bt_lsp.rules.codes import BT, FixData, Severity, define, defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -49,8 +50,10 @@ class Resolved:
     """The model of a node type as the checks need it.
 
     ``origin`` says where it comes from: a built-in of BehaviorTree.CPP (exact), a custom
-    ``<TreeNodesModel>`` entry (what the author declared; BehaviorTree.CPP itself reads the
-    C++ registration), or the ``<SubTree>`` model of a tree.
+    ``<TreeNodesModel>`` entry, or the ``<SubTree>`` model of a tree.  A custom entry is
+    exact when its source is authoritative (a catalog of what BehaviorTree.CPP registers,
+    ``decl``'s source), else it is what an author declared while BehaviorTree.CPP itself
+    reads the C++ registration.
     """
 
     id: str
@@ -60,11 +63,12 @@ class Resolved:
     min_children: int
     max_children: int | None
     required: tuple[str, ...] = ()  # ports that must be given (see ports.py)
+    authoritative: bool = False  # a custom model from an authoritative source
 
     @property
     def exact(self) -> bool:
         """Whether BehaviorTree.CPP is known to use exactly this model."""
-        return self.origin != "custom"
+        return self.origin != "custom" or self.authoritative
 
 
 def resolve_builtin(type_id: str) -> Resolved | None:
@@ -87,6 +91,22 @@ _BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
 }
 
 
+def _resolve_v3(m: NodeModel) -> Resolved:
+    required = tuple(
+        p.name
+        for p in m.ports
+        if p.default is None and p.direction != "output" and (m.id, p.name) not in V3_OPTIONAL_PORTS
+    )
+    ports = {p.name: p for p in m.ports}
+    return Resolved(m.id, "builtin", m.category, ports, m.min_children, m.max_children, required)
+
+
+#: The built-ins of a BehaviorTree.CPP 3.8 factory (see :mod:`bt_lsp.rules.builtins_v3`).
+_BUILTIN_RESOLVED_V3: Final[dict[str, Resolved]] = {
+    k: _resolve_v3(m) for k, m in V3_BUILTINS.items()
+}
+
+
 def is_compact(el: Element) -> bool:
     return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
 
@@ -101,6 +121,7 @@ class State:
     text: str
     out: list[Diagnostic] = field(default_factory=list)
     v4: bool = False  # <root> declares BTCPP_format
+    v3: bool = False  # the project builds against BehaviorTree.CPP 3 (ctx.btcpp_version)
     _types: dict[str, Resolved | None] = field(default_factory=dict)
     _subtrees: dict[str, Resolved | None] = field(default_factory=dict)
     # Models resolved from declarations, shared by the runs over the sections of one check:
@@ -131,12 +152,18 @@ class State:
         sev = defined(code).severity if severity is None else severity
         if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
             sev = Severity.WARNING
-            message += " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
+            if self.v3:
+                message += " (a check BehaviorTree.CPP 4 makes; this project builds against 3)"
+            else:
+                message += (
+                    " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
+                )
         self.out.append(Diagnostic(start, end, code, message, sev, data))
 
     def resolve(self, type_id: str) -> Resolved | None:
-        """The model of node type ``type_id``: built-in first, then a custom declaration."""
-        r = _BUILTIN_RESOLVED.get(type_id)
+        """The model of node type ``type_id``: built-in first (of the project's
+        BehaviorTree.CPP version), then a custom declaration."""
+        r = (_BUILTIN_RESOLVED_V3 if self.v3 else _BUILTIN_RESOLVED).get(type_id)
         if r is not None:
             return r
         if type_id in self._types:
@@ -152,7 +179,14 @@ class State:
                 p.name for p in decl.ports if p.default is None and p.direction != "output"
             )
             res = Resolved(
-                decl.id, "custom", decl.category, {p.name: p for p in decl.ports}, lo, hi, required
+                decl.id,
+                "custom",
+                decl.category,
+                {p.name: p for p in decl.ports},
+                lo,
+                hi,
+                required,
+                decl.authoritative,
             )
             self.made["model", type_id] = (decl, res)
         self._types[type_id] = res

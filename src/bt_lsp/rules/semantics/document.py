@@ -18,6 +18,11 @@
   was not specified correctly", but applications that call ``createTree("ID")`` and
   documents included by others are fine, so it is only reported for documents no
   workspace document includes.  Range: ``root``.
+* ``no-tree`` (warning): a ``<root>`` with no ``<BehaviorTree>``, no ``<TreeNodesModel>``
+  and no ``<include>``.  BehaviorTree.CPP loads it without complaint and registers
+  nothing; ``createTreeFromText``/``createTreeFromFile`` on it fails ("Can't find a tree").
+  A warning, not an error: an application may load it next to the files that hold its
+  trees and create those.  Range: ``root``.
 * ``nesting-depth`` (error): an element more than 256 levels below its ``<BehaviorTree>``
   ("Maximum XML nesting depth exceeded (limit: 256)").  Range: the first such element's
   name in each tree.
@@ -55,6 +60,12 @@ INCLUDE_ROS_PKG: Final = define(
 NO_MAIN_TREE: Final = define(
     "no-main-tree", Severity.INFORMATION, "several trees and no `main_tree_to_execute`", BT
 )
+NO_TREE: Final = define(
+    "no-tree",
+    Severity.WARNING,
+    "a `<root>` with no tree, no node models and no include: nothing to create",
+    BT,
+)
 NESTING_DEPTH: Final = define(
     "nesting-depth", Severity.ERROR, "a tree nested deeper than 256 levels", BT
 )
@@ -85,6 +96,7 @@ def check_root(st: State) -> None:
         declared = root.attr("BTCPP_format") is not None
         version = st.ctx.btcpp_version
         st.v4 = declared or version == "4"
+        st.v3 = version == "3"
         # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only.
         if not declared and version != "3":
             st.add(
@@ -118,6 +130,20 @@ def check_root(st: State) -> None:
                 "<TreeNodesModel> present BehaviorTree.CPP requires one (model entries "
                 "belong inside <TreeNodesModel>)",
             )
+    if (
+        root.name == "root"
+        and not trees
+        and not models_sections
+        and not model.root_children_named(("include",))
+    ):
+        st.add(
+            root.name_start,
+            root.name_end,
+            "no-tree",
+            "This <root> has no <BehaviorTree>, no <TreeNodesModel> and no <include>: loading "
+            "it registers nothing, and creating a tree from it alone fails with 'Can't find a "
+            "tree'",
+        )
     if (
         root.name == "root"
         and trees > 1

@@ -7,7 +7,10 @@
 * ``unknown-node``: a compact element name or explicit ``ID`` that is neither a built-in
   nor declared in a ``<TreeNodesModel>`` of the context ("Node not recognized").  An error
   when a catalog of the custom nodes is configured (``ctx.workspace_has_custom_models``),
-  else a hint: nodes registered only in C++ are normal.  BehaviorTree.CPP 3 names
+  and then also for a type that only advisory models declare (a tree file's own
+  ``<TreeNodesModel>``, a palette: BehaviorTree.CPP registers from C++ alone); else a
+  warning when the type is one edit away from a known model (very likely a typo), and a
+  hint otherwise: nodes registered only in C++ are normal.  BehaviorTree.CPP 3 names
   (``SequenceStar``, ``SubTreePlus``), the ``RetryUntilSuccesful`` typo and tree IDs used
   as node types are errors in a document with ``BTCPP_format`` and warnings without; a
   case-insensitive match of a built-in is an error; the version 3 built-ins
@@ -32,6 +35,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from typing import Final
@@ -74,8 +78,8 @@ UNKNOWN_NODE: Final = define(
     "unknown-node",
     Severity.ERROR,
     (
-        "a node type that is neither built in nor declared (a hint "
-        "unless a catalog of the custom nodes is configured)"
+        "a node type that is neither built in nor registered (an error with a node "
+        "catalog; else a warning one typo away from a known node, a hint otherwise)"
     ),
     BT,
     fixes={
@@ -123,7 +127,7 @@ V3_ONLY: Final[dict[str, str]] = {
 def check_node(st: State, el: Element) -> Resolved | None:
     """The checks of one node element; returns its model when known."""
     name = el.name
-    if name == "SubTree":
+    if name == "SubTree" or (st.v3 and name == "SubTreePlus"):
         if el.children:
             st.add(
                 el.name_start,
@@ -165,6 +169,9 @@ def check_node(st: State, el: Element) -> Resolved | None:
     if res is None:
         _unknown(st, el, type_id, start, end, name in EXPLICIT_TAGS)
         return None
+    if res.origin == "custom" and not res.authoritative and st.ctx.workspace_has_custom_models:
+        _unregistered(st, type_id, start, end, name in EXPLICIT_TAGS)
+        return None
     _children(st, el, res)
     if res.id == "ReactiveSequence":
         _reactive(st, el)
@@ -196,6 +203,17 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             "unknown-node",
             f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}",
             Severity.ERROR if st.v4 else Severity.WARNING,
+            data,
+        )
+        return
+    if st.v3 and type_id in BUILTINS:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"{quoted(type_id)} is a built-in node of BehaviorTree.CPP 4; this project builds "
+            "against BehaviorTree.CPP 3, which does not register it (register it in C++)",
+            Severity.WARNING,
             data,
         )
         return
@@ -233,8 +251,13 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             data,
         )
         return
-    severity = None if ctx.workspace_has_custom_models else Severity.HINT
     suggestion = _closest(st, type_id)
+    if ctx.workspace_has_custom_models:
+        severity = None
+    elif suggestion is not None and edit_distance(type_id, suggestion, 1) <= 1:
+        severity = Severity.WARNING  # one typo away from a known model: very likely wrong
+    else:
+        severity = Severity.HINT
     if suggestion is not None:
         data = UnknownNodeData(type_id, explicit, suggestion)
     if ctx.workspace_has_custom_models:
@@ -250,6 +273,28 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
     if suggestion is not None:
         message += f"; did you mean {quoted(suggestion)}?"
     st.add(start, end, "unknown-node", message, severity, data)
+
+
+def _unregistered(st: State, type_id: str, start: int, end: int, explicit: bool) -> None:
+    """A node type that only advisory models declare, while a catalog of what the
+    application registers is known: BehaviorTree.CPP registers nodes from C++ alone and
+    fails with 'Node not recognized'."""
+    decl = st.ctx.models.get(type_id)
+    where = "this document" if decl is None or st.ctx.is_own(decl) else _base(decl.path)
+    st.add(
+        start,
+        end,
+        "unknown-node",
+        f"Node type {quoted(type_id)} is not in the node catalog; only the <TreeNodesModel> "
+        f"of {where} declares it, and BehaviorTree.CPP registers nodes from C++ alone, so it "
+        "fails with 'Node not recognized'",
+        Severity.ERROR,
+        UnknownNodeData(type_id, explicit),
+    )
+
+
+def _base(path: str | None) -> str:
+    return os.path.basename(path) if path else "another document"
 
 
 def _closest(st: State, type_id: str) -> str | None:

@@ -4,37 +4,50 @@ An attribute is a port exactly when :func:`bt_lsp.rules.names.is_allowed_port_na
 BehaviorTree.CPP); ``ID``, ``name``, ``_autoremap`` and the pre/post-condition scripts are
 reserved; everything else is silently ignored by BehaviorTree.CPP.
 
+A model is exact when it is a built-in's or comes from an authoritative catalog (see
+:data:`bt_lsp.rules.context.AUTHORITATIVE`); a ``<TreeNodesModel>`` entry of a tree file is
+advisory (BehaviorTree.CPP reads the C++ registration, not it).
+
 * ``undeclared-port``: a port attribute the node's model does not declare.  An error for
-  a built-in ("… is found in the XML but not in the providedPorts()"), a warning for a
-  node declared in ``<TreeNodesModel>`` (the C++ declaration is what counts) and for a
+  an exact model (BehaviorTree.CPP 4 throws at tree creation: "a port with name … is found
+  in the XML but not in the providedPorts()"), a warning for an advisory one and for a
   ``<SubTree>`` call whose tree has a ``<SubTree>`` model (BehaviorTree.CPP passes any
   attribute on as a remapping, so an undeclared one is only suspicious).  Nothing is
   reported when the model is unknown, or for a ``<SubTree>`` call without a model.
   Range: the attribute name.
 * ``missing-required-port``: a port without a default that is not given.  Built-ins:
-  input and inout ports, an error (the node fails when it reads it).  Custom models: input
-  and inout ports without a ``default``, a warning.  ``<SubTree>`` models: every port whose
-  ``default`` is absent or empty, an error unless ``_autoremap`` is true ("is defining a
-  mandatory port … but you are not remapping it").  Range: the element name.
+  input and inout ports, an error (the node fails when it reads it).  Custom models: a
+  hint at most, since BehaviorTree.CPP never checks ports when it loads or creates a tree
+  and a node's code often reads a port without a default as optional (``getInput``
+  returning an error).  ``<SubTree>`` models: every port whose ``default`` is absent or
+  empty, an error unless ``_autoremap`` is true ("is defining a mandatory port … but you
+  are not remapping it").  Range: the element name.
 * ``invalid-port-value``: a literal that does not convert to the declared type (values in
-  ``{…}`` are blackboard references and never checked); an error for built-ins, a
-  warning for custom models; ``_autoremap`` on ``<SubTree>`` must be a bool literal.
-  Range: the value.
+  ``{…}`` are blackboard references and never checked); an error for an exact model
+  (BehaviorTree.CPP converts the literal at tree creation for a strongly typed port with
+  a converter), a warning for an advisory one; ``_autoremap`` on ``<SubTree>`` must be a
+  bool literal.  Range: the value.
 * ``blackboard-type-mismatch``: within one tree, a ``{key}`` used by ports of two
   different strong types (the first use fixes the entry's type; a ``std::string`` entry
-  accepts anything).  An error when both types come from built-ins, else a warning.
-  Range: the later value.
+  accepts anything).  An error when both models are exact, else a warning.  Shared
+  pointers of two classes read by an input port are a hint: BehaviorTree.CPP accepts the
+  connection when the application registers a polymorphic cast between them (input ports
+  only; an inout or output port must match exactly).  Range: the later value.
 * ``port-name-not-remappable`` (warning): an attribute that passes the name rules but
   not ``is_allowed_port_name`` and does not start with ``_`` (``检查``, ``-x``): never a
   port.  Range: the attribute name.
-* ``unknown-attribute`` (warning): an attribute starting with ``_`` that is not reserved
+* ``unknown-attribute``: an attribute starting with ``_`` that is not reserved
   (``_skipif``); ``_description``, ``_uid`` and ``_fullpath`` (written by BehaviorTree.CPP
-  itself) are allowed.  Fix: the reserved name it most likely means (``__shared_blackboard``
-  and ``__autoremap`` are version 3 spellings of ``_autoremap``).  Range: the name.
+  itself) are allowed.  BehaviorTree.CPP keeps such an attribute in the node's
+  ``NodeConfig::other_attributes``, where only the node's C++ can read it.  A warning when
+  it is close to a reserved name (then very likely a misspelling), else a hint.  Fix: the
+  reserved name it most likely means (``__shared_blackboard`` and ``__autoremap`` are
+  version 3 spellings of ``_autoremap``).  Range: the name.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Final
@@ -90,7 +103,11 @@ UNDECLARED_PORT: Final = define(
     "undeclared-port", Severity.ERROR, "an attribute the node's model does not declare", BT
 )
 MISSING_REQUIRED_PORT: Final = define(
-    "missing-required-port", Severity.ERROR, "a port without a default that is not given", BT
+    "missing-required-port",
+    Severity.ERROR,
+    "a port without a default that is not given (a hint for custom nodes: "
+    "BehaviorTree.CPP does not check it)",
+    BT,
 )
 INVALID_PORT_VALUE: Final = define(
     "invalid-port-value", Severity.ERROR, "a literal that does not convert to the port's type", BT
@@ -110,7 +127,8 @@ PORT_NAME_NOT_REMAPPABLE: Final = define(
 UNKNOWN_ATTRIBUTE: Final = define(
     "unknown-attribute",
     Severity.WARNING,
-    "an underscore attribute BehaviorTree.CPP silently ignores",
+    "an underscore attribute that is neither a port nor reserved (kept in the node's "
+    "`other_attributes`; a hint unless it looks like a misspelled reserved name)",
     BT,
     fixes={"rename": "Did you mean '{suggestion}'? Rename '{old}'"},
 )
@@ -161,6 +179,20 @@ def canonical_type(type_: str) -> str | None:
     return t
 
 
+_SHARED_POINTER: Final = re.compile(
+    r"(?:std::)?shared_ptr<\s*(?P<a>.+?)\s*>|(?P<b>.+?)::(?:Ptr|SharedPtr|ConstPtr)"
+)
+
+
+def pointee(type_: str) -> str | None:
+    """The class a shared pointer type points to (``std::shared_ptr<Cat>``, ``Cat::Ptr``),
+    or ``None`` for any other type."""
+    m = _SHARED_POINTER.fullmatch(type_)
+    if m is None:
+        return None
+    return m.group("a") or m.group("b")
+
+
 def suggest_attribute(name: str) -> tuple[str, bool] | None:
     """The reserved attribute ``name`` probably means, and whether that is a sure match."""
     if name in V3_ATTRIBUTES:
@@ -193,7 +225,8 @@ def check_attributes(
         if an in CONDITION_ATTRS:
             scripts.check(st, el, a)
             continue
-        if an == "_autoremap":
+        if an == "_autoremap" or (st.v3 and is_subtree and an in V3_ATTRIBUTES):
+            # Version 3 spells it __shared_blackboard (SubTree) or __autoremap (SubTreePlus).
             if is_subtree:
                 autoremap = _check_autoremap(st, el, a, value)
             continue
@@ -220,15 +253,18 @@ def check_attributes(
 
 def _unknown_attribute(st: State, an: str, s: int, e: int) -> None:
     message = (
-        f"BehaviorTree.CPP silently ignores the attribute {quoted(an)}: it is neither a port "
-        "(ports start with a letter) nor a reserved attribute"
+        f"{quoted(an)} is neither a port (ports start with a letter) nor a reserved "
+        "attribute: BehaviorTree.CPP only keeps it in the node's other_attributes, which "
+        "nothing but the node's own C++ code reads"
     )
     sug = suggest_attribute(an)
     data: AttributeSuggestion | None = None
+    severity: Severity | None = Severity.HINT
     if sug is not None:
         message += f"; did you mean {quoted(sug[0])}?"
         data = AttributeSuggestion(sug[0], sug[1])
-    st.add(s, e, "unknown-attribute", message, None, data)
+        severity = None
+    st.add(s, e, "unknown-attribute", message, severity, data)
 
 
 def _check_autoremap(st: State, el: Element, a: Attr, value: str) -> bool:
@@ -238,7 +274,7 @@ def _check_autoremap(st: State, el: Element, a: Attr, value: str) -> bool:
             s,
             e,
             "invalid-port-value",
-            f"_autoremap must be a bool literal (true/false, 1/0), not {quoted(value)}; "
+            f"{a.name} must be a bool literal (true/false, 1/0), not {quoted(value)}; "
             "BehaviorTree.CPP fails with 'invalid bool conversion'",
         )
         return False
@@ -249,6 +285,8 @@ def _owner(res: Resolved) -> str:
     if res.origin == "subtree":
         return f"The <SubTree> model of tree {quoted(res.id)}"
     if res.origin == "custom":
+        if res.authoritative:
+            return f"The node catalog's model of {quoted(res.id)}"
         return f"The <TreeNodesModel> entry of {quoted(res.id)}"
     return f"The built-in node {quoted(res.id)}"
 
@@ -297,8 +335,11 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         st.add(s, e, "undeclared-port", message, Severity.WARNING)
         return
     message = f"{_owner(res)} has no port {quoted(a.name)} (ports: {declared}){hint}"
-    if res.origin == "builtin":
-        message += "; BehaviorTree.CPP rejects attributes missing from providedPorts()"
+    if res.exact:
+        message += (
+            "; BehaviorTree.CPP refuses to create the tree: the attribute is not in the "
+            "node's providedPorts()"
+        )
         st.add(s, e, "undeclared-port", message)
     else:
         message += "; BehaviorTree.CPP rejects it unless the C++ node declares it"
@@ -306,8 +347,8 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
 
 
 def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: bool) -> None:
-    if not res.required or (autoremap and res.origin == "subtree"):
-        return
+    if not res.required or (res.origin == "subtree" and (autoremap or st.v3)):
+        return  # BehaviorTree.CPP 3 does not check a SubTree model's ports
     missing = [p for p in res.required if p not in given]
     if not missing:
         return
@@ -327,10 +368,12 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         severity = None
     else:
         message = (
-            f"{_owner(res)} declares port{plural} {shown} without a default, and it is not "
-            "given here"
+            f"{_owner(res)} declares port{plural} {shown} without a default, and "
+            f"{'they are' if plural else 'it is'} not given here; BehaviorTree.CPP does not "
+            "check ports when it loads or creates the tree, and a port without a default may "
+            "be optional in the node's code"
         )
-        severity = Severity.WARNING
+        severity = Severity.HINT
     st.add(
         el.name_start,
         el.name_end,
@@ -362,6 +405,19 @@ def _blackboard_use(
     if first.type == canon or first.type == "std::string":
         return
     s, e = el.span_of_value(a)
+    held, wanted = pointee(first.type), pointee(canon)
+    if held is not None and wanted is not None and port.direction == "input":
+        st.add(
+            s,
+            e,
+            "blackboard-type-mismatch",
+            f"Blackboard key {quoted(key)} holds a {first.shown} (port {quoted(first.port)} "
+            f"of {quoted(first.node)}) and is read as {port.type} here; BehaviorTree.CPP "
+            "creates the tree only if the application registers a polymorphic cast between "
+            f"{held} and {wanted} (registerPolymorphicCast)",
+            Severity.HINT,
+        )
+        return
     st.add(
         s,
         e,

@@ -110,7 +110,7 @@ class _History:
     sigs: dict[Dep, object] = dataclasses.field(default_factory=dict)
     sources: tuple[object, ...] = ()
     valid: set[Section] | None = None
-    noisy: set[Section] = dataclasses.field(default_factory=set)
+    with_diagnostics: set[Section] = dataclasses.field(default_factory=set)
     lines: set[Section] = dataclasses.field(default_factory=set)
 
 
@@ -130,7 +130,10 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         ctx.workspace_has_custom_models,
         tuple(sorted(ctx.ros_pkg_paths.items())),
         ctx.included_by,
+        ctx.included,
+        ctx.workspace_files,
         st.v4,
+        st.v3,
         root is not None and len(root.children) > 1,
     )
     memo: dict[Dep, object] = {}
@@ -170,7 +173,7 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         """``sec``'s results are valid: file it under what the next check looks at."""
         valid.add(sec)
         if found.out:
-            noisy.add(sec)
+            with_diagnostics.add(sec)
         if found.line is not None:
             line_dependent.add(sec)
 
@@ -178,7 +181,7 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         assert hist.valid is not None
         valid = hist.valid & now
         todo.extend(now - valid)
-        noisy = hist.noisy & valid
+        with_diagnostics = hist.with_diagnostics & valid
         line_dependent = hist.lines & valid
         if line_dependent:
             index = dict(zip(sections, range(len(sections)), strict=True))
@@ -186,12 +189,12 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
                 entry: _Entry = sec.cache[_KEY]
                 if entry.line != lines.line_of(origins[index[sec]]):
                     valid.discard(sec)
-                    noisy.discard(sec)
+                    with_diagnostics.discard(sec)
                     line_dependent.discard(sec)
                     todo.append(sec)
     else:
         trusted = hist.valid if same and hist.valid is not None else set()
-        valid, noisy, line_dependent = set(), set(), set()
+        valid, with_diagnostics, line_dependent = set(), set(), set()
         for sec, origin in zip(sections, origins, strict=True):
             found: _Entry | None = sec.cache.get(_KEY)
             if found is not None and sec in trusted:
@@ -217,11 +220,11 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
                 sec.cache[_KEY] = found
             assert found is not None
             keep(sec, found)
-    if noisy:
+    if with_diagnostics:
         if index is None:
             index = dict(zip(sections, range(len(sections)), strict=True))
         out = st.out
-        for sec in noisy:
+        for sec in with_diagnostics:
             origin = origins[index[sec]]
             out.extend(
                 Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
@@ -230,7 +233,7 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
     hist.settings = settings
     hist.sigs.update(memo)
     hist.sources = ctx.sources
-    hist.valid, hist.noisy, hist.lines = valid, noisy, line_dependent
+    hist.valid, hist.with_diagnostics, hist.lines = valid, with_diagnostics, line_dependent
 
 
 def _still_valid(
@@ -304,6 +307,7 @@ def _run(
         local,
         st.text[origin : origin + sec.length],
         v4=st.v4,
+        v3=st.v3,
         origin=origin,
         made=st.made,
     )

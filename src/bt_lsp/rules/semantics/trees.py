@@ -6,15 +6,19 @@
 * ``tree-child-count`` (error): a ``<BehaviorTree>`` without exactly one child element.
   Range: ``BehaviorTree``.
 * ``registered-name-as-tree-id``: a ``<BehaviorTree ID>`` or ``<SubTree ID>`` that is the
-  name of a built-in node (error: BehaviorTree.CPP refuses it) or of a node declared in a
-  ``<TreeNodesModel>`` (warning: refused if that node is registered).  Range: the value.
+  name of a built-in node or of a node in an authoritative catalog (error: BehaviorTree.CPP
+  refuses it when it loads the file) or of a node only an advisory ``<TreeNodesModel>``
+  declares (warning: refused if that node is registered).  Range: the value.
 * ``duplicate-tree-id`` (warning): a tree ID defined again, in this document or in a
   document of its include closure (BehaviorTree.CPP silently keeps the last one loaded).
   Range: the ID value of every definition in this document except the first one of it.
 * ``unknown-subtree`` / ``unknown-main-tree``: a ``<SubTree ID>`` or
   ``main_tree_to_execute`` naming no visible tree: an error ("Can't find a tree with
   name"), or a hint when a workspace document that this one does not include defines it
-  (applications often register every file).  Range: the value.
+  (applications often register every file).  The message says where bt-lsp looked: this
+  document, its includes (named), the other BT files of the workspace (counted).  A
+  ``<SubTree ID>`` that breaks a name rule and names no tree is left to the name rules:
+  one problem, one diagnostic.  Range: the value.
 * ``duplicate-subtree-name`` (error): a second ``<SubTree>`` with the same ``name`` in one
   tree ("Duplicate SubTree path detected").  Range: the second ``name`` value.
 * ``subtree-recursion`` (error): trees calling each other in a cycle ("Recursive behavior
@@ -35,6 +39,7 @@ from typing import TYPE_CHECKING, Final
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.context import TreeDecl
+from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import State, TreeScope, quoted
 from bt_lsp.syntax.elements import Element
 
@@ -94,15 +99,25 @@ def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) ->
     decl = st.ctx.models.get(tree_id)
     if decl is not None:
         where = "" if st.ctx.is_own(decl) or not decl.path else f" in {os.path.basename(decl.path)}"
-        st.add(
-            start,
-            end,
-            "registered-name-as-tree-id",
-            f"{quoted(tree_id)} is declared as a node type (<{decl.category}> in "
-            f"<TreeNodesModel>{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
-            "registered node",
-            Severity.WARNING,
-        )
+        if decl.authoritative:
+            st.add(
+                start,
+                end,
+                "registered-name-as-tree-id",
+                f"{quoted(tree_id)} is a registered node type (<{decl.category}> in the node "
+                f"catalog{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
+                "registered node",
+            )
+        else:
+            st.add(
+                start,
+                end,
+                "registered-name-as-tree-id",
+                f"{quoted(tree_id)} is declared as a node type (<{decl.category}> in "
+                f"<TreeNodesModel>{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
+                "registered node, if the C++ registers it",
+                Severity.WARNING,
+            )
         return True
     return False
 
@@ -178,7 +193,9 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
         )
     elif a.value:
         s, e = el.span_of_value(a)
-        if not _registered_name(st, "SubTree", a.value, s, e):
+        if not _registered_name(st, "SubTree", a.value, s, e) and not (
+            a.value not in st.ctx.trees and check_name(a.value, NameKind.MODEL)
+        ):  # an ID that breaks a name rule is one problem: the name rules report it
             _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
     name = el.attr("name")
     if name is not None and name.value is not None:
@@ -214,13 +231,27 @@ def _unknown_tree(st: State, tree_id: str, start: int, end: int, code: str, what
             Severity.HINT,
         )
         return
-    st.add(
-        start,
-        end,
-        code,
-        f"{what} {quoted(tree_id)}, but no tree with that ID is defined in this document "
-        "or in the documents it includes",
+    st.add(start, end, code, f"{what} {quoted(tree_id)}, but {searched(st)}")
+
+
+def searched(st: State) -> str:
+    """Where bt-lsp looked for a tree, for a message: the document, its includes, the
+    workspace."""
+    ctx = st.ctx
+    n = len(ctx.included)
+    if n:
+        names = ", ".join(os.path.basename(p) for p in ctx.included[:3])
+        more = f" and {n - 3} more" if n > 3 else ""
+        files = f"the {n} file{'s' if n > 1 else ''} it includes ({names}{more})"
+    else:
+        files = "any file it includes (it includes none)"
+    m = ctx.workspace_files
+    others = (
+        f"the {m} other BehaviorTree.CPP file{'s' if m > 1 else ''} of the workspace"
+        if m
+        else "the workspace (it holds no other BehaviorTree.CPP file)"
     )
+    return f"no tree with that ID is defined in this document, in {files}, or in {others}"
 
 
 def check_main_tree(st: State) -> None:

@@ -111,7 +111,7 @@ def includes_of(
     return out
 
 
-class Workspace:
+class ProjectIndex:
     """The files of one or more folders.  ``settings`` are the editor's (or the defaults);
     each file's settings are those with its configuration file (:mod:`bt_lsp.project.config`)
     over them, and ``overrides`` (command-line flags) over both."""
@@ -150,7 +150,9 @@ class Workspace:
         self._open[normalize(path)] = doc
 
     def close(self, path: str | os.PathLike[str]) -> None:
-        self._open.pop(normalize(path), None)
+        p = normalize(path)
+        self._open.pop(p, None)
+        self._disk.pop(p, None)  # read again: the file may have been saved while open
         self.generation += 1
 
     def is_open(self, path: Path) -> bool:
@@ -183,7 +185,7 @@ class Workspace:
             self._disk[path] = ((0, 0), None, str(e))
             return None, str(e)
         if not path.is_file():
-            self._disk[path] = ((0, 0), None, "not a file")
+            self._disk[path] = ((st.st_mtime_ns, st.st_size), None, "not a file")
             return None, "not a file"
         stamp = (st.st_mtime_ns, st.st_size)
         try:
@@ -208,6 +210,14 @@ class Workspace:
         if self.cpp is not None:
             self.cpp.file_changed(p)
         self.generation += 1
+
+    def revalidate(self) -> bool:
+        """Forget the files whose modification time or size changed since they were read
+        (for clients that do not report file changes); ``True`` if any did."""
+        changed = [p for p, (stamp, _, _) in self._disk.items() if _stamp(p) != stamp]
+        for p in changed:
+            self.file_changed(p)
+        return bool(changed)
 
     def refresh(self) -> None:
         """Forget everything read from disk (for clients that do not report file changes)."""
@@ -539,6 +549,15 @@ class Workspace:
     def dependents(self, path: Path) -> list[Path]:
         """Open documents whose include closure contains ``path``."""
         return [p for p in self._open if p != path and path in self.include_closure(p)]
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    """What :meth:`Workspace._read` records of a file: (mtime_ns, size), (0, 0) if none."""
+    try:
+        st = path.stat()
+    except (OSError, ValueError):
+        return (0, 0)
+    return (st.st_mtime_ns, st.st_size)
 
 
 def _short(p: Path, base: Path) -> str:

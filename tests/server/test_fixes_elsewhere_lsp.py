@@ -1,0 +1,195 @@
+"""A fix never breaks a working reference, end to end: ``bt-lsp serve`` in a workspace
+folder where some SubTree targets are missing (MoveIt Pro objectives call trees of the
+installation), driven by VS Code's capabilities (versioned edits with change annotations)
+and Neovim 0.11's (plain ``changes``)."""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from collections.abc import AsyncIterator
+from pathlib import Path
+
+import pytest
+import pytest_lsp
+from lsprotocol import types
+from pygls.exceptions import JsonRpcException
+from pygls.uris import from_fs_path
+
+from tests.server.test_navigation_lsp import (
+    CACHE,
+    CONFIG,
+    NavClient,
+    apply,
+    doc_pos,
+    edits_by_uri,
+    ident,
+    open_doc,
+    position,
+    span,
+)
+from tests.test_fixes_elsewhere import FIXED, HELPER, OBJECTIVE, OUTSIDE_TREE
+
+pytestmark = pytest.mark.asyncio(loop_scope="module")
+
+
+def _capabilities(spec: str) -> types.ClientCapabilities:
+    """The client's capabilities; ``eglot-plain`` is Emacs's eglot without markdown-mode,
+    which asks for plain-text hovers only."""
+    if spec != "eglot-plain":
+        return pytest_lsp.client_capabilities(spec)
+    caps = pytest_lsp.client_capabilities("emacs")
+    assert caps.text_document is not None and caps.text_document.hover is not None
+    caps.text_document.hover.content_format = [types.MarkupKind.PlainText]
+    return caps
+
+
+@pytest_lsp.fixture(
+    config=CONFIG, scope="module", params=["visual-studio-code", "neovim@v0.11.0", "eglot-plain"]
+)
+async def lsp(lsp_client: NavClient, request: pytest.FixtureRequest) -> AsyncIterator[None]:
+    ws = Path(tempfile.mkdtemp(prefix="bt-lsp-elsewhere-ws-")).resolve()
+    (ws / "pick.xml").write_text(OBJECTIVE, encoding="utf-8")
+    (ws / "helper.xml").write_text(HELPER, encoding="utf-8")
+    lsp_client.ws = ws
+    lsp_client.spec = request.param
+    folder_uri = from_fs_path(str(ws))
+    assert folder_uri is not None
+    lsp_client.init_result = await lsp_client.initialize_session(
+        types.InitializeParams(
+            capabilities=_capabilities(request.param),
+            workspace_folders=[types.WorkspaceFolder(uri=folder_uri, name="ws")],
+            root_uri=folder_uri,
+            initialization_options={"debounceMs": 0},
+        )
+    )
+    lsp_client.encoding = str(lsp_client.init_result.capabilities.position_encoding or "utf-16")
+    open_doc(lsp_client, "pick.xml", OBJECTIVE)
+    yield
+    await lsp_client.shutdown_session()
+    shutil.rmtree(ws, ignore_errors=True)
+    shutil.rmtree(CACHE, ignore_errors=True)
+
+
+async def _actions(
+    lsp: NavClient, needle: str, only: list[str] | None = None
+) -> list[types.CodeAction]:
+    s, e = span(OBJECTIVE, needle)
+    got = await lsp.text_document_code_action_async(
+        types.CodeActionParams(
+            text_document=ident(lsp.uri("pick.xml")),
+            range=types.Range(
+                position(OBJECTIVE, s, lsp.encoding), position(OBJECTIVE, e, lsp.encoding)
+            ),
+            context=types.CodeActionContext(diagnostics=[], only=only),
+        )
+    )
+    out = [a for a in got or [] if isinstance(a, types.CodeAction)]
+    resolved = []
+    for a in out:
+        if a.edit is None and a.data is not None:
+            a = await lsp.code_action_resolve_async(a)
+        resolved.append(a)
+    return resolved
+
+
+async def test_a_call_of_a_tree_defined_elsewhere_gets_no_fix(lsp: NavClient) -> None:
+    actions = await _actions(lsp, "Open Right Gripper")
+    assert [a.title for a in actions if "Open Right Gripper" in a.title] == []
+
+
+async def test_rename_of_a_call_of_a_tree_defined_elsewhere_is_refused(lsp: NavClient) -> None:
+    with pytest.raises(JsonRpcException) as info:
+        await lsp.text_document_rename_async(
+            types.RenameParams(
+                text_document=ident(lsp.uri("pick.xml")),
+                position=doc_pos(lsp, OBJECTIVE, "Open Right Gripper", into=3),
+                new_name="Open_Right_Gripper",
+            )
+        )
+    assert f"Cannot rename the tree 'Open Right Gripper': {OUTSIDE_TREE}" in str(info.value)
+
+
+async def test_a_node_type_registered_elsewhere_gets_no_preferred_fix(lsp: NavClient) -> None:
+    actions = await _actions(lsp, "Say.Hi")
+    named = [a for a in actions if a.kind == types.CodeActionKind.QuickFix]
+    assert named and not any(a.is_preferred for a in named)
+    assert named[0].title.endswith("is registered outside the workspace: rename it there too")
+
+
+async def test_edits_of_other_files_need_confirmation(lsp: NavClient) -> None:
+    pick, helper = lsp.uri("pick.xml"), lsp.uri("helper.xml")
+    (fix, *_) = await _actions(lsp, "Pick Object Helper")
+    assert fix.is_preferred and fix.edit is not None
+    by_uri = edits_by_uri(fix.edit)
+    assert apply(lsp, HELPER, by_uri[helper]) == HELPER.replace(
+        "Pick Object Helper", "Pick_Object_Helper"
+    )
+    if lsp.spec == "visual-studio-code":  # documentChanges and change annotations
+        changes = fix.edit.document_changes or []
+        kinds = {
+            dc.text_document.uri: {type(e).__name__ for e in dc.edits}
+            for dc in changes
+            if isinstance(dc, types.TextDocumentEdit)
+        }
+        assert kinds == {pick: {"TextEdit"}, helper: {"AnnotatedTextEdit"}}
+        annotations = fix.edit.change_annotations or {}
+        (annotation,) = annotations.values()
+        assert annotation.needs_confirmation is True
+        for dc in changes:
+            assert isinstance(dc, types.TextDocumentEdit)
+            for e in dc.edits:
+                if isinstance(e, types.AnnotatedTextEdit):
+                    assert e.annotation_id in annotations
+    elif lsp.spec == "neovim@v0.11.0":  # no documentChanges: plain edits
+        assert fix.edit.change_annotations is None
+        assert set((fix.edit.changes or {}).keys()) == {pick, helper}
+    else:  # documentChanges without annotation support: plain edits
+        assert fix.edit.change_annotations is None
+        for dc in fix.edit.document_changes or []:
+            assert isinstance(dc, types.TextDocumentEdit)
+            assert all(type(e) is types.TextEdit for e in dc.edits)
+
+
+async def test_fix_all_keeps_calls_of_trees_defined_elsewhere(lsp: NavClient) -> None:
+    pick, helper = lsp.uri("pick.xml"), lsp.uri("helper.xml")
+    (action,) = await _actions(lsp, "<root", only=["source.fixAll.bt-lsp"])
+    assert action.edit is not None
+    by_uri = edits_by_uri(action.edit)
+    assert apply(lsp, OBJECTIVE, by_uri[pick]) == FIXED
+    assert apply(lsp, HELPER, by_uri[helper]) == HELPER.replace(
+        "Pick Object Helper", "Pick_Object_Helper"
+    )
+
+
+async def _hover(lsp: NavClient, needle: str) -> types.MarkupContent:
+    got = await lsp.text_document_hover_async(
+        types.HoverParams(
+            text_document=ident(lsp.uri("pick.xml")),
+            position=doc_pos(lsp, OBJECTIVE, needle, into=2),
+        )
+    )
+    assert got is not None and isinstance(got.contents, types.MarkupContent)
+    plain = lsp.spec == "eglot-plain"
+    kind = types.MarkupKind.PlainText if plain else types.MarkupKind.Markdown
+    assert got.contents.kind == kind
+    if plain:
+        assert "**" not in got.contents.value and "`" not in got.contents.value
+    return got.contents
+
+
+async def test_hover_counts_the_places_the_quick_fix_renames(lsp: NavClient) -> None:
+    (fix, *_) = await _actions(lsp, "Pick Object Helper")
+    assert fix.title.endswith("(2 places, 1 other file)")
+    hover = await _hover(lsp, "Pick Object Helper")
+    new = "'Pick_Object_Helper'" if lsp.spec == "eglot-plain" else "`Pick_Object_Helper`"
+    assert f"Suggested replacement: {new} (the quick fix renames 2 places, 1 other file)" in (
+        hover.value
+    )
+
+
+async def test_hover_says_why_a_call_of_a_tree_defined_elsewhere_has_no_fix(
+    lsp: NavClient,
+) -> None:
+    hover = await _hover(lsp, "Open Right Gripper")
+    assert f"No quick fix renames it: {OUTSIDE_TREE}." in hover.value

@@ -1,0 +1,114 @@
+"""Hover text: Markdown or plain text, narrow lists, where a name comes from (said as a
+fact), the quick fix's count of places, and blackboard keys."""
+
+from __future__ import annotations
+
+from bt_lsp.ide.hover import hover_at
+from bt_lsp.rules.context import Context
+from bt_lsp.syntax.document import Document
+
+KEYS = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main">\n'
+    "    <Sequence>\n"
+    '      <ComputePath path="{goal}" start="{pose}"/>\n'
+    '      <FollowPath path="{goal}"/>\n'
+    '      <ScriptCondition code="goal != 0"/>\n'
+    '      <Unknown thing="{goal}"/>\n'
+    "    </Sequence>\n"
+    "  </BehaviorTree>\n"
+    "  <TreeNodesModel>\n"
+    '    <Action ID="ComputePath">\n'
+    '      <output_port name="path" type="nav_msgs::msg::Path"/>\n'
+    '      <input_port name="start" type="Pose"/>\n'
+    "    </Action>\n"
+    '    <Action ID="FollowPath"><input_port name="path" type="nav_msgs::msg::Path"/></Action>\n'
+    "  </TreeNodesModel>\n"
+    "</root>\n"
+)
+
+
+def _hover(text: str, needle: str, into: int = 1, *, markdown: bool = True, nth: int = 0) -> str:
+    doc = Document(text, "/ws/a.xml")
+    start = -1
+    for _ in range(nth + 1):
+        start = text.index(needle, start + 1)
+    found = hover_at(doc, start + into, Context.from_document(doc), markdown=markdown)
+    assert found is not None, needle
+    assert found.markdown is markdown
+    return found.text
+
+
+def test_a_key_shows_where_it_is_written_and_read_and_its_types() -> None:
+    text = _hover(KEYS, "{goal}", into=2)
+    assert text == (
+        "**Blackboard key `goal` of the tree `Main`**\n"
+        "\n"
+        "Written by:\n"
+        "- `ComputePath` port `path` (line 4), `nav_msgs::msg::Path`\n"
+        "\n"
+        "Read by:\n"
+        "- `FollowPath` port `path` (line 5), `nav_msgs::msg::Path`\n"
+        "- `Unknown` port `thing` (line 7), direction unknown\n"
+        "\n"
+        "In scripts:\n"
+        "- `ScriptCondition` `code` (line 6)\n"
+        "\n"
+        "Port types: `nav_msgs::msg::Path`"
+    )
+    # From its use in a script too.
+    assert _hover(KEYS, "goal != 0", into=1).startswith("**Blackboard key `goal`")
+
+
+def test_plain_text_has_no_markup() -> None:
+    doc = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Main Tree">'
+        '<Sleep msec="1"/></BehaviorTree></root>'
+    )
+    for needle in ("Main Tree", "Sleep", "msec"):
+        text = _hover(doc, needle, markdown=False)
+        assert "**" not in text and "`" not in text, text
+        assert not any(line.startswith("|") for line in text.splitlines()), text
+    bad = _hover(doc, "Main Tree", markdown=False)
+    assert bad.startswith("Model name 'Main Tree' breaks the BehaviorTree.CPP naming rules\n")
+    assert "- column 5 (line 1, col 46): ' ' (space), whitespace:" in bad
+    assert "Suggested replacement: 'Main_Tree' (the quick fix renames 1 place)" in bad
+    assert "- 'msec': input, 'unsigned int', required" in _hover(doc, "Sleep", markdown=False)
+    key = _hover(KEYS, "{goal}", into=2, markdown=False)
+    assert key.startswith("Blackboard key 'goal' of the tree 'Main'\n")
+
+
+def test_where_a_name_comes_from_is_a_fact_not_an_error() -> None:
+    doc = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Main">'
+        '<Sequence><SubTree ID="Elsewhere"/><Spin/></Sequence></BehaviorTree></root>'
+    )
+    call = _hover(doc, "Elsewhere")
+    assert call == (
+        "**SubTree call of the tree `Elsewhere`**\n"
+        "\n"
+        "No file of the workspace defines this tree: it comes from elsewhere, such as an "
+        "installed package."
+    )
+    spin = _hover(doc, "Spin")
+    assert spin == (
+        "**Node type `Spin`**\n"
+        "\n"
+        "Registered in code: no TreeNodesModel entry in the workspace declares this node type."
+    )
+    for text in (call, spin):
+        assert "Not declared" not in text
+
+
+def test_a_bad_call_of_a_tree_defined_elsewhere_says_why_there_is_no_fix() -> None:
+    doc = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Main">'
+        '<SubTree ID="Open Right Gripper"/></BehaviorTree></root>'
+    )
+    text = _hover(doc, "Open Right Gripper")
+    assert text.endswith(
+        "No quick fix renames it: the tree 'Open Right Gripper' is not defined in the "
+        "workspace (it comes from elsewhere, such as an installed package, and keeps its ID "
+        "there); rename it where it is defined first, then this reference."
+    )
+    assert "Suggested replacement" not in text
