@@ -90,6 +90,13 @@ def test_sniffing() -> None:
     assert is_bt_file(PKG / "missing.xml")  # unreadable: checked, so that the error shows
 
 
+def test_broken_bt_files_are_still_checked(tmp_path: Path) -> None:
+    for text in ("", "<Root/>", "<root"):
+        p = tmp_path / "t.xml"
+        p.write_text(text)
+        assert is_bt_file(p), text
+
+
 def test_utf16_files_are_sniffed(tmp_path: Path) -> None:
     p = tmp_path / "t.xml"
     p.write_bytes("\ufeff<root/>".encode("utf-16-le"))

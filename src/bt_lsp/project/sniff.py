@@ -51,10 +51,20 @@ def top_element(text: str) -> str | None:
     return m.group(1) if m is not None else None
 
 
+# The top elements of the other XML a ROS source tree holds: package manifests, launch
+# files, URDF and xacro, pluginlib descriptions, Gazebo SDF, ament/catkin metadata.
+OTHER_XML: Final = frozenset(
+    {"package", "launch", "robot", "library", "class_libraries", "sdf", "model", "world"}
+)
+
+
 def is_bt_file(path: Path | str) -> bool:
-    """Whether the file looks like BehaviorTree.CPP XML: its top element is ``<root>``.
-    A file that cannot be read counts as one, so that reading it reports the error."""
+    """Whether the file is to be checked as BehaviorTree.CPP XML: anything but the known
+    other XML of a source tree (its top element one of :data:`OTHER_XML`), so that a
+    broken BT file (no element, a misspelt ``<root>``) is still reported. A file that
+    cannot be read counts as one, so that reading it reports the error."""
     head = head_of(path)
     if head is None:
         return True
-    return top_element(head) == "root"
+    top = top_element(head)
+    return top is None or top.rpartition(":")[2] not in OTHER_XML
