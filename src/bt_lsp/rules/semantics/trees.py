@@ -194,7 +194,9 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
     elif a.value:
         s, e = el.span_of_value(a)
         if not _registered_name(st, "SubTree", a.value, s, e) and not (
-            a.value not in st.ctx.trees and check_name(a.value, NameKind.MODEL)
+            a.value not in st.ctx.trees
+            and a.value not in st.ctx.workspace_trees
+            and check_name(a.value, NameKind.MODEL)
         ):  # an ID that breaks a name rule is one problem: the name rules report it
             _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
     name = el.attr("name")
