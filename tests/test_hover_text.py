@@ -73,7 +73,7 @@ def test_plain_text_has_no_markup() -> None:
     assert bad.startswith("Model name 'Main Tree' breaks the BehaviorTree.CPP naming rules\n")
     assert "- column 5 (line 1, col 46): ' ' (space), whitespace:" in bad
     assert "Suggested replacement: 'Main_Tree' (the quick fix renames 1 place)" in bad
-    assert "- 'msec': input, 'unsigned int', required" in _hover(doc, "Sleep", markdown=False)
+    assert "- 'msec': input, 'unsigned int', no default" in _hover(doc, "Sleep", markdown=False)
     key = _hover(KEYS, "{goal}", into=2, markdown=False)
     assert key.startswith("Blackboard key 'goal' of the tree 'Main'\n")
 
