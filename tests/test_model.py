@@ -7,7 +7,16 @@ import pytest
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.rules.names import NameKind
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.elements import Role, Zone
+from bt_lsp.syntax.elements import (
+    NameSymbol,
+    PortSymbol,
+    Role,
+    Symbol,
+    Zone,
+    model_symbol,
+    port_symbol,
+    tree_symbol,
+)
 from tests.marks import unmark
 
 # Every checked name position of the contract is marked; nothing else may be a checked name.
@@ -57,24 +66,28 @@ def test_symbols_link_references_to_their_targets() -> None:
         '<SubTree ID="Sub"><input_port name="p"/></SubTree></TreeNodesModel></root>'
     )
     model = Document(text).model
-    by_symbol: dict[tuple[str, ...], list[Role]] = {}
+    by_symbol: dict[Symbol, list[Role]] = {}
     for r in model.refs:
         if r.symbol is not None:
             by_symbol.setdefault(r.symbol, []).append(r.role)
-    assert by_symbol[("tree", "Main")] == [Role.MAIN_TREE, Role.TREE_DEF]
-    assert by_symbol[("tree", "Sub")] == [Role.SUBTREE_CALL, Role.TREE_DEF, Role.MODEL_DEF]
-    assert by_symbol[("model", "Go")] == [
+    assert by_symbol[tree_symbol("Main")] == [Role.MAIN_TREE, Role.TREE_DEF]
+    assert by_symbol[tree_symbol("Sub")] == [Role.SUBTREE_CALL, Role.TREE_DEF, Role.MODEL_DEF]
+    assert by_symbol[model_symbol("Go")] == [
         Role.NODE_TYPE,
         Role.NODE_TYPE_END,
         Role.NODE_ID,
         Role.MODEL_DEF,
     ]
-    assert by_symbol[("port", "model", "Go", "to")] == [
+    assert by_symbol[port_symbol(model_symbol("Go"), "to")] == [
         Role.PORT_USE,
         Role.PORT_USE,
         Role.PORT_DECL,
     ]
-    assert by_symbol[("port", "tree", "Sub", "p")] == [Role.PORT_USE, Role.PORT_DECL]
+    assert by_symbol[port_symbol(tree_symbol("Sub"), "p")] == [Role.PORT_USE, Role.PORT_DECL]
+    port = next(s for s in by_symbol if s.kind == "port" and s.owner_kind == "tree")
+    assert isinstance(port, PortSymbol)
+    assert (port.owner, port.name, port.owner_symbol) == ("Sub", "p", tree_symbol("Sub"))
+    assert all(isinstance(s, NameSymbol | PortSymbol) for s in by_symbol)
 
 
 def test_zones() -> None:

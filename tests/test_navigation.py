@@ -23,6 +23,7 @@ from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
+from bt_lsp.syntax.elements import model_symbol, port_symbol
 from tests.marks import cursor
 
 
@@ -139,10 +140,10 @@ def test_builtin_catalog_is_a_clean_tree_nodes_model() -> None:
     for node in BUILTINS.values():
         if node.category == "SubTree":
             continue
-        s, e = cat.spans[("model", node.id)]
+        s, e = cat.spans[model_symbol(node.id)]
         assert cat.text[s:e] == node.id
         for p in node.ports:
-            s, e = cat.spans[("port", "model", node.id, p.name)]
+            s, e = cat.spans[port_symbol(model_symbol(node.id), p.name)]
             assert cat.text[s:e] == p.name
 
 

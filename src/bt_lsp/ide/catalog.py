@@ -10,7 +10,7 @@ from functools import cache
 
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.syntax.edits import escape_value
-from bt_lsp.syntax.elements import Symbol
+from bt_lsp.syntax.elements import PortSymbol, Symbol, model_symbol
 
 BUILTIN_CATALOG = "bt-lsp:builtins.xml"
 """The ``path`` of places in the built-in node catalog (see :func:`builtin_catalog`)."""
@@ -19,8 +19,8 @@ BUILTIN_CATALOG = "bt-lsp:builtins.xml"
 @dataclass(frozen=True, slots=True)
 class Catalog:
     """A ``<TreeNodesModel>`` of BehaviorTree.CPP's built-in nodes, and where each node's
-    ``ID`` (symbol ``("model", id)``) and each port's ``name`` (``("port", "model", id,
-    port)``) are written in it."""
+    ``ID`` (its :class:`~bt_lsp.syntax.elements.NameSymbol`) and each port's ``name`` (its
+    :class:`~bt_lsp.syntax.elements.PortSymbol`) are written in it."""
 
     text: str
     spans: Mapping[Symbol, tuple[int, int]]
@@ -61,7 +61,7 @@ def builtin_catalog() -> Catalog:
             continue  # <SubTree> is a call of a tree, never a node type of its own
         add(f"    <!-- {_comment(node.description)} -->\n")
         add(f'    <{node.category} ID="')
-        spans[("model", node.id)] = (pos, pos + len(node.id))
+        spans[model_symbol(node.id)] = (pos, pos + len(node.id))
         add(node.id)
         if not node.ports:
             add('"/>\n')
@@ -69,7 +69,7 @@ def builtin_catalog() -> Catalog:
         add('">\n')
         for p in node.ports:
             add(f'      <{p.direction}_port name="')
-            spans[("port", "model", node.id, p.name)] = (pos, pos + len(p.name))
+            spans[PortSymbol("port", "model", node.id, p.name)] = (pos, pos + len(p.name))
             add(p.name)
             add(f'" type="{escape_value(p.type, chr(34))}"')
             if p.default is not None:

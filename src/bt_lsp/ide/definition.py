@@ -15,7 +15,7 @@ from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
 from bt_lsp.ide.places import IncludeLink, Place
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.elements import Role, Symbol
+from bt_lsp.syntax.elements import PortSymbol, Role, Symbol, model_symbol, tree_symbol
 
 
 def _declarations(
@@ -40,7 +40,7 @@ def _place(ctx: Context, path: str | None, start: int, end: int) -> Place:
 def _tree_definition(
     doc: Document, others: Mapping[str, Document], ctx: Context | None, tree_id: str
 ) -> list[Place]:
-    sym: Symbol = ("tree", tree_id)
+    sym = tree_symbol(tree_id)
     own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.TREE_DEF]
     if own:
         return own
@@ -55,7 +55,7 @@ def _tree_definition(
 def _model_definition(
     doc: Document, others: Mapping[str, Document], ctx: Context | None, model_id: str
 ) -> list[Place]:
-    sym: Symbol = ("model", model_id)
+    sym = model_symbol(model_id)
     own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.MODEL_DEF]
     if own:
         return own
@@ -70,7 +70,7 @@ def _model_definition(
     return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
 
 
-def _port_definition(doc: Document, others: Mapping[str, Document], sym: Symbol) -> list[Place]:
+def _port_definition(doc: Document, others: Mapping[str, Document], sym: PortSymbol) -> list[Place]:
     found = _declarations(doc, others, sym, Role.PORT_DECL)
     if found:
         return found
@@ -103,10 +103,8 @@ def definition(
     if ref.declaration:
         return [Place(None, ref.start, ref.end)]
     sym = ref.symbol
-    if sym[0] == "tree":
-        return _tree_definition(doc, others, ctx, sym[1])
-    if sym[0] == "model":
-        return _model_definition(doc, others, ctx, sym[1])
-    if sym[0] == "port":
+    if sym.kind == "port":
         return _port_definition(doc, others, sym)
-    return []
+    if sym.kind == "tree":
+        return _tree_definition(doc, others, ctx, sym.name)
+    return _model_definition(doc, others, ctx, sym.name)

@@ -87,11 +87,11 @@ def _what(w: _Writer, ref: NameRef) -> str:
     sym = ref.symbol
     if ref.role == Role.INSTANCE or sym is None:
         return "Instance name (the node's label; it defaults to the node type)"
-    if sym[0] == "port":
-        owner = f"tree {w.code(sym[2])}" if sym[1] == "tree" else f"node type {w.code(sym[2])}"
+    if sym.kind == "port":
+        kind = "tree" if sym.owner_kind == "tree" else "node type"
         what = "Port declaration" if ref.role == Role.PORT_DECL else "Port"
-        return f"{what} {w.code(sym[3])} of the {owner}"
-    name = w.code(sym[1])
+        return f"{what} {w.code(sym.name)} of the {kind} {w.code(sym.owner)}"
+    name = w.code(sym.name)
     return {
         Role.TREE_DEF: f"Behavior tree {name}",
         Role.SUBTREE_CALL: f"SubTree call of the tree {name}",
@@ -118,16 +118,16 @@ def _ports(w: _Writer, ports: Sequence[PortModel]) -> None:
 def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     """What BehaviorTree.CPP knows of a node type or tree: category, ports, description."""
     sym = ref.symbol
-    if sym is None or sym[0] not in ("model", "tree"):
+    if sym is None or sym.kind == "port":
         return
-    if sym[0] == "model" and sym[1] in BUILTINS:
-        b = BUILTINS[sym[1]]
+    if sym.kind == "model" and sym.name in BUILTINS:
+        b = BUILTINS[sym.name]
         w.para(f"Built-in {b.category} of BehaviorTree.CPP: {w.prose(b.description)}")
         _ports(w, b.ports)
         return
     if ctx is None:
         return
-    decl = ctx.models.get(sym[1]) if sym[0] == "model" else ctx.subtree_models.get(sym[1])
+    decl = ctx.models.get(sym.name) if sym.kind == "model" else ctx.subtree_models.get(sym.name)
     if decl is None:
         return
     where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
@@ -142,14 +142,15 @@ def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
 
 def _port_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     sym = ref.symbol
-    if sym is None or sym[0] != "port":
+    if sym is None or sym.kind != "port":
         return
     port: PortModel | None = None
-    if sym[1] == "model" and sym[2] in BUILTINS:
-        port = BUILTINS[sym[2]].port(sym[3])
+    owner = sym.owner
+    if sym.owner_kind == "model" and owner in BUILTINS:
+        port = BUILTINS[owner].port(sym.name)
     elif ctx is not None:
-        decl = ctx.models.get(sym[2]) if sym[1] == "model" else ctx.subtree_models.get(sym[2])
-        port = decl.port(sym[3]) if decl is not None else None
+        decl = ctx.models.get(owner) if sym.owner_kind == "model" else ctx.subtree_models.get(owner)
+        port = decl.port(sym.name) if decl is not None else None
     if port is None:
         return
     default = "no default" if port.default is None else f"default {w.code(port.default)}"
@@ -164,14 +165,14 @@ def _where_defined(
     """Where a name with no declaration in this document comes from: another workspace
     file, or (said as a fact, not as an error) from outside the workspace."""
     sym = ref.symbol
-    if sym is None or ref.role == Role.INSTANCE or sym[0] == "port":
+    if sym is None or ref.role == Role.INSTANCE or sym.kind == "port":
         return
-    if sym[0] == "model" and sym[1] in BUILTINS:
+    if sym.kind == "model" and sym.name in BUILTINS:
         return
-    if sym[0] == "tree":
-        found = ctx.workspace_trees.get(sym[1]) if ctx is not None else None
+    if sym.kind == "tree":
+        found = ctx.workspace_trees.get(sym.name) if ctx is not None else None
         if not found and ctx is not None:
-            found = ctx.trees.get(sym[1])
+            found = ctx.trees.get(sym.name)
         if found:
             w.para(f"Defined in {found[0].path or 'another document'}.")
             return
@@ -182,7 +183,7 @@ def _where_defined(
                 "such as an installed package."
             )
         return
-    decl = ctx.models.get(sym[1]) if ctx is not None else None
+    decl = ctx.models.get(sym.name) if ctx is not None else None
     if decl is None:
         w.para(
             "Registered in code: no TreeNodesModel entry in the workspace declares this node type."

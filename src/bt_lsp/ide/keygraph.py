@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TypeGuard
 
 from bt_lsp.ide.blackboard import (
     KeyRef,
@@ -20,7 +21,7 @@ from bt_lsp.ide.blackboard import (
 from bt_lsp.ide.name_edits import shown
 from bt_lsp.rules.names import is_allowed_port_name
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.elements import NameRef, Role, Symbol, Zone
+from bt_lsp.syntax.elements import NameRef, PortSymbol, Role, Symbol, Zone, tree_symbol
 
 
 @dataclass(frozen=True, slots=True)
@@ -91,13 +92,13 @@ class KeyGraph:
         """The trees with ID ``tid``."""
         return [
             Tree(path, d, r.element)
-            for path, d, r in self.refs(("tree", tid))
+            for path, d, r in self.refs(tree_symbol(tid))
             if r.role == Role.TREE_DEF
         ]
 
     def calls_to(self, tid: str) -> list[_Call]:
         out: list[_Call] = []
-        for path, d, r in self.refs(("tree", tid)):
+        for path, d, r in self.refs(tree_symbol(tid)):
             if r.role == Role.SUBTREE_CALL:
                 c = _call_at(path, d, r.element)
                 if c is not None:
@@ -148,7 +149,7 @@ class KeyGraph:
         tid = t.id
         if tid is None:
             return True
-        roles = {r.role for _, _, r in self.refs(("tree", tid))}
+        roles = {r.role for _, _, r in self.refs(tree_symbol(tid))}
         return Role.MAIN_TREE in roles or Role.SUBTREE_CALL not in roles
 
     def root_users(self, key: str) -> list[Tree]:
@@ -167,7 +168,7 @@ class KeyGraph:
 
     def has_port(self, t: Tree, name: str) -> bool:
         tid = t.id
-        return tid is not None and bool(self.refs(("port", "tree", tid, name)))
+        return tid is not None and bool(self.refs(PortSymbol("port", "tree", tid, name)))
 
 
 @dataclass(slots=True)
@@ -179,7 +180,7 @@ class KeyTargets:
     key: str
     homes: list[Tree]
     uses: list[tuple[Tree, KeyRef]]
-    port: Symbol | None = None
+    port: PortSymbol | None = None
     port_refs: list[tuple[str | None, Document, NameRef]] = field(default_factory=list)
 
     def places(self) -> list[tuple[str | None, int, int, bool]]:
@@ -189,10 +190,10 @@ class KeyTargets:
         return out
 
 
-def port_targets(ws: KeyGraph, sym: Symbol, home: Tree | None = None) -> KeyTargets:
-    """A port of a tree (``("port", "tree", id, name)``): in the tree, the key ``name``."""
-    key = sym[3]
-    homes = ws.trees(sym[2])
+def port_targets(ws: KeyGraph, sym: PortSymbol, home: Tree | None = None) -> KeyTargets:
+    """A port of a tree (``owner_kind == "tree"``): in the tree, the key of its name."""
+    key = sym.name
+    homes = ws.trees(sym.owner)
     if home is not None and home not in homes:
         homes.insert(0, home)
     uses = [(t, u) for t in homes for u in ws.keys(t).of(key)]
@@ -202,11 +203,11 @@ def port_targets(ws: KeyGraph, sym: Symbol, home: Tree | None = None) -> KeyTarg
 def key_targets(ws: KeyGraph, home: Tree, key: str) -> KeyTargets:
     tid = home.id
     if tid is not None and not key.startswith("@"):
-        sym: Symbol = ("port", "tree", tid, key)
+        sym = PortSymbol("port", "tree", tid, key)
         if ws.refs(sym):
             return port_targets(ws, sym, home)
     return KeyTargets(key, [home], [(home, u) for u in ws.keys(home).of(key)])
 
 
-def is_tree_port(sym: Symbol | None) -> bool:
-    return sym is not None and len(sym) == 4 and sym[:2] == ("port", "tree")
+def is_tree_port(sym: Symbol | None) -> TypeGuard[PortSymbol]:
+    return sym is not None and sym.kind == "port" and sym.owner_kind == "tree"

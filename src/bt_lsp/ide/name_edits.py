@@ -50,11 +50,11 @@ def rename_edits(refs: Iterable[NameRef], new_name: str) -> list[TextEdit]:
 def namespace(symbol: Symbol) -> tuple[str, ...]:
     """Names in one namespace must stay distinct: trees and models share one (a tree ID may
     not be a node type), a port's namespace is its owner's ports."""
-    return ("port", *symbol[1:-1]) if symbol[0] == "port" else ("ids",)
+    return ("port", symbol.owner_kind, symbol.owner) if symbol.kind == "port" else ("ids",)
 
 
 def _names_in(model: Model, ns: tuple[str, ...]) -> set[str]:
-    return {sym[-1] for sym in model.by_symbol if namespace(sym) == ns}
+    return {sym.name for sym in model.by_symbol if namespace(sym) == ns}
 
 
 def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = ()) -> set[str]:
@@ -68,7 +68,7 @@ def taken_names(model: Model, symbol: Symbol | None, others: Iterable[Model] = (
     for m in (model, *others):
         taken |= _names_in(m, ns)
     if not any(symbol in m.by_symbol for m in others):
-        taken.discard(symbol[-1])
+        taken.discard(symbol.name)
     return taken
 
 
@@ -109,31 +109,31 @@ def elsewhere(symbol: Symbol | None, models: Iterable[Model]) -> Elsewhere | Non
 
     ``None`` when the target is here, or when there is none: an instance name, and an
     empty name (nothing is registered or defined under it, so no reference works)."""
-    if symbol is None or not symbol[-1]:
+    if symbol is None or not symbol.name:
         return None
-    if symbol[0] == "port":
-        owner: Symbol = (symbol[1], symbol[2])
-        subject = f"the port '{shown(symbol[3])}' of "
+    if symbol.kind == "port":
+        owner = symbol.owner_symbol
+        subject = f"the port '{shown(symbol.name)}' of "
     else:
         owner = symbol
         subject = ""
     models = list(models)
-    if owner[0] == "tree":
+    if owner.kind == "tree":
         if any(r.role == Role.TREE_DEF for m in models for r in m.refs_to(owner)):
             return None
         return Elsewhere(
-            f"{subject}the tree '{shown(owner[1])}'",
-            f"the tree '{shown(owner[1])}' is not defined in the workspace (it comes from "
+            f"{subject}the tree '{shown(owner.name)}'",
+            f"the tree '{shown(owner.name)}' is not defined in the workspace (it comes from "
             "elsewhere, such as an installed package, and keeps its ID there); rename it "
             "where it is defined first, then this reference",
             refuse=True,
         )
-    if owner[0] == "model":
+    if owner.kind == "model":
         if any(r.role == Role.MODEL_DEF for m in models for r in m.refs_to(owner)):
             return None
         return Elsewhere(
-            f"{subject}the node type '{shown(owner[1])}'",
-            f"the node type '{shown(owner[1])}' is registered in code bt-lsp cannot see (no "
+            f"{subject}the node type '{shown(owner.name)}'",
+            f"the node type '{shown(owner.name)}' is registered in code bt-lsp cannot see (no "
             "<TreeNodesModel> entry in the workspace declares it); its registration must be "
             "renamed too",
             refuse=False,

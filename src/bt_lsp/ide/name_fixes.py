@@ -158,14 +158,14 @@ def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str])
         return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken), caution=caution)
     except RenameRefused as e:
         sym = ref.symbol
-        if e.new_name or sym is None or sym[:2] != ("port", "tree"):
+        if e.new_name or sym is None or sym.kind != "port" or sym.owner_kind != "tree":
             return None
         why = e.message
     try:
         plan = renamer.plan(ref, new, keys=False, taken=taken)
     except RenameRefused:
         return None
-    kept = f"key '{shown(sym[3])}' in tree '{shown(sym[2])}'"
+    kept = f"key '{shown(sym.name)}' in tree '{shown(sym.owner)}'"
     return Renaming(ref.text, new, plan, kept, why, caution)
 
 
@@ -274,7 +274,7 @@ def fix_all(
     taken_by_ns: dict[tuple[str, ...], set[str]] = {}
     for m in (model, *(d.model for d in others.values())):
         for sym in m.by_symbol:
-            taken_by_ns.setdefault(namespace(sym), set()).add(sym[-1])
+            taken_by_ns.setdefault(namespace(sym), set()).add(sym.name)
     for diag in diags:
         ref = _name_ref(doc, diag)
         if ref is None:
@@ -293,7 +293,7 @@ def fix_all(
         taken: AbstractSet[str] = frozenset()
         if ref.symbol is not None:
             names = taken_by_ns.setdefault(namespace(ref.symbol), set())
-            taken = _Without(names, ref.symbol[-1])
+            taken = _Without(names, ref.symbol.name)
         r = next(renamings(renamer, ref, taken), None)
         if r is None:
             continue

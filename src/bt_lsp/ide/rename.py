@@ -24,7 +24,7 @@ from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.elements import NameRef, Role, Symbol
+from bt_lsp.syntax.elements import NameRef, PortSymbol, Role, Symbol
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.xmlnames import XML_NAME_RE
 
@@ -97,18 +97,19 @@ def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
         _refuse_key_use(key)
         return RenameTarget(key.start, key.end, key.key, key=key)
     sym = ref.symbol
-    if sym is not None and sym[0] == "model" and sym[1] in BUILTINS:
+    if sym is not None and sym.kind == "model" and sym.name in BUILTINS:
         raise RenameRefused(
-            f"'{shown(sym[1])}' is a built-in node type of BehaviorTree.CPP; it cannot be renamed"
+            f"'{shown(sym.name)}' is a built-in node type of BehaviorTree.CPP; it cannot be renamed"
         )
     if (
         sym is not None
-        and sym[:2] == ("port", "model")
-        and sym[2] in BUILTINS
-        and BUILTINS[sym[2]].port(sym[3]) is not None
+        and sym.kind == "port"
+        and sym.owner_kind == "model"
+        and sym.owner in BUILTINS
+        and BUILTINS[sym.owner].port(sym.name) is not None
     ):
         raise RenameRefused(
-            f"'{shown(sym[3])}' is a port of the built-in node '{sym[2]}'; "
+            f"'{shown(sym.name)}' is a port of the built-in node '{sym.owner}'; "
             "BehaviorTree.CPP declares it, so it cannot be renamed"
         )
     return RenameTarget(ref.start, ref.end, ref.text, ref)
@@ -160,9 +161,9 @@ def _check_new_name(
             new_name,
             "the node type is written as an element name, and this is not a valid XML name",
         )
-    if new_name == sym[-1]:
+    if new_name == sym.name:
         return
-    if sym[0] != "port" and new_name in BUILTINS:
+    if sym.kind != "port" and new_name in BUILTINS:
         _refuse_new_name(
             new_name,
             "it is a built-in node type of BehaviorTree.CPP, and trees and node types share "
@@ -171,8 +172,10 @@ def _check_new_name(
     if taken is None:
         taken = taken_names(model, sym, (d.model for d in others.values()))
     if new_name in taken:
-        if sym[0] == "port":
-            owner = f"tree '{sym[2]}'" if sym[1] == "tree" else f"node type '{sym[2]}'"
+        if sym.kind == "port":
+            owner = (
+                f"tree '{sym.owner}'" if sym.owner_kind == "tree" else f"node type '{sym.owner}'"
+            )
             _refuse_new_name(new_name, f"the {owner} already has a port with that name")
         _refuse_new_name(
             new_name,
@@ -343,7 +346,7 @@ def combined(plans: Iterable[RenamePlan]) -> RenamePlan:
     return edits.plan()
 
 
-def _port_edits(ws: KeyGraph, sym: Symbol, new_name: str) -> _Edits:
+def _port_edits(ws: KeyGraph, sym: PortSymbol, new_name: str) -> _Edits:
     """Renaming a port: its names, and the ``{=}`` values of renamed attributes spelled out."""
     edits = _Edits()
     for path, d, r in ws.refs(sym):
@@ -424,7 +427,7 @@ class Renamer:
                 return _rename_keys(ws, targets, new_name, port_checked=True)
             _check_no_merge(ws, targets, new_name)
             return _port_edits(ws, sym, new_name).plan()
-        if sym[0] == "port":
+        if sym.kind == "port":
             return _port_edits(ws, sym, new_name).plan()
         return RenamePlan(
             tuple(rename_edits(ws.doc.model.refs_to(sym), new_name)),

@@ -193,13 +193,13 @@ class CppService:
         cat = self._catalog(od) if sym is not None else None
         if sym is None or cat is None:
             return None
-        if sym[0] == "model":
-            node = cat.by_id.get(str(sym[1]))
+        if sym.kind == "model":
+            node = cat.by_id.get(sym.name)
             return (node, None) if node is not None else None
-        if sym[0] == "port" and sym[1] == "model":
-            node = cat.by_id.get(str(sym[2]))
+        if sym.kind == "port" and sym.owner_kind == "model":
+            node = cat.by_id.get(sym.owner)
             if node is not None:
-                port = node.port(str(sym[3]))
+                port = node.port(sym.name)
                 return (node, port) if port is not None else None
         return None
 

@@ -3,19 +3,55 @@ does there (its :class:`Role`), and the records a model is made of (:class:`Elem
 :class:`NameRef`, :class:`StructureProblem`).
 
 A *symbol* identifies what a name denotes, so that renaming one occurrence can rename all:
-``("tree", id)``, ``("model", id)`` and ``("port", "tree"|"model", owner_id, port)``.
+a :class:`NameSymbol` (a tree or a node type, by ID) or a :class:`PortSymbol` (a port of
+one).  They are tuples, so equal symbols are equal keys however they were made.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 from bt_lsp.syntax.scanner import Attr
 from bt_lsp.syntax.vocabulary import NameKind
 
-Symbol = tuple[str, ...]
+
+class NameSymbol(NamedTuple):
+    """A tree (``kind == "tree"``: a ``<BehaviorTree>`` ID, a ``<SubTree>`` entry or call)
+    or a node type (``kind == "model"``) called ``name``."""
+
+    kind: Literal["tree", "model"]
+    name: str
+
+
+class PortSymbol(NamedTuple):
+    """The port ``name`` of the tree or node type ``owner`` (of kind ``owner_kind``)."""
+
+    kind: Literal["port"]
+    owner_kind: Literal["tree", "model"]
+    owner: str
+    name: str
+
+    @property
+    def owner_symbol(self) -> NameSymbol:
+        return NameSymbol(self.owner_kind, self.owner)
+
+
+Symbol = NameSymbol | PortSymbol
+
+
+def tree_symbol(tree_id: str) -> NameSymbol:
+    return NameSymbol("tree", tree_id)
+
+
+def model_symbol(model_id: str) -> NameSymbol:
+    return NameSymbol("model", model_id)
+
+
+def port_symbol(owner: NameSymbol, name: str) -> PortSymbol:
+    return PortSymbol("port", owner.kind, owner.name, name)
+
 
 EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator"})
 PORT_TAGS = frozenset({"input_port", "output_port", "inout_port"})

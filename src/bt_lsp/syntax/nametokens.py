@@ -8,7 +8,20 @@ Symbols repeat (every use of a node type or port), so they are shared, in bounde
 
 from __future__ import annotations
 
-from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, NameRef, Role, Symbol, Zone
+from typing import TypeVar, cast
+
+from bt_lsp.syntax.elements import (
+    EXPLICIT_TAGS,
+    Element,
+    NameRef,
+    NameSymbol,
+    Role,
+    Symbol,
+    Zone,
+    model_symbol,
+    port_symbol,
+    tree_symbol,
+)
 from bt_lsp.syntax.scanner import Attr, scan_token
 from bt_lsp.syntax.vocabulary import RESERVED_PORT_NAMES, NameKind
 
@@ -34,36 +47,38 @@ _ZONE_ROOT = Zone.ROOT
 _ZONE_TREE = Zone.TREE
 
 
-def _owner(el: Element) -> Symbol:
+def _owner(el: Element) -> NameSymbol:
     """The symbol whose ports an element's attributes (or port declarations) are."""
     if el.name == "SubTree":
-        return ("tree", el.value("ID") or "")
+        return tree_symbol(el.value("ID") or "")
     if el.zone == _ZONE_NODE and el.name not in EXPLICIT_TAGS:
-        return ("model", el.name)
-    return ("model", el.value("ID") or "")
+        return model_symbol(el.name)
+    return model_symbol(el.value("ID") or "")
 
 
 # A named tuple from all its fields, without the (slower) Python-level constructor.
 _new = tuple.__new__
 
+_S = TypeVar("_S", bound=Symbol)
+
 # Every symbol made so far, to share (bounded).
 _SYMBOLS: dict[Symbol, Symbol] = {}
 
 
-def shared_symbol(symbol: Symbol) -> Symbol:
+def shared_symbol(symbol: _S) -> _S:
     shared = _SYMBOLS.get(symbol)
     if shared is None:
         if len(_SYMBOLS) >= 65536:
             _SYMBOLS.clear()
         shared = _SYMBOLS[symbol] = symbol
-    return shared
+    return cast(_S, shared)  # equal symbols are of one class
 
 
 # The port symbols of each owner, by port name (bounded).
-_PORTS: dict[Symbol, dict[str, Symbol]] = {}
+_PORTS: dict[NameSymbol, dict[str, Symbol]] = {}
 
 
-def _port_symbols(owner: Symbol) -> dict[str, Symbol]:
+def _port_symbols(owner: NameSymbol) -> dict[str, Symbol]:
     ports = _PORTS.get(owner)
     if ports is None:
         if len(_PORTS) >= 4096:
@@ -101,15 +116,15 @@ def _value_ref(
 
 # The symbol of each node type and the symbols of its ports, by type (bounded): every
 # element of a document looks them up.
-_MODEL_SYMBOLS: dict[str, tuple[Symbol, dict[str, Symbol]]] = {}
+_MODEL_SYMBOLS: dict[str, tuple[NameSymbol, dict[str, Symbol]]] = {}
 
 
-def _model_symbols(name: str) -> tuple[Symbol, dict[str, Symbol]]:
+def _model_symbols(name: str) -> tuple[NameSymbol, dict[str, Symbol]]:
     found = _MODEL_SYMBOLS.get(name)
     if found is None:
         if len(_MODEL_SYMBOLS) >= 4096:
             _MODEL_SYMBOLS.clear()
-        owner: Symbol = ("model", name)
+        owner = model_symbol(name)
         found = _MODEL_SYMBOLS[name] = (shared_symbol(owner), _port_symbols(owner))
     return found
 
@@ -125,14 +140,16 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
             a = el.attr("ID")
             if a is not None:
                 role, sym = (
-                    (_ROLE_SUBTREE_CALL, "tree") if name == "SubTree" else (_ROLE_NODE_ID, "model")
+                    (_ROLE_SUBTREE_CALL, tree_symbol(a.value or ""))
+                    if name == "SubTree"
+                    else (_ROLE_NODE_ID, model_symbol(a.value or ""))
                 )
-                _value_ref(out, el, idx, a, _KIND_MODEL, role, (sym, a.value or ""))
+                _value_ref(out, el, idx, a, _KIND_MODEL, role, sym)
             owner = _owner(el)
             ports = _port_symbols(owner)
         else:
-            model_symbol, ports = _model_symbols(name)
-            owner = model_symbol
+            type_symbol, ports = _model_symbols(name)
+            owner = type_symbol
             out.append(
                 _new(
                     NameRef,
@@ -142,7 +159,7 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
                         name,
                         _KIND_MODEL,
                         _ROLE_NODE_TYPE,
-                        model_symbol,
+                        type_symbol,
                         idx,
                         "",
                     ),
@@ -170,7 +187,7 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
             elif an not in RESERVED_PORT_NAMES:
                 psym = ports.get(an)
                 if psym is None:
-                    psym = ports[an] = shared_symbol(("port", *owner, an))
+                    psym = ports[an] = shared_symbol(port_symbol(owner, an))
                 out.append(
                     _new(
                         NameRef,
@@ -180,15 +197,15 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
     elif zone == _ZONE_ROOT:
         a = el.attr("main_tree_to_execute")
         if a is not None:
-            _value_ref(out, el, idx, a, None, _ROLE_MAIN_TREE, ("tree", a.value or ""))
+            _value_ref(out, el, idx, a, None, _ROLE_MAIN_TREE, tree_symbol(a.value or ""))
     elif zone == _ZONE_TREE:
         a = el.attr("ID")
         if a is not None:
-            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, ("tree", a.value or ""))
+            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, tree_symbol(a.value or ""))
     elif zone == _ZONE_MODEL_ENTRY:
         a = el.attr("ID")
         if a is not None:
-            entry: Symbol = ("tree" if el.name == "SubTree" else "model", a.value or "")
+            entry = NameSymbol("tree" if el.name == "SubTree" else "model", a.value or "")
             _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_MODEL_DEF, entry)
     elif zone == _ZONE_PORT_DECL and parent is not None:
         a = el.attr("name")
@@ -200,7 +217,7 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
                 a,
                 _KIND_PORT,
                 _ROLE_PORT_DECL,
-                ("port", *_owner(parent), a.value or ""),
+                port_symbol(_owner(parent), a.value or ""),
             )
 
 

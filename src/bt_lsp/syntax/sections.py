@@ -21,6 +21,7 @@ from bt_lsp.syntax.elements import (
     StructureProblem,
     Symbol,
     Zone,
+    model_symbol,
 )
 from bt_lsp.syntax.nametokens import name_refs, shared_symbol
 
@@ -119,7 +120,7 @@ class Section:
                         el.name,
                         None,
                         _ROLE_NODE_TYPE_END,
-                        shared_symbol(("model", el.name)),
+                        shared_symbol(model_symbol(el.name)),
                         i,
                     )
                 )
