@@ -44,7 +44,7 @@ from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.project import (
     BUILD_FOLDER,
     config_errors,
-    project_workspace,
+    project_index,
     skip_reason,
     version_lines,
 )
@@ -267,7 +267,7 @@ def run(
     err = err if err is not None else sys.stderr
     # The folders named on the command line are the workspace: includes resolve as
     # BehaviorTree.CPP resolves them, and every file's models and trees are known.
-    project = project_workspace(paths, options)
+    project = project_index(paths, options)
     if options.cpp:
         project.cpp = CppModels(project.roots, project.packages)
     skipped: Counter[str] = Counter()

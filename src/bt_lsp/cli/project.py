@@ -18,7 +18,7 @@ __all__ = [
     "NOT_BT",
     "WALK_SKIP_DIRS",
     "config_errors",
-    "project_workspace",
+    "project_index",
     "skip_reason",
     "version_lines",
 ]
@@ -44,7 +44,7 @@ class ProjectOptions(Protocol):
     def max_bytes(self) -> int: ...
 
 
-def project_workspace(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex:
+def project_index(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex:
     """The folders named on the command line as one workspace, each file with its
     configuration file's settings and the flags over them."""
     overrides = Layer(

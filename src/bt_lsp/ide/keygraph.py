@@ -190,23 +190,23 @@ class KeyTargets:
         return out
 
 
-def port_targets(ws: KeyGraph, sym: PortSymbol, home: Tree | None = None) -> KeyTargets:
+def port_targets(graph: KeyGraph, sym: PortSymbol, home: Tree | None = None) -> KeyTargets:
     """A port of a tree (``owner_kind == "tree"``): in the tree, the key of its name."""
     key = sym.name
-    homes = ws.trees(sym.owner)
+    homes = graph.trees(sym.owner)
     if home is not None and home not in homes:
         homes.insert(0, home)
-    uses = [(t, u) for t in homes for u in ws.keys(t).of(key)]
-    return KeyTargets(key, homes, uses, sym, ws.refs(sym))
+    uses = [(t, u) for t in homes for u in graph.keys(t).of(key)]
+    return KeyTargets(key, homes, uses, sym, graph.refs(sym))
 
 
-def key_targets(ws: KeyGraph, home: Tree, key: str) -> KeyTargets:
+def key_targets(graph: KeyGraph, home: Tree, key: str) -> KeyTargets:
     tid = home.id
     if tid is not None and not key.startswith("@"):
         sym = PortSymbol("port", "tree", tid, key)
-        if ws.refs(sym):
-            return port_targets(ws, sym, home)
-    return KeyTargets(key, [home], [(home, u) for u in ws.keys(home).of(key)])
+        if graph.refs(sym):
+            return port_targets(graph, sym, home)
+    return KeyTargets(key, [home], [(home, u) for u in graph.keys(home).of(key)])
 
 
 def is_tree_port(sym: Symbol | None) -> TypeGuard[PortSymbol]:

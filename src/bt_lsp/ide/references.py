@@ -27,13 +27,13 @@ def references(
     identifiers) and, when the key is a port of its tree, that port's declarations and the
     ``<SubTree>`` attributes that remap it: the places a rename of the key changes.  A
     tree's port likewise includes its uses as a key inside the tree."""
-    ws = KeyGraph(doc, others or {})
+    graph = KeyGraph(doc, others or {})
     ref = doc.model.ref_at(offset)
     if ref is None:
         key = key_at(doc, offset)
         if key is None or key.tree < 0:
             return []
-        targets = key_targets(ws, Tree(None, doc, key.tree), key.key)
+        targets = key_targets(graph, Tree(None, doc, key.tree), key.key)
         return [
             Place(path, s, e)
             for path, s, e, decl in targets.places()
@@ -45,9 +45,9 @@ def references(
     def keep(r: NameRef) -> bool:
         return r.role != Role.NODE_TYPE_END and (include_declaration or not r.declaration)
 
-    out = [Place(path, r.start, r.end) for path, _, r in ws.refs(ref.symbol) if keep(r)]
+    out = [Place(path, r.start, r.end) for path, _, r in graph.refs(ref.symbol) if keep(r)]
     if is_tree_port(ref.symbol):
-        out.extend(Place(t.path, u.start, u.end) for t, u in port_targets(ws, ref.symbol).uses)
+        out.extend(Place(t.path, u.start, u.end) for t, u in port_targets(graph, ref.symbol).uses)
     return out
 
 
@@ -67,20 +67,20 @@ def highlights(doc: Document, offset: int) -> list[Highlight]:
     port or instance name, a blackboard key (as :func:`references` finds it), or an
     element's start and end tag names."""
     model = doc.model
-    ws = KeyGraph(doc, {})
+    graph = KeyGraph(doc, {})
     ref = model.ref_at(offset)
     if ref is not None:
         if ref.symbol is None:
             return [Highlight(ref.start, ref.end)]
         found = {Highlight(r.start, r.end, r.declaration) for r in model.refs_to(ref.symbol)}
         if is_tree_port(ref.symbol):
-            found.update(Highlight(u.start, u.end) for _, u in port_targets(ws, ref.symbol).uses)
+            found.update(Highlight(u.start, u.end) for _, u in port_targets(graph, ref.symbol).uses)
         return sorted(found)
     key = key_at(doc, offset)
     if key is not None:
         if key.tree < 0:
             return [Highlight(key.start, key.end)]
-        targets = key_targets(ws, Tree(None, doc, key.tree), key.key)
+        targets = key_targets(graph, Tree(None, doc, key.tree), key.key)
         return sorted({Highlight(s, e, decl) for _, s, e, decl in targets.places()})
     hit = element_at_tag(model, offset)
     if hit is None:

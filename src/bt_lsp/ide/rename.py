@@ -218,7 +218,7 @@ def _check_key_name(new_name: str, in_script: bool) -> None:
         )
 
 
-def _check_key_movable(ws: KeyGraph, targets: KeyTargets, new_name: str) -> None:
+def _check_key_movable(graph: KeyGraph, targets: KeyTargets, new_name: str) -> None:
     """Refuse a key rename that would not change every use of the key in the blackboards of
     the running program (whatever the new name)."""
     key = targets.key
@@ -230,7 +230,7 @@ def _check_key_movable(ws: KeyGraph, targets: KeyTargets, new_name: str) -> None
                 f"references in '{u.attr}' in {t.shown()}; write it out plainly first"
             )
     for t in homes:
-        if unread_mentions(ws.keys(t), key):
+        if unread_mentions(graph.keys(t), key):
             raise RenameRefused(
                 f"Cannot rename '{shown(key)}': a script in {t.shown()} has a syntax error "
                 f"before a '{shown(key)}' that may be this key; fix the script first"
@@ -238,16 +238,16 @@ def _check_key_movable(ws: KeyGraph, targets: KeyTargets, new_name: str) -> None
     if new_name == key:
         return
     for t in homes:
-        group = ws.shared(t, key)
+        group = graph.shared(t, key)
         for o in group:
-            if o not in homes and mentions(ws.keys(o), key):
+            if o not in homes and mentions(graph.keys(o), key):
                 raise RenameRefused(
                     f"Cannot rename '{shown(key)}': {o.shown()} shares it with {t.shown()} "
                     'through <SubTree _autoremap="true">, and renaming it in one tree '
                     "would disconnect them"
                 )
-        root = next((o for o in group if ws.may_be_root(o)), None)
-        users = ws.root_users(key) if root is not None else []
+        root = next((o for o in group if graph.may_be_root(o)), None)
+        users = graph.root_users(key) if root is not None else []
         if root is not None and users:
             raise RenameRefused(
                 f"Cannot rename '{shown(key)}': '@{shown(key)}' in {users[0].shown()} is this "
@@ -255,23 +255,23 @@ def _check_key_movable(ws: KeyGraph, targets: KeyTargets, new_name: str) -> None
             )
 
 
-def _check_no_merge(ws: KeyGraph, targets: KeyTargets, new_name: str) -> None:
+def _check_no_merge(graph: KeyGraph, targets: KeyTargets, new_name: str) -> None:
     """Refuse a new name that is already a key of the trees owning the key (or of a tree
     sharing it): the two keys would become one."""
     if new_name == targets.key:
         return
     for t in targets.homes:
-        group = ws.shared(t, new_name)
+        group = graph.shared(t, new_name)
         for o in group:
-            if mentions(ws.keys(o), new_name) or ws.has_port(o, new_name):
+            if mentions(graph.keys(o), new_name) or graph.has_port(o, new_name):
                 how = "" if o == t else f", shared with {t.shown()} through _autoremap"
                 _refuse_new_name(
                     new_name,
                     f"{o.shown()} already uses a key '{shown(new_name)}'{how}; the two keys "
                     "would become one",
                 )
-        root = next((o for o in group if ws.may_be_root(o)), None)
-        users = ws.root_users(new_name) if root is not None else []
+        root = next((o for o in group if graph.may_be_root(o)), None)
+        users = graph.root_users(new_name) if root is not None else []
         if root is not None and users:
             _refuse_new_name(
                 new_name,
@@ -346,10 +346,10 @@ def combined(plans: Iterable[RenamePlan]) -> RenamePlan:
     return edits.plan()
 
 
-def _port_edits(ws: KeyGraph, sym: PortSymbol, new_name: str) -> _Edits:
+def _port_edits(graph: KeyGraph, sym: PortSymbol, new_name: str) -> _Edits:
     """Renaming a port: its names, and the ``{=}`` values of renamed attributes spelled out."""
     edits = _Edits()
-    for path, d, r in ws.refs(sym):
+    for path, d, r in graph.refs(sym):
         fix = _spelled_out(d, r)
         if fix is not None:
             edits.add(path, fix, written_out=True)
@@ -359,15 +359,15 @@ def _port_edits(ws: KeyGraph, sym: PortSymbol, new_name: str) -> _Edits:
 
 
 def _rename_keys(
-    ws: KeyGraph, targets: KeyTargets, new_name: str, port_checked: bool = False
+    graph: KeyGraph, targets: KeyTargets, new_name: str, port_checked: bool = False
 ) -> RenamePlan:
     if targets.uses or not targets.port:
         _check_key_name(new_name, any(u.form == KeyForm.SCRIPT for _, u in targets.uses))
     if targets.port_refs and not port_checked:
-        _check_new_name(targets.port_refs[0][2], new_name, ws.doc.model, ws.others)
-    _check_key_movable(ws, targets, new_name)
-    _check_no_merge(ws, targets, new_name)
-    edits = _port_edits(ws, targets.port, new_name) if targets.port is not None else _Edits()
+        _check_new_name(targets.port_refs[0][2], new_name, graph.doc.model, graph.others)
+    _check_key_movable(graph, targets, new_name)
+    _check_no_merge(graph, targets, new_name)
+    edits = _port_edits(graph, targets.port, new_name) if targets.port is not None else _Edits()
     for t, u in targets.uses:
         edits.add(t.path, _key_edit(u, new_name))
     return edits.plan()
@@ -379,7 +379,7 @@ class Renamer:
     (the name fixes use it so): what it reads of their trees is read once."""
 
     def __init__(self, doc: Document, others: Mapping[str, Document] | None = None) -> None:
-        self._ws = KeyGraph(doc, others or {})
+        self._graph = KeyGraph(doc, others or {})
         self._elsewhere: dict[Symbol, Elsewhere | None] = {}
 
     def elsewhere(self, sym: Symbol | None) -> Elsewhere | None:
@@ -390,9 +390,9 @@ class Renamer:
         if sym is None:
             return None
         if sym not in self._elsewhere:
-            ws = self._ws
+            graph = self._graph
             self._elsewhere[sym] = elsewhere(
-                sym, [ws.doc.model, *(d.model for d in ws.others.values())]
+                sym, [graph.doc.model, *(d.model for d in graph.others.values())]
             )
         return self._elsewhere[sym]
 
@@ -413,33 +413,33 @@ class Renamer:
         only the new name is checked, also against the keys of the tree.  ``taken`` are the
         names the new one must avoid in its namespace, when the caller knows them already
         (by default they are collected from the documents)."""
-        ws = self._ws
+        graph = self._graph
         away = self.elsewhere(ref.symbol)
         if away is not None and away.refuse:
             raise RenameRefused(f"Cannot rename {away.what}: {away.why}")
-        _check_new_name(ref, new_name, ws.doc.model, ws.others, taken)
+        _check_new_name(ref, new_name, graph.doc.model, graph.others, taken)
         sym = ref.symbol
         if sym is None:
             return RenamePlan(tuple(rename_edits([ref], new_name)))
         if is_tree_port(sym):
-            targets = port_targets(ws, sym)
+            targets = port_targets(graph, sym)
             if keys:
-                return _rename_keys(ws, targets, new_name, port_checked=True)
-            _check_no_merge(ws, targets, new_name)
-            return _port_edits(ws, sym, new_name).plan()
+                return _rename_keys(graph, targets, new_name, port_checked=True)
+            _check_no_merge(graph, targets, new_name)
+            return _port_edits(graph, sym, new_name).plan()
         if sym.kind == "port":
-            return _port_edits(ws, sym, new_name).plan()
+            return _port_edits(graph, sym, new_name).plan()
         return RenamePlan(
-            tuple(rename_edits(ws.doc.model.refs_to(sym), new_name)),
-            other_file_edits(sym, new_name, {p: d.model for p, d in ws.others.items()}),
+            tuple(rename_edits(graph.doc.model.refs_to(sym), new_name)),
+            other_file_edits(sym, new_name, {p: d.model for p, d in graph.others.items()}),
         )
 
     def key_plan(self, key: KeyRef, new_name: str) -> RenamePlan:
         """The edits renaming the blackboard key used at ``key`` (a use in the document)
         in its tree, and the port it is, as :func:`rename` makes them."""
-        ws = self._ws
-        home = Tree(None, ws.doc, key.tree)
-        return _rename_keys(ws, key_targets(ws, home, key.key), new_name)
+        graph = self._graph
+        home = Tree(None, graph.doc, key.tree)
+        return _rename_keys(graph, key_targets(graph, home, key.key), new_name)
 
 
 def rename(

@@ -61,7 +61,7 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
     symbols; the references of a symbol are made (in document coordinates) when asked for,
     from the sections that have it."""
 
-    __slots__ = ("_cache", "_chunks", "_keys")
+    __slots__ = ("_chunks", "_keys", "_refs")
 
     def __init__(self, chunks: list[tuple[Part, tuple[Symbol, ...]]]) -> None:
         self._chunks = chunks
@@ -69,10 +69,10 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
         for _, symbols in chunks:
             keys.update(symbols)
         self._keys = keys
-        self._cache: dict[Symbol, list[NameRef]] = {}
+        self._refs: dict[Symbol, list[NameRef]] = {}
 
     def __getitem__(self, symbol: Symbol) -> list[NameRef]:
-        refs = self._cache.get(symbol)
+        refs = self._refs.get(symbol)
         if refs is None:
             if symbol not in self._keys:
                 raise KeyError(symbol)
@@ -83,7 +83,7 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
                 for r in part.section.refs
                 if r.symbol == symbol
             ]
-            self._cache[symbol] = refs
+            self._refs[symbol] = refs
         return refs
 
     def __contains__(self, symbol: object) -> bool:
@@ -108,7 +108,7 @@ class Model:
 
     __slots__ = (
         "_by_symbol",
-        "_cache",
+        "_by_zone",
         "_elements",
         "_problems",
         "_ref_starts",
@@ -140,7 +140,7 @@ class Model:
         self._problems: Sequence[StructureProblem] | None = problems
         self._ref_starts = ref_starts
         self._by_symbol: Mapping[Symbol, list[NameRef]] | None = None
-        self._cache: dict[Zone | None, list[Element]] = {}
+        self._by_zone: dict[Zone | None, list[Element]] = {}
         self.root_element: Element | None = None
         self.local: Section | None = None  # the section a section's own model is of
         self.head: Section | None = None  # None for a model that is not made of sections
@@ -244,9 +244,9 @@ class Model:
         if root is None:
             return []
         if self.head is not None:
-            found: list[Element] | None = self._cache.get(zone)
+            found: list[Element] | None = self._by_zone.get(zone)
             if found is None:
-                found = self._cache[zone] = [
+                found = self._by_zone[zone] = [
                     section_top(sec, o, f, b)
                     for sec, o, f, b in zip(
                         self.sections, self.origins, self.firsts, self.bases, strict=True
