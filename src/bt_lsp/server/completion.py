@@ -8,8 +8,7 @@ from typing import TYPE_CHECKING
 from lsprotocol import types
 
 from bt_lsp.ide.completion import ItemKind, complete
-from bt_lsp.server.convert import to_range
-from bt_lsp.server.lookup import context_of, offset_of
+from bt_lsp.server.lookup import at_position
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -44,16 +43,13 @@ def register(server: BtServer) -> None:
         types.CompletionOptions(trigger_characters=TRIGGER_CHARACTERS),
     )
     def completion(ls: BtServer, params: types.CompletionParams) -> types.CompletionList | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
-        enc = ls.encoding
-        lines = od.doc.lines
-        offset = offset_of(ls, od, params.position)
-        found = complete(od.doc, offset, context_of(ls, od))
+        found = complete(req.doc, req.offset, req.context())
         if found is None:
             return types.CompletionList(is_incomplete=False, items=[])
-        rng = to_range(lines, found.start, found.end, enc)
+        rng = req.range(found.start, found.end)
         item_caps = _item_caps(ls)
         snippets = bool(item_caps and item_caps.snippet_support)
         formats = (item_caps.documentation_format if item_caps else None) or []

@@ -10,8 +10,7 @@ from lsprotocol import types
 
 from bt_lsp.ide.hover import hover_at, root_hover
 from bt_lsp.project.index import normalize
-from bt_lsp.server.convert import to_range
-from bt_lsp.server.lookup import context_of, offset_of
+from bt_lsp.server.lookup import at_position
 
 # Inline code in the C++ catalog's Markdown, written as quotes for plain-text clients.
 _INLINE_CODE_RE = re.compile(r"`([^`]*)`")
@@ -33,19 +32,17 @@ def wants_markdown(caps: types.ClientCapabilities | None) -> bool:
 def register(server: BtServer) -> None:
     @server.feature(types.TEXT_DOCUMENT_HOVER)
     def hover(ls: BtServer, params: types.HoverParams) -> types.Hover | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
-        enc = ls.encoding
-        lines = od.doc.lines
-        offset = offset_of(ls, od, params.position)
+        od, offset = req.od, req.offset
         others = ls.project.other_documents(normalize(od.path)) if od.path is not None else {}
         try:
             caps: types.ClientCapabilities | None = ls.client_capabilities
         except Exception:  # before initialize
             caps = None
         markdown = wants_markdown(caps)
-        found = hover_at(od.doc, offset, context_of(ls, od), others, markdown=markdown)
+        found = hover_at(od.doc, offset, req.context(), others, markdown=markdown)
         if found is None and od.path is not None:
             detected = ls.project.btcpp_for(od.path, od.doc)
             found = root_hover(od.doc, offset, detected.version, detected.source, markdown)
@@ -60,5 +57,5 @@ def register(server: BtServer) -> None:
         kind = types.MarkupKind.Markdown if found.markdown else types.MarkupKind.PlainText
         return types.Hover(
             contents=types.MarkupContent(kind=kind, value=text),
-            range=to_range(lines, found.start, found.end, enc),
+            range=req.range(found.start, found.end),
         )

@@ -1,4 +1,5 @@
-"""The workspace as the navigation features see it: open documents first, files after.
+"""The workspace as the request handlers see it: the preamble of a position-based request
+(:func:`at_position`), and for navigation the open documents first, files after.
 
 Every other BT document is keyed by its path (its URI when it is not a file), with the URI,
 text and version to answer with.  An open document's text wins over the file on disk, so
@@ -9,15 +10,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from lsprotocol import types
 from pygls.uris import from_fs_path, to_fs_path
 
 from bt_lsp.project.index import Include, normalize
 from bt_lsp.rules.context import Context
+from bt_lsp.server.convert import to_range
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.text import Encoding
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -35,6 +38,56 @@ class Source:
 def offset_of(ls: BtServer, od: OpenDocument, pos: types.Position) -> int:
     """The code-point offset of a position in the client's encoding."""
     return od.doc.lines.offset(pos.line, pos.character, ls.encoding)
+
+
+class AtPosition(Protocol):
+    """The parameters of a request at a position (``textDocument/definition``, ``hover``,
+    ``completion``, ...): lsprotocol gives them no common base."""
+
+    @property
+    def text_document(self) -> types.TextDocumentIdentifier: ...
+
+    @property
+    def position(self) -> types.Position: ...
+
+
+class PositionRequest:
+    """A request at a position of an open BT document, its shared look-up done once: the
+    document, the cursor as a code-point offset (the position read with the document's
+    line index in the negotiated encoding), the encoding to answer in, and the document's
+    context, made on first use (some requests never need it)."""
+
+    __slots__ = ("_ctx", "enc", "ls", "od", "offset")
+
+    def __init__(self, ls: BtServer, od: OpenDocument, offset: int) -> None:
+        self.ls = ls
+        self.od = od
+        self.offset = offset
+        self.enc: Encoding = ls.encoding
+        self._ctx: Context | None = None
+
+    @property
+    def doc(self) -> Document:
+        return self.od.doc
+
+    def context(self) -> Context:
+        """The document's workspace context (see :func:`context_of`)."""
+        if self._ctx is None:
+            self._ctx = context_of(self.ls, self.od)
+        return self._ctx
+
+    def range(self, start: int, end: int) -> types.Range:
+        """Offsets of the document as an LSP range in the negotiated encoding."""
+        return to_range(self.od.doc.lines, start, end, self.enc)
+
+
+def at_position(ls: BtServer, params: AtPosition) -> PositionRequest | None:
+    """The request at ``params``'s position, or ``None`` when its document is not an open
+    BT document (the handlers then answer with nothing)."""
+    od = ls.get(params.text_document.uri)
+    if od is None or not od.is_bt:
+        return None
+    return PositionRequest(ls, od, offset_of(ls, od, params.position))
 
 
 def path_of(od: OpenDocument) -> Path | None:

@@ -31,9 +31,9 @@ from bt_lsp.project.index import links
 from bt_lsp.server.convert import RawJson, to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,
+    at_position,
     context_of,
     includes_of,
-    offset_of,
     source_at,
     workspace_sources,
 )
@@ -207,31 +207,33 @@ def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encod
 def register(server: BtServer) -> None:
     @server.feature(types.TEXT_DOCUMENT_DEFINITION)
     def definition(ls: BtServer, params: types.DefinitionParams) -> list[types.Location] | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
-        in_cpp = ls.cpp.definition(od, offset_of(ls, od, params.position))
+        od = req.od
+        in_cpp = ls.cpp.definition(od, req.offset)
         if in_cpp is not None:  # a node or port learned from C++: its class, registration, call
             return in_cpp
         sources = workspace_sources(ls, od)
         places = find_definition(
             od.doc,
-            offset_of(ls, od, params.position),
+            req.offset,
             {k: s.doc for k, s in sources.items()},
-            ctx=context_of(ls, od),
+            ctx=req.context(),
             includes=links(includes_of(ls, od)),
         )
         return _locations(ls, od, places, sources) or None
 
     @server.feature(types.TEXT_DOCUMENT_REFERENCES)
     def references(ls: BtServer, params: types.ReferenceParams) -> list[types.Location] | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
+        od = req.od
         sources = workspace_sources(ls, od)
         places = find_references(
             od.doc,
-            offset_of(ls, od, params.position),
+            req.offset,
             {k: s.doc for k, s in sources.items()},
             include_declaration=params.context.include_declaration,
         )
@@ -241,51 +243,50 @@ def register(server: BtServer) -> None:
     def highlight(
         ls: BtServer, params: types.DocumentHighlightParams
     ) -> list[types.DocumentHighlight] | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
-        enc = ls.encoding
-        lines = od.doc.lines
         return [
             types.DocumentHighlight(
-                range=to_range(lines, h.start, h.end, enc),
+                range=req.range(h.start, h.end),
                 kind=types.DocumentHighlightKind.Text
                 if h.text
                 else types.DocumentHighlightKind.Write
                 if h.write
                 else types.DocumentHighlightKind.Read,
             )
-            for h in highlights(od.doc, offset_of(ls, od, params.position))
+            for h in highlights(req.doc, req.offset)
         ]
 
     @server.feature(types.TEXT_DOCUMENT_PREPARE_RENAME)
     def prepare_rename(
         ls: BtServer, params: types.PrepareRenameParams
     ) -> types.PrepareRenamePlaceholder | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
         try:
-            target = rename_target(od.doc, offset_of(ls, od, params.position))
+            target = rename_target(req.doc, req.offset)
         except RenameRefused as e:
             raise RequestFailed(e.message) from None
         if target is None:
             return None
         return types.PrepareRenamePlaceholder(
-            range=to_range(od.doc.lines, target.start, target.end, ls.encoding),
+            range=req.range(target.start, target.end),
             placeholder=target.placeholder,
         )
 
     @server.feature(types.TEXT_DOCUMENT_RENAME)
     def rename(ls: BtServer, params: types.RenameParams) -> types.WorkspaceEdit | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
+        od = req.od
         sources = workspace_sources(ls, od)
         try:
             plan = plan_rename(
                 od.doc,
-                offset_of(ls, od, params.position),
+                req.offset,
                 params.new_name,
                 {k: s.doc for k, s in sources.items()},
             )
@@ -346,14 +347,13 @@ def register(server: BtServer) -> None:
     def linked_editing_range(
         ls: BtServer, params: types.LinkedEditingRangeParams
     ) -> types.LinkedEditingRanges | None:
-        od = ls.get(params.text_document.uri)
-        if od is None or not od.is_bt:
+        req = at_position(ls, params)
+        if req is None:
             return None
-        spans = linked_editing_ranges(od.doc, offset_of(ls, od, params.position))
+        spans = linked_editing_ranges(req.doc, req.offset)
         if spans is None:
             return None
-        enc = ls.encoding
         return types.LinkedEditingRanges(
-            ranges=[to_range(od.doc.lines, s, e, enc) for s, e in spans],
+            ranges=[req.range(s, e) for s, e in spans],
             word_pattern=r"[^\s<>/=\"']+",
         )
