@@ -5,7 +5,9 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.syntax.scanner import Kind, decode_value, rescan, scan
+from bt_lsp.syntax.scanner import rescan, scan
+from bt_lsp.syntax.tokens import Kind
+from bt_lsp.syntax.values import decode_value
 
 # Text built from the pieces that matter to a tag scanner, so hypothesis reaches the
 # interesting states (half tags, quotes, references) far more often than with raw text.

@@ -16,8 +16,7 @@ from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.semantics.nodes import UnknownNodeData
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, apply_edits
-from bt_lsp.syntax.scanner import decode_value
-from bt_lsp.syntax.values import raw_offsets, raw_span
+from bt_lsp.syntax.values import decode_value, raw_offsets, raw_span
 from tests.marks import unmark
 from tests.test_semantics import CASES, R, T
 

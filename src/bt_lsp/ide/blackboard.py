@@ -39,7 +39,7 @@ from bt_lsp.rules.script import CONDITION_ATTRS, SCRIPT_PORTS, identifiers
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Element, Zone
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.values import raw_offsets
 
 __all__ = [

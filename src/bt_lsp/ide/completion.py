@@ -34,7 +34,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.scanner import Kind
+from bt_lsp.syntax.tokens import Kind
 
 __all__ = ["Completions", "Item", "ItemKind", "complete", "ports_markdown"]
 

@@ -25,7 +25,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Zone
-from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.tokens import Attr
 
 _NODE_RESERVED: tuple[tuple[str, str], ...] = (
     ("name", "Instance name: the node's label (defaults to its type)."),

@@ -24,7 +24,7 @@ from bt_lsp.rules.context import Context, source_label
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Zone
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.scanner import Token
+from bt_lsp.syntax.tokens import Token
 
 # Models learned from C++ (bt_lsp.project.cpp_models) are declared in a C++ file.
 _CPP = (".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp")

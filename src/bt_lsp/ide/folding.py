@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from bt_lsp.ide.places import element_at_tag, element_end
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.scanner import Kind
+from bt_lsp.syntax.tokens import Kind
 
 
 @dataclass(frozen=True, slots=True, order=True)

@@ -12,8 +12,10 @@ from collections.abc import Sequence
 
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, StructureProblem, Zone, zone_in
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.scanner import XML_SYNTAX, Kind, Rescan, Scan, Token, decode_value
+from bt_lsp.syntax.scanner import Rescan, Scan
 from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
+from bt_lsp.syntax.tokens import XML_SYNTAX, Kind, Token
+from bt_lsp.syntax.values import decode_value
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
 
 _ZONE_OUTSIDE = Zone.OUTSIDE

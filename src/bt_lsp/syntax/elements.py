@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from enum import IntEnum, StrEnum
 from typing import Literal, NamedTuple
 
-from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.vocabulary import NameKind
 
 

@@ -22,7 +22,8 @@ from bt_lsp.syntax.elements import (
     port_symbol,
     tree_symbol,
 )
-from bt_lsp.syntax.scanner import Attr, scan_token
+from bt_lsp.syntax.scanner import scan_token
+from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.vocabulary import RESERVED_PORT_NAMES, NameKind
 
 # Members read in the hot loops below, as module globals: in Python 3.11 reading a member

@@ -21,73 +21,14 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from enum import IntEnum
-from typing import NamedTuple
 
 from bt_lsp.syntax.text import Offsets
-
-
-class Kind(IntEnum):
-    TEXT = 0
-    START = 1  # start tag or empty-element tag
-    END = 2  # end tag
-    COMMENT = 3
-    CDATA = 4
-    PI = 5  # processing instruction or XML declaration
-    DOCTYPE = 6
-    STRAY = 7  # a '<' that starts no markup
-
+from bt_lsp.syntax.tokens import DOCTYPE_CODE, XML_SYNTAX, Attr, Kind, Problem, Token
+from bt_lsp.syntax.values import decode_value
 
 # Read for every start tag: a module global is quicker than a member read from its enum
 # class in Python 3.11.
 _START = Kind.START
-
-XML_SYNTAX = "xml-syntax"
-UNESCAPED = "xml-unescaped-char"
-DOCTYPE_CODE = "xml-doctype"
-
-
-class Problem(NamedTuple):
-    """A lexical problem; offsets relative to the token start."""
-
-    start: int
-    end: int
-    code: str
-    message: str
-
-
-class Attr(NamedTuple):
-    """An attribute; offsets relative to the token start.
-
-    ``value_start``/``value_end`` delimit the raw value between the quotes (entity
-    references included).  ``value`` is the decoded value, ``None`` when the attribute
-    has no value at all.
-    """
-
-    name: str
-    name_start: int
-    name_end: int
-    value: str | None
-    value_start: int
-    value_end: int
-    quote: str
-
-
-class Token(NamedTuple):
-    """A token; offsets relative to its start.  Tokens, attributes and problems are named
-    tuples: immutable, small and quick to make (a document has tens of thousands).  Equal
-    tokens may be one object (whitespace runs and end tags are shared)."""
-
-    kind: Kind
-    length: int
-    reach: int  # how far (from the token start) the scan looked; >= length
-    name: str = ""
-    name_start: int = 0
-    name_end: int = 0
-    attrs: tuple[Attr, ...] = ()
-    self_closing: bool = False
-    closed: bool = True
-    problems: tuple[Problem, ...] = ()
 
 
 # Characters that end a tag or attribute name.  Anything else is part of the name, so
@@ -112,106 +53,6 @@ _VALUE_END_RE = {
 }
 _STRAY_QUOTE_END = {q: re.compile(f"[{q}<]") for q in "\"'"}
 _UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
-# An entity or character reference (the one definition: the value offsets follow it too).
-REFERENCE_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
-_PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
-
-
-def _char_ref(body: str) -> str | None:
-    try:
-        cp = int(body[2:], 16) if body[1] == "x" else int(body[1:])
-    except ValueError:
-        return None
-    if cp == 0 or cp > 0x10FFFF or 0xD800 <= cp <= 0xDFFF:
-        return None
-    return chr(cp)
-
-
-def _is_nul_ref(body: str) -> bool:
-    digits = body[2:] if body[1:2] == "x" else body[1:]
-    return digits != "" and set(digits) == {"0"}
-
-
-def decode_value(raw: str, base: int, problems: list[Problem] | None) -> str:
-    """Decode references in an attribute value.
-
-    ``base`` is the raw value's offset (relative to its token) for problem positions.
-    BehaviorTree.CPP's tinyxml2 keeps a raw ``&`` or ``<`` as written, so they are
-    reported as warnings and kept.  Unknown entities are kept as written: bt-lsp never
-    expands DOCTYPE entities.
-    """
-    if "&" not in raw and "<" not in raw:
-        return raw
-    if problems is not None:
-        pos = raw.find("<")
-        while pos != -1:
-            problems.append(
-                Problem(
-                    base + pos,
-                    base + pos + 1,
-                    UNESCAPED,
-                    "Raw '<' in an attribute value; XML requires '&lt;'",
-                )
-            )
-            pos = raw.find("<", pos + 1)
-    if "&" not in raw:
-        return raw
-    out: list[str] = []
-    pos = 0
-    while True:
-        amp = raw.find("&", pos)
-        if amp == -1:
-            out.append(raw[pos:])
-            break
-        out.append(raw[pos:amp])
-        m = REFERENCE_RE.match(raw, amp)
-        if m is None:
-            if problems is not None:
-                problems.append(
-                    Problem(
-                        base + amp,
-                        base + amp + 1,
-                        UNESCAPED,
-                        "Raw '&' in an attribute value; XML requires '&amp;'",
-                    )
-                )
-            out.append("&")
-            pos = amp + 1
-            continue
-        body = m.group(1)
-        if body[0] == "#":
-            ch = _char_ref(body)
-            if ch is None:
-                if problems is not None:
-                    problems.append(
-                        Problem(
-                            base + amp,
-                            base + m.end(),
-                            XML_SYNTAX,
-                            f"Invalid character reference '{m.group(0)}'",
-                        )
-                    )
-                # A reference to NUL stands for that character in the names it is in (so
-                # the name's own rule reports it, as for '&#1;'); others stay as written.
-                out.append("\x00" if _is_nul_ref(body) else m.group(0))
-            else:
-                out.append(ch)
-        elif body in _PREDEFINED:
-            out.append(_PREDEFINED[body])
-        else:
-            if problems is not None:
-                problems.append(
-                    Problem(
-                        base + amp,
-                        base + m.end(),
-                        XML_SYNTAX,
-                        f"Undefined entity '&{body};' (bt-lsp never expands DOCTYPE entities)",
-                    )
-                )
-            out.append(m.group(0))
-        pos = m.end()
-    return "".join(out)
-
 
 # Makes a named tuple from all its fields without the Python-level constructor (three times
 # quicker, for the hot paths).

@@ -73,7 +73,7 @@ from bt_lsp.rules.semantics.base import (
     quoted,
 )
 from bt_lsp.syntax.elements import Element
-from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.tokens import Attr
 
 
 @dataclass(frozen=True, slots=True)

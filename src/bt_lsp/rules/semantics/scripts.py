@@ -20,7 +20,7 @@ from bt_lsp.rules.codes import BT, Severity, define
 from bt_lsp.rules.script import ScriptError, check_script
 from bt_lsp.rules.semantics.base import State
 from bt_lsp.syntax.elements import Element
-from bt_lsp.syntax.scanner import Attr
+from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.values import raw_span
 
 # The codes of these rules (see bt_lsp.rules.registry).
