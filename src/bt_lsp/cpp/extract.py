@@ -29,7 +29,8 @@ from bt_lsp.cpp.facts import (
     Registration,
     Span,
 )
-from bt_lsp.cpp.names import last_name, split_top, squash, strip_args, unescape
+from bt_lsp.cpp.names import last_name, squash, strip_args, unescape
+from bt_lsp.cpp.tree_walk import declared_name, enclosing_call, template_args, up, up_to
 
 Node = tree_sitter.Node
 
@@ -142,14 +143,14 @@ class _Reader:
     def read(self, root: Node) -> FileFacts:
         src = self.src
         for m in _DEFINE.finditer(src):
-            n = _up(root.descendant_for_byte_range(m.start(), m.end()), 2)
+            n = up(root.descendant_for_byte_range(m.start(), m.end()), 2)
             if n is not None and n.type == "preproc_def":
                 self._define(n)
             elif n is not None and n.type == "preproc_function_def":
                 self._macro(n)
         for m in _CONST_STRING.finditer(src):
             lit = root.descendant_for_byte_range(m.start(1), m.start(1) + 1)
-            decl = _up_to(lit, ("declaration", "field_declaration"), 5)
+            decl = up_to(lit, ("declaration", "field_declaration"), 5)
             if (
                 decl is not None
                 and decl.parent is not None
@@ -214,7 +215,7 @@ class _Reader:
             if value is None or target is None:
                 continue
             s = self.string(value)
-            name = _declared_name(target)
+            name = declared_name(target)
             if s is not None and name is not None:
                 return self.text(name), s
         return None
@@ -334,7 +335,7 @@ class _Reader:
         if name in ("providedPorts", "providedBasicPorts"):
             self._ports_fn(ident, name)
             return
-        call = _enclosing_call(ident)
+        call = enclosing_call(ident)
         if call is None or call.id in self._seen_calls:
             return
         self._seen_calls.add(call.id)
@@ -342,7 +343,7 @@ class _Reader:
         if args_node is None:
             return
         args = [a for a in args_node.named_children if a.type != "comment"]
-        targs = _template_args(call.child_by_field_name("function"))
+        targs = template_args(call.child_by_field_name("function"))
         if name in _TEMPLATE_REGISTRARS and targs:
             if args:
                 self._registration(name, args[0], targs[0], None, None, call)
@@ -350,7 +351,7 @@ class _Reader:
             manifest = args[0]
             mf = manifest.child_by_field_name("function")
             margs_node = manifest.child_by_field_name("arguments")
-            mt = _template_args(mf)
+            mt = template_args(mf)
             if mf is None or margs_node is None or not mt or "CreateManifest" not in self.text(mf):
                 return
             margs = margs_node.named_children
@@ -407,7 +408,7 @@ class _Reader:
             for p in params.named_children:
                 d = p.child_by_field_name("declarator")
                 if d is not None:
-                    nm = _declared_name(d)
+                    nm = declared_name(d)
                     param = self.text(nm) if nm is not None else None
         self.fns.append(PortsFn(owner, name, param, self.ports_body(body, param), self.span(fn)))
 
@@ -543,7 +544,7 @@ class _Reader:
         return Op("unknown", ref=squash(self.text(n))[:80])
 
     def _port(self, call: Node, direction: str, args: list[Node]) -> PortFacts:
-        targs = _template_args(call.child_by_field_name("function"))
+        targs = template_args(call.child_by_field_name("function"))
         type_ = targs[0] if targs else None
         name_node = args[0]
         name = self.string(name_node)
@@ -633,70 +634,6 @@ class _Reader:
             )
 
 
-def _up(n: Node | None, steps: int) -> Node | None:
-    """``n``'s parent ``steps`` times at most, stopping at a preprocessor definition."""
-    for _ in range(steps):
-        if n is None or n.type in ("preproc_def", "preproc_function_def"):
-            return n
-        n = n.parent
-    return n
-
-
-def _up_to(n: Node | None, types: tuple[str, ...], steps: int) -> Node | None:
-    for _ in range(steps):
-        if n is None or n.type in types:
-            return n
-        n = n.parent
-    return n if n is not None and n.type in types else None
-
-
 _STRING_TYPES: Final = frozenset(
     {"std::string", "string", "BT::StringView", "StringView", "std::string_view"}
 )
-
-
-def _enclosing_call(ident: Node) -> Node | None:
-    """The call whose function ``ident`` names (through templates, fields, scopes)."""
-    n = ident
-    for _ in range(4):
-        p = n.parent
-        if p is None:
-            return None
-        if p.type == "call_expression":
-            return p if p.child_by_field_name("function") == n else None
-        if p.type not in (
-            "template_method",
-            "template_function",
-            "field_expression",
-            "qualified_identifier",
-        ):
-            return None
-        n = p
-    return None
-
-
-def _template_args(fn: Node | None) -> list[str]:
-    """The template arguments of a called function, as written (squashed)."""
-    if fn is None:
-        return []
-    stack = [fn]
-    while stack:
-        n = stack.pop()
-        if n.type == "template_argument_list":
-            src = n.text or b""
-            inner = src.decode("utf-8", "replace")[1:-1]
-            return [squash(a) for a in split_top(inner)]
-        stack.extend(reversed(n.named_children))
-    return []
-
-
-def _declared_name(d: Node) -> Node | None:
-    """The identifier a declarator declares (through pointers, arrays, references)."""
-    n: Node | None = d
-    while n is not None and n.type not in ("identifier", "field_identifier"):
-        inner = n.child_by_field_name("declarator")
-        if inner is None:
-            named = [c for c in n.named_children if c.type in ("identifier", "field_identifier")]
-            return named[0] if named else None
-        n = inner
-    return n
