@@ -11,8 +11,9 @@ marks an empty range at its column.  A range that starts left of the comment's o
 or ``@L:C-L:C`` (0-based lines and columns of the text without its annotations).  Then
 the severity, the code, and after ``:`` the message exactly (without one, the message is
 not checked); ``{root}`` in a message
-stands for the folder the files of a fixture are written to, ``{size}`` for the size of
-the text in bytes (which its line ends change).
+stands for the folder the files of a fixture are written to (the path after it written
+with ``/`` on every system), ``{not-found}`` for the operating system's words for a
+missing file, ``{size}`` for the size of the text in bytes (which its line ends change).
 
 Annotation lines are removed (with their line ends) before the text is analysed, so they
 never shift what they annotate.  :func:`check` compares every diagnostic of the text,
@@ -31,6 +32,8 @@ others; its annotations are its ``config-error``, if it has one.
 
 from __future__ import annotations
 
+import errno
+import os
 import re
 import tempfile
 from dataclasses import dataclass, replace
@@ -54,6 +57,14 @@ _ANNOTATION = re.compile(
     r"(?P<severity>error|warning|information|hint) (?P<code>[a-z0-9-]+)"
     r"(?:: (?P<message>.*?))? *-->"
 )
+# What operating systems say of a missing file: C's strerror(ENOENT), and Windows's own
+# words where Python reports a Windows error.
+_NOT_FOUND_REASONS = (
+    os.strerror(errno.ENOENT),
+    "The system cannot find the file specified",
+    "The system cannot find the path specified",
+)
+_UNDER_ROOT = re.compile(r"\{root\}[^\s:'\")]*")
 _FILE = re.compile(r"<!-- file: (?P<path>\S+) -->")
 _DIRECTIVE = re.compile(r"<!-- check: (?P<name>[a-z-]+)=(?P<value>\d+) -->")
 
@@ -138,12 +149,19 @@ def _position(doc: Document, offset: int) -> tuple[int, int]:
 
 
 def found(doc: Document, diags: list[Diagnostic], root: str | None = None) -> list[Expected]:
-    """``diags`` of ``doc`` as expectations (messages with ``root`` written ``{root}``
-    and the document's size ``{size}``)."""
+    """``diags`` of ``doc`` as expectations, written as the annotations write them on any
+    system: ``root`` as ``{root}`` (the path after it with ``/``), a missing file's reason
+    as ``{not-found}``, the document's size as ``{size}``."""
     out = []
     size = f" {doc.utf8_size} bytes"
     for d in diags:
-        message = d.message if root is None else d.message.replace(root, "{root}")
+        message = d.message
+        if root is not None:
+            message = _UNDER_ROOT.sub(
+                lambda m: m.group(0).replace(os.sep, "/"), message.replace(root, "{root}")
+            )
+            for reason in _NOT_FOUND_REASONS:
+                message = message.replace(f": {reason})", ": {not-found})")
         message = message.replace(size, " {size} bytes")
         out.append(
             Expected(

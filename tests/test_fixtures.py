@@ -8,8 +8,11 @@ from pathlib import Path
 
 import pytest
 
+from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.registry import CODES
-from tests.annotated import check, check_fix, diagnostics, parse, render, split_files
+from bt_lsp.syntax.document import Document
+from tests.annotated import check, check_fix, diagnostics, found, parse, render, split_files
 
 FIXTURES = Path(__file__).parent / "fixtures"
 FILES = sorted(FIXTURES.glob("*.xml"))
@@ -83,6 +86,23 @@ def test_a_wrong_annotation_fails_and_shows_what_is_reported() -> None:
     wrong = MARKED.replace("^^^^^^^^^", "^^^^^^^^")
     with pytest.raises(AssertionError, match="model-name-forbidden-char: Model name"):
         check(wrong)
+
+
+@pytest.mark.parametrize(
+    "reason",
+    ["No such file or directory", "The system cannot find the path specified"],
+)
+def test_a_missing_file_reads_the_same_on_every_system(
+    reason: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr("tests.annotated.os.sep", "\\")
+    root = "C:\\tmp\\fx"
+    message = f"Included file 'trees/dock.xml' not found ({root}\\trees\\dock.xml: {reason})"
+    diag = Diagnostic(0, 1, "include-not-found", message, Severity.ERROR)
+    (e,) = found(Document("<root/>"), [diag], root)
+    assert e.message == (
+        "Included file 'trees/dock.xml' not found ({root}/trees/dock.xml: {not-found})"
+    )
 
 
 def test_crlf_positions_are_the_same_lines_and_columns() -> None:
