@@ -5,19 +5,14 @@ and Neovim 0.11's (plain ``changes``)."""
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 from collections.abc import AsyncIterator
-from pathlib import Path
 
 import pytest
 import pytest_lsp
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
-from pygls.uris import from_fs_path
 
 from tests.server.test_navigation_lsp import (
-    CACHE,
     CONFIG,
     NavClient,
     apply,
@@ -27,6 +22,8 @@ from tests.server.test_navigation_lsp import (
     open_doc,
     position,
     span,
+    start_in_folder,
+    stop_in_folder,
 )
 from tests.test_fixes_elsewhere import FIXED, HELPER, OBJECTIVE, OUTSIDE_TREE
 
@@ -48,27 +45,11 @@ def _capabilities(spec: str) -> types.ClientCapabilities:
     config=CONFIG, scope="module", params=["visual-studio-code", "neovim@v0.11.0", "eglot-plain"]
 )
 async def lsp(lsp_client: NavClient, request: pytest.FixtureRequest) -> AsyncIterator[None]:
-    ws = Path(tempfile.mkdtemp(prefix="bt-lsp-elsewhere-ws-")).resolve()
-    (ws / "pick.xml").write_text(OBJECTIVE, encoding="utf-8")
-    (ws / "helper.xml").write_text(HELPER, encoding="utf-8")
-    lsp_client.ws = ws
-    lsp_client.spec = request.param
-    folder_uri = from_fs_path(str(ws))
-    assert folder_uri is not None
-    lsp_client.init_result = await lsp_client.initialize_session(
-        types.InitializeParams(
-            capabilities=_capabilities(request.param),
-            workspace_folders=[types.WorkspaceFolder(uri=folder_uri, name="ws")],
-            root_uri=folder_uri,
-            initialization_options={"debounceMs": 0},
-        )
-    )
-    lsp_client.encoding = str(lsp_client.init_result.capabilities.position_encoding or "utf-16")
+    files = {"pick.xml": OBJECTIVE, "helper.xml": HELPER}
+    await start_in_folder(lsp_client, request.param, files, _capabilities(request.param))
     open_doc(lsp_client, "pick.xml", OBJECTIVE)
     yield
-    await lsp_client.shutdown_session()
-    shutil.rmtree(ws, ignore_errors=True)
-    shutil.rmtree(CACHE, ignore_errors=True)
+    await stop_in_folder(lsp_client)
 
 
 async def _actions(

@@ -121,26 +121,42 @@ CONFIG = ClientServerConfig(
     config=CONFIG, scope="module", params=["visual-studio-code", "neovim@v0.11.0", "emacs"]
 )
 async def lsp(lsp_client: NavClient, request: pytest.FixtureRequest) -> AsyncIterator[None]:
+    await start_in_folder(lsp_client, request.param, {"a.xml": A_XML, "b.xml": B_XML})
+    open_doc(lsp_client, "a.xml", A_XML)
+    yield
+    await stop_in_folder(lsp_client)
+
+
+async def start_in_folder(
+    client: NavClient,
+    spec: str,
+    files: dict[str, str],
+    capabilities: types.ClientCapabilities | None = None,
+) -> None:
+    """Writes ``files`` to a fresh workspace folder and initializes the session on it as
+    the client ``spec`` (with its capabilities unless given), diagnostics undelayed."""
     ws = Path(tempfile.mkdtemp(prefix="bt-lsp-nav-ws-")).resolve()
-    (ws / "a.xml").write_text(A_XML, encoding="utf-8")
-    (ws / "b.xml").write_text(B_XML, encoding="utf-8")
-    lsp_client.ws = ws
-    lsp_client.spec = request.param
+    for name, text in files.items():
+        (ws / name).write_text(text, encoding="utf-8")
+    client.ws = ws
+    client.spec = spec
     folder_uri = from_fs_path(str(ws))
     assert folder_uri is not None
-    lsp_client.init_result = await lsp_client.initialize_session(
+    client.init_result = await client.initialize_session(
         types.InitializeParams(
-            capabilities=pytest_lsp.client_capabilities(request.param),
+            capabilities=capabilities or pytest_lsp.client_capabilities(spec),
             workspace_folders=[types.WorkspaceFolder(uri=folder_uri, name="ws")],
             root_uri=folder_uri,
             initialization_options={"debounceMs": 0},
         )
     )
-    lsp_client.encoding = str(lsp_client.init_result.capabilities.position_encoding or "utf-16")
-    open_doc(lsp_client, "a.xml", A_XML)
-    yield
-    await lsp_client.shutdown_session()
-    shutil.rmtree(ws, ignore_errors=True)
+    client.encoding = str(client.init_result.capabilities.position_encoding or "utf-16")
+
+
+async def stop_in_folder(client: NavClient) -> None:
+    """Ends the session of :func:`start_in_folder` and removes its folder and the cache."""
+    await client.shutdown_session()
+    shutil.rmtree(client.ws, ignore_errors=True)
     shutil.rmtree(CACHE, ignore_errors=True)
 
 
