@@ -7,6 +7,7 @@ from pathlib import Path
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
 from bt_lsp.syntax.document import Document
+from tests.annotated import check
 
 
 def tree(body: str = "", includes: tuple[str, ...] = ()) -> str:
@@ -35,30 +36,34 @@ def test_include_resolved_relative_to_the_including_file(tmp_path: Path) -> None
     assert diags(ws, a) == []
 
 
-def test_missing_include_is_flagged_at_its_path(tmp_path: Path) -> None:
-    a = write(tmp_path / "a.xml", tree(includes=("nope.xml",)))
-    ws = ProjectIndex([tmp_path])
-    assert diags(ws, a) == [("include-not-found", "nope.xml")]
+_CYCLE = "BehaviorTree.CPP fails with a misleading 'file not found' or crashes"
 
 
-def test_self_include_by_bare_name_is_a_cycle(tmp_path: Path) -> None:
-    a = write(tmp_path / "a.xml", tree(includes=("a.xml",)))
-    ws = ProjectIndex([tmp_path])
-    assert diags(ws, a) == [("include-cycle", "a.xml")]
+def test_missing_include_is_flagged_at_its_path() -> None:
+    check("""<!-- file: a.xml -->
+<root BTCPP_format="4"><include path="nope.xml"/></root>
+<!--                                  ^^^^^^^^ error include-not-found: Included file 'nope.xml' not found ({root}/nope.xml: {not-found}) -->
+""")  # noqa: E501
 
 
-def test_every_file_of_a_cycle_is_flagged_at_its_include(tmp_path: Path) -> None:
-    a = write(tmp_path / "a.xml", tree(includes=("trees/b.xml",)))
-    b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
-    c = write(tmp_path / "trees" / "c.xml", tree(includes=("../a.xml",)))
-    ws = ProjectIndex([tmp_path])
-    assert diags(ws, a) == [("include-cycle", "trees/b.xml")]
-    assert diags(ws, b) == [("include-cycle", "c.xml")]
-    assert diags(ws, c) == [("include-cycle", "../a.xml")]
-    doc = ws.document(a)
-    assert doc is not None
-    (d,) = ws.include_diagnostics(a, doc)
-    assert "a.xml → trees/b.xml → trees/c.xml → a.xml" in d.message
+def test_self_include_by_bare_name_is_a_cycle() -> None:
+    check("""<!-- file: a.xml -->
+<root BTCPP_format="4"><include path="a.xml"/></root>
+<!--                                  ^^^^^ error include-cycle: 'a.xml' includes this file itself; BehaviorTree.CPP recurses until it crashes -->
+""")  # noqa: E501
+
+
+def test_every_file_of_a_cycle_is_flagged_at_its_include() -> None:
+    check(f"""<!-- file: a.xml -->
+<root BTCPP_format="4"><include path="trees/b.xml"/></root>
+<!--                                  ^^^^^^^^^^^ error include-cycle: Include cycle: a.xml → trees/b.xml → trees/c.xml → a.xml; {_CYCLE} -->
+<!-- file: trees/b.xml -->
+<root BTCPP_format="4"><include path="c.xml"/></root>
+<!--                                  ^^^^^ error include-cycle: Include cycle: b.xml → c.xml → ../a.xml → b.xml; {_CYCLE} -->
+<!-- file: trees/c.xml -->
+<root BTCPP_format="4"><include path="../a.xml"/></root>
+<!--                                  ^^^^^^^^ error include-cycle: Include cycle: c.xml → ../a.xml → b.xml → c.xml; {_CYCLE} -->
+""")  # noqa: E501
 
 
 def test_open_document_overrides_disk_and_dependents(tmp_path: Path) -> None:
