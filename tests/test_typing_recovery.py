@@ -9,22 +9,23 @@ from __future__ import annotations
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Zone
+from tests.annotated import check, parse
 
-OPEN_TREE = (
-    '<root BTCPP_format="4" main_tree_to_execute="A">\n'
-    '  <BehaviorTree ID="A">\n'
-    "    <Sequence>\n"
-    "      <AlwaysSuccess/>\n"
-    '  <BehaviorTree ID="Bad Tree">\n'
-    "    <AlwaysSuccess/>\n"
-    "  </BehaviorTree>\n"
-    "</root>\n"
-)
-
-
-def _found(text: str) -> list[tuple[str, str]]:
-    doc = Document(text)
-    return [(d.code, text[d.start : d.end]) for d in analyze(doc)]
+# The diagnostics: the open elements above are reported where they start, once each; the
+# new tree's ID is a tree ID, with the tree ID's rule (no unknown node "BehaviorTree").
+OPEN_TREE_REPORTS = """<root BTCPP_format="4" main_tree_to_execute="A">
+  <BehaviorTree ID="A">
+<!-- @3-15 error xml-syntax: Element '<BehaviorTree>' is not closed before the next '<BehaviorTree>' -->
+    <Sequence>
+<!-- ^^^^^^^^ error xml-syntax: Element '<Sequence>' is not closed before the next '<BehaviorTree>' -->
+      <AlwaysSuccess/>
+  <BehaviorTree ID="Bad Tree">
+<!--                ^^^^^^^^ error model-name-forbidden-char -->
+    <AlwaysSuccess/>
+  </BehaviorTree>
+</root>
+"""  # noqa: E501
+OPEN_TREE = parse(OPEN_TREE_REPORTS).text
 
 
 def test_a_tree_typed_below_an_open_tree_starts_a_new_tree() -> None:
@@ -32,18 +33,7 @@ def test_a_tree_typed_below_an_open_tree_starts_a_new_tree() -> None:
     trees = [e for e in doc.model.elements if e.name == "BehaviorTree"]
     assert [t.zone for t in trees] == [Zone.TREE, Zone.TREE]
     assert trees[1].parent == 0  # a child of <root>
-    found = _found(OPEN_TREE)
-    # Its ID is a tree ID, with the tree ID's rule; no unknown node "BehaviorTree".
-    assert ("model-name-forbidden-char", "Bad Tree") in found
-    assert not any(code in ("unknown-node", "id-on-compact-node") for code, _ in found)
-    # The open elements above are reported where they start, once each.
-    unclosed = [span for code, span in found if code == "xml-syntax"]
-    assert unclosed == ["BehaviorTree", "Sequence"]
-    messages = [d.message for d in analyze(doc) if d.code == "xml-syntax"]
-    assert messages == [
-        "Element '<BehaviorTree>' is not closed before the next '<BehaviorTree>'",
-        "Element '<Sequence>' is not closed before the next '<BehaviorTree>'",
-    ]
+    check(OPEN_TREE_REPORTS)
 
 
 def test_typing_the_tree_gives_the_model_of_the_whole_text() -> None:
