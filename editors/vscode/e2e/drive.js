@@ -17,35 +17,13 @@
 'use strict';
 
 const path = require('node:path');
-const { chromium } = require('playwright-core');
+const { driver } = require('./workbench');
 
 const config = JSON.parse(process.argv[2] || '{}');
-const STEP_TIMEOUT = config.stepTimeoutMs || 20000;
-const SERVER_TIMEOUT = config.serverTimeoutMs || 60000;
-const CHROMIUM = config.chromium || '/usr/bin/chromium';
-
-const result = { steps: [], consoleErrors: [] };
-let step = 'start';
-const started = Date.now();
-
-function mark(name) {
-  step = name;
-  result.steps.push({ step: name, atMs: Date.now() - started });
-  process.stderr.write(`[drive] ${name}\n`);
-}
-
-/** Polls fn() until it returns a truthy value; returns it (or the last value after the timeout). */
-async function until(fn, timeoutMs, intervalMs = 250) {
-  const deadline = Date.now() + timeoutMs;
-  let value;
-  for (;;) {
-    value = await fn();
-    if (value || Date.now() > deadline) {
-      return value;
-    }
-    await new Promise((resolve) => setTimeout(resolve, intervalMs));
-  }
-}
+const { STEP_TIMEOUT, SERVER_TIMEOUT, result, mark, until, gotoPosition, openFile, loadWorkbench, run } = driver(
+  'drive',
+  config,
+);
 
 async function problemRows(page) {
   return page.$$eval('.markers-panel .monaco-list-row', (rows) =>
@@ -64,46 +42,12 @@ async function editorText(page) {
   );
 }
 
-async function gotoPosition(page, line, column) {
-  await page.keyboard.press('Control+G');
-  await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: STEP_TIMEOUT });
-  await page.keyboard.type(`${line}:${column}`);
-  await page.keyboard.press('Enter');
-  await page.waitForSelector('.quick-input-widget', { state: 'hidden', timeout: STEP_TIMEOUT });
-}
-
 async function main(page) {
   mark('load workbench');
-  await page.goto(config.url);
-  await page.waitForSelector('.monaco-workbench', { timeout: SERVER_TIMEOUT });
-  // The explorer lists the folder once the remote file system answers.
-  await page.waitForSelector(`.explorer-folders-view .monaco-list-row[aria-label*="${config.file}"]`, {
-    timeout: SERVER_TIMEOUT,
-  });
+  await loadWorkbench(page, config.file);
 
   mark('open file');
-  const opened = await until(async () => {
-    await page.keyboard.press('Escape');
-    await page.keyboard.press('Control+P');
-    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
-    if (!input) {
-      return false;
-    }
-    await page.keyboard.type(config.file);
-    const row = await page
-      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .catch(() => null);
-    if (!row) {
-      return false;
-    }
-    await page.keyboard.press('Enter');
-    return page
-      .waitForSelector(`.tabs-container .tab[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .then(() => true, () => false);
-  }, STEP_TIMEOUT, 500);
-  if (!opened) {
-    throw new Error(`could not open ${config.file} with Quick Open`);
-  }
+  await openFile(page, config.file);
   await page.waitForSelector('.editor-instance .monaco-editor .view-lines', { timeout: STEP_TIMEOUT });
   result.textBefore = await editorText(page);
 
@@ -197,38 +141,4 @@ async function main(page) {
   mark('done');
 }
 
-(async () => {
-  let exitCode = 0;
-  const browser = await chromium.launch({
-    executablePath: CHROMIUM,
-    headless: true,
-    args: [
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-dev-shm-usage',
-      '--disable-background-networking',
-      '--disable-component-update',
-      '--disable-sync',
-      '--no-first-run',
-    ],
-  });
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
-  page.on('console', (message) => {
-    if (message.type() === 'error') {
-      result.consoleErrors.push(message.text().slice(0, 300));
-    }
-  });
-  try {
-    await main(page);
-  } catch (error) {
-    exitCode = 1;
-    result.failedStep = step;
-    result.error = String(error && error.stack ? error.stack : error);
-    await page.screenshot({ path: path.join(config.shotDir, 'failure.png') }).catch(() => {});
-  } finally {
-    result.elapsedMs = Date.now() - started;
-    await browser.close().catch(() => {});
-  }
-  process.stdout.write(JSON.stringify(result) + '\n');
-  process.exit(exitCode);
-})();
+run(main, { viewport: { width: 1280, height: 800 }, failureShot: 'failure.png' });

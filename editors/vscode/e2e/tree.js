@@ -21,41 +21,13 @@
 'use strict';
 
 const path = require('node:path');
-const { chromium } = require('playwright-core');
+const { driver } = require('./workbench');
 
 const config = JSON.parse(process.argv[2] || '{}');
-const STEP_TIMEOUT = config.stepTimeoutMs || 20000;
-const SERVER_TIMEOUT = config.serverTimeoutMs || 60000;
-
-const result = { steps: [], consoleErrors: [] };
-let step = 'start';
-const started = Date.now();
-
-function mark(name) {
-  step = name;
-  result.steps.push({ step: name, atMs: Date.now() - started });
-  process.stderr.write(`[tree] ${name}\n`);
-}
-
-async function until(fn, timeoutMs, intervalMs = 250) {
-  const deadline = Date.now() + timeoutMs;
-  let value;
-  for (;;) {
-    value = await fn();
-    if (value || Date.now() > deadline) {
-      return value;
-    }
-    await new Promise((resolve) => setTimeout(resolve, intervalMs));
-  }
-}
-
-async function gotoPosition(page, line, column) {
-  await page.keyboard.press('Control+G');
-  await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: STEP_TIMEOUT });
-  await page.keyboard.type(`${line}:${column}`);
-  await page.keyboard.press('Enter');
-  await page.waitForSelector('.quick-input-widget', { state: 'hidden', timeout: STEP_TIMEOUT });
-}
+const { STEP_TIMEOUT, SERVER_TIMEOUT, result, mark, until, gotoPosition, openFile, loadWorkbench, run } = driver(
+  'tree',
+  config,
+);
 
 /** The frame of the tree webview (nested iframes in the workbench), once its script has run. */
 async function treeFrame(page) {
@@ -95,38 +67,9 @@ async function selectionStatus(page) {
     .catch(() => '');
 }
 
-async function openFile(page, file) {
-  const opened = await until(async () => {
-    await page.keyboard.press('Escape');
-    await page.keyboard.press('Control+P');
-    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
-    if (!input) {
-      return false;
-    }
-    await page.keyboard.type(file);
-    const row = await page
-      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${file}"]`, { timeout: 5000 })
-      .catch(() => null);
-    if (!row) {
-      return false;
-    }
-    await page.keyboard.press('Enter');
-    return page
-      .waitForSelector(`.tabs-container .tab[aria-label*="${file}"]`, { timeout: 5000 })
-      .then(() => true, () => false);
-  }, STEP_TIMEOUT, 500);
-  if (!opened) {
-    throw new Error(`could not open ${file} with Quick Open`);
-  }
-}
-
 async function main(page) {
   mark('load workbench');
-  await page.goto(config.url);
-  await page.waitForSelector('.monaco-workbench', { timeout: SERVER_TIMEOUT });
-  await page.waitForSelector(`.explorer-folders-view .monaco-list-row[aria-label*="${config.file}"]`, {
-    timeout: SERVER_TIMEOUT,
-  });
+  await loadWorkbench(page, config.file);
 
   mark('open file');
   await openFile(page, config.file);
@@ -287,38 +230,4 @@ async function main(page) {
   mark('done');
 }
 
-(async () => {
-  let exitCode = 0;
-  const browser = await chromium.launch({
-    executablePath: config.chromium || '/usr/bin/chromium',
-    headless: true,
-    args: [
-      '--no-sandbox',
-      '--disable-gpu',
-      '--disable-dev-shm-usage',
-      '--disable-background-networking',
-      '--disable-component-update',
-      '--disable-sync',
-      '--no-first-run',
-    ],
-  });
-  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
-  page.on('console', (message) => {
-    if (message.type() === 'error') {
-      result.consoleErrors.push(message.text().slice(0, 300));
-    }
-  });
-  try {
-    await main(page);
-  } catch (error) {
-    exitCode = 1;
-    result.failedStep = step;
-    result.error = String(error && error.stack ? error.stack : error);
-    await page.screenshot({ path: path.join(config.shotDir, 'tree-failure.png') }).catch(() => {});
-  } finally {
-    result.elapsedMs = Date.now() - started;
-    await browser.close().catch(() => {});
-  }
-  process.stdout.write(JSON.stringify(result) + '\n');
-  process.exit(exitCode);
-})();
+run(main, { viewport: { width: 1400, height: 800 }, failureShot: 'tree-failure.png' });

@@ -9,24 +9,9 @@
 --   "no-client" the file is plain XML: no client may start for it; then BT_LSP_E2E_OTHER
 --               (a BehaviorTree file) is opened to show that the plugin was working.
 
+local e2e = dofile(debug.getinfo(1, "S").source:sub(2):match("^(.*)[/\\]") .. "/common.lua")
+local emit, wait, TIMEOUT = e2e.emit, e2e.wait, e2e.TIMEOUT
 local uv = vim.uv or vim.loop
-local TIMEOUT = tonumber(os.getenv("BT_LSP_E2E_WAIT_MS") or "") or 10000
-
-local started = uv.hrtime()
-
-local function emit(event, data)
-  data = data or {}
-  data.event = event
-  data.ms = math.floor((uv.hrtime() - started) / 1e6)
-  io.stdout:write("BTLSP-E2E " .. vim.fn.json_encode(data) .. "\n")
-  io.stdout:flush()
-end
-
-local function wait(what, cond, ms)
-  if not vim.wait(ms or TIMEOUT, cond, 20) then
-    error("timed out waiting for " .. what, 0)
-  end
-end
 
 local function buf_clients(bufnr)
   local found = {}
@@ -314,15 +299,7 @@ local function main()
   vim.wait(3000, function()
     return #all_clients() == 0
   end, 20)
-  -- Warnings Neovim showed (e.g. deprecations) end up in :messages.
-  local messages = vim.api.nvim_exec2 and vim.api.nvim_exec2("messages", { output = true }).output
-    or vim.api.nvim_exec("messages", true)
-  emit("done", { messages = messages })
+  emit("done", { messages = e2e.messages() })
 end
 
-local ok, err = xpcall(main, debug.traceback)
-if not ok then
-  emit("error", { message = tostring(err) })
-  vim.cmd("cquit 1")
-end
-vim.cmd("qa!")
+e2e.run(main)
