@@ -348,3 +348,27 @@ async def test_unchanged_only_when_nothing_changed(client: BtClient) -> None:
         assert summary(now.items) == summary(first.items)
     else:
         assert summary(again.items) == summary(now.items)
+
+
+async def test_requests_at_a_position_of_non_bt_xml_answer_nothing(client: BtClient) -> None:
+    """The shared preamble of position requests: a document that is not BT XML gets no
+    answer from any of them (on a name that would be one in a BT document)."""
+    uri = client.open(LAUNCH)
+    line = LAUNCH.splitlines().index('  <node pkg="nav2.bringup" exec="a b" name="x.y">')
+    td = types.TextDocumentIdentifier(uri=uri)
+    at = types.Position(line=line, character=LAUNCH.splitlines()[line].index("node"))
+    c = client
+    assert await c.text_document_hover_async(types.HoverParams(td, at)) is None
+    assert await c.text_document_definition_async(types.DefinitionParams(td, at)) is None
+    context = types.ReferenceContext(include_declaration=True)
+    refs = types.ReferenceParams(context=context, text_document=td, position=at)
+    assert await c.text_document_references_async(refs) is None
+    highlights = types.DocumentHighlightParams(td, at)
+    assert await c.text_document_document_highlight_async(highlights) is None
+    prepare = types.PrepareRenameParams(td, at)
+    assert await c.text_document_prepare_rename_async(prepare) is None
+    rename = types.RenameParams(text_document=td, position=at, new_name="n")
+    assert await c.text_document_rename_async(rename) is None
+    linked = types.LinkedEditingRangeParams(td, at)
+    assert await c.text_document_linked_editing_range_async(linked) is None
+    assert await c.text_document_completion_async(types.CompletionParams(td, at)) is None
