@@ -112,3 +112,48 @@ def test_explicit_config(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     py = write(tmp_path / "pyproject.toml", '[project]\nname = "x"\n')
     code, _, err = run(capsys, "--config", str(py), str(tmp_path))
     assert code == 2 and "has no [tool.bt-lsp] table" in err
+
+
+def test_an_installed_dependency_catalog_is_authoritative(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ROS package depending (through another) on an installed package found through
+    AMENT_PREFIX_PATH gets its shipped catalog: its nodes are known, and an attribute that
+    is not one of their ports is an error (BehaviorTree.CPP throws at tree creation)."""
+    share = tmp_path / "opt" / "share"
+    write(
+        share / "nav2_behavior_tree" / "package.xml",
+        "<package><name>nav2_behavior_tree</name></package>",
+    )
+    write(
+        share / "nav2_behavior_tree" / "nav2_tree_nodes.xml",
+        "<root>\n  <!-- nodes -->\n  <TreeNodesModel>\n"
+        '    <Action ID="Go"><input_port name="speed"/></Action>\n'
+        "  </TreeNodesModel>\n</root>\n",
+    )
+    src = tmp_path / "ws" / "src"
+    write(
+        src / "lib" / "package.xml",
+        "<package><name>lib</name><depend>nav2_behavior_tree</depend></package>",
+    )
+    write(
+        src / "app" / "package.xml",
+        "<package><name>app</name><exec_depend>lib</exec_depend></package>",
+    )
+    write(src / "app" / "launch" / "a.launch.xml", "<launch/>")
+    tree = write(
+        src / "app" / "trees" / "t.xml",
+        '<root BTCPP_format="4" main_tree_to_execute="T">\n'
+        '  <BehaviorTree ID="T"><Sequence><Go speed="1" sped="2"/></Sequence></BehaviorTree>\n'
+        "</root>\n",
+    )
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "opt"))
+    code, out, _ = run(capsys, str(tmp_path / "ws"))
+    assert code == 1
+    assert [line.split(": ", 1)[1].split()[:2] for line in out.splitlines()] == [
+        ["error", "undeclared-port"]
+    ]
+    assert out.startswith(f"{tree}:2:")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", "")
+    code, out, _ = run(capsys, str(tmp_path / "ws"))
+    assert "undeclared-port" not in codes(out)  # nothing is known of Go

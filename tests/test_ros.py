@@ -144,3 +144,100 @@ def test_a_new_catalog_is_heard(tmp_path: Path) -> None:
     cat = write(src / "app" / "nodes.xml", CATALOG)
     ws.file_changed(cat)
     assert ws.catalog_files(tree) == [cat]
+
+
+def severities(ws: Workspace, path: Path) -> dict[str, str]:
+    doc = Document(path.read_text(encoding="utf-8"), str(path))
+    return {d.code: d.severity.name.lower() for d in ws.diagnostics(path, doc)}
+
+
+NAV_TREE = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main">\n'
+    "    <Sequence>\n"
+    '      <ComputePathToPose goal="{g}" planner="GridBased"/>\n'
+    "    </Sequence>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+
+
+def test_an_installed_catalog_is_authoritative_for_its_nodes(tmp_path: Path) -> None:
+    prefix = installed(tmp_path)
+    app = tmp_path / "ws" / "src" / "app"
+    write(app / "package.xml", manifest("app", "nav2_behavior_tree"))
+    tree = write(app / "trees" / "t.xml", NAV_TREE)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(prefix)])
+    ctx = ws.context_for(tree, Document(tree.read_text(encoding="utf-8"), str(tree)))
+    assert ctx.models["ComputePathToPose"].source == "ros"
+    found = severities(ws, tree)
+    assert "unknown-node" not in found
+    # 'planner' is not a port of nav2's model: BehaviorTree.CPP throws at creation.
+    assert found["undeclared-port"] == "error"
+    # The catalog is one package's: a node it lacks is still most likely registered.
+    assert not ctx.workspace_has_custom_models
+
+
+def test_dependencies_are_followed_transitively_and_cycles_end(tmp_path: Path) -> None:
+    prefix = installed(tmp_path)
+    share = prefix / "share"
+    # Installed: nav2_bt_navigator -> nav2_behavior_tree; a cycle between two others.
+    write(
+        share / "nav2_bt_navigator" / "package.xml",
+        manifest("nav2_bt_navigator", "nav2_behavior_tree"),
+    )
+    write(share / "loop_a" / "package.xml", manifest("loop_a", "loop_b"))
+    write(share / "loop_b" / "package.xml", manifest("loop_b", "loop_a", "nav2_bt_navigator"))
+    src = tmp_path / "ws" / "src"
+    # In the workspace: app -> lib -> loop_a -> loop_b -> nav2_bt_navigator -> nav2_behavior_tree.
+    write(src / "lib" / "package.xml", manifest("lib", "loop_a", "app"))
+    lib_catalog = write(src / "lib" / "lib_nodes.xml", LIB_CATALOG)
+    write(src / "app" / "package.xml", manifest("app", "lib"))
+    tree = write(src / "app" / "trees" / "t.xml", NAV_TREE)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(prefix)])
+    nav2 = share / "nav2_behavior_tree" / "nav2_tree_nodes.xml"
+    assert ws.catalog_files(tree) == [lib_catalog, nav2]
+    assert ws.package_folders(tree) == [
+        src / "app",
+        src / "lib",
+        share / "loop_a",
+        share / "loop_b",
+        share / "nav2_bt_navigator",
+        share / "nav2_behavior_tree",
+    ]
+    found = severities(ws, tree)
+    assert "unknown-node" not in found
+    assert found["undeclared-port"] == "error"
+
+
+def test_a_package_sees_its_dependencies_nodes_not_every_node(tmp_path: Path) -> None:
+    src = tmp_path / "ws" / "src"
+    write(src / "lib" / "package.xml", manifest("lib"))
+    write(src / "lib" / "lib_nodes.xml", LIB_CATALOG)
+    write(src / "app" / "package.xml", manifest("app", "lib"))
+    uses_lib = NAV_TREE.replace("ComputePathToPose", "LibNode").replace(' planner="GridBased"', "")
+    app_tree = write(src / "app" / "trees" / "t.xml", uses_lib)
+    write(src / "solo" / "package.xml", manifest("solo"))
+    solo_tree = write(src / "solo" / "t.xml", uses_lib)
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[])
+    assert "unknown-node" not in codes(ws, app_tree)
+    solo_doc = Document(solo_tree.read_text(encoding="utf-8"), str(solo_tree))
+    assert "LibNode" not in ws.context_for(solo_tree, solo_doc).models
+    assert "unknown-node" in codes(ws, solo_tree)
+
+
+def test_excluded_files_are_not_part_of_the_workspace(tmp_path: Path) -> None:
+    write(tmp_path / "bt-lsp.toml", 'exclude = ["old/**", "scratch.xml"]\n')
+    models = '<root BTCPP_format="4"><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>'
+    write(tmp_path / "old" / "models.xml", models)
+    write(tmp_path / "scratch.xml", models)
+    kept = write(tmp_path / "trees" / "t.xml", MAIN)
+    ws = Workspace([tmp_path], ament_prefix_path=[])
+    assert ws.files() == [kept]
+    # An open excluded document is not part of the workspace either.
+    scratch = tmp_path / "scratch.xml"
+    ws.open(scratch, Document(models, str(scratch)))
+    assert [p for p, _ in ws.bt_documents()] == [kept]
+    # Editing the configuration brings them back.
+    ws.config_edited(tmp_path / "bt-lsp.toml", "exclude = []\n")
+    assert ws.files() == [tmp_path / "old" / "models.xml", scratch, kept]

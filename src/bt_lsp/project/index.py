@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from bt_lsp.ide.places import IncludeLink
-from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer
+from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer, excluded
 from bt_lsp.project.cpp_models import CppModels, cpp_diagnostics
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError, read_text
@@ -58,6 +58,7 @@ SKIP_DIRS = frozenset(
 )
 MAX_WORKSPACE_FILES = 5000
 MAX_INCLUDE_FILES = 1000
+MAX_PACKAGES = 1000  # the dependency closure of one package
 
 
 def normalize(path: str | os.PathLike[str]) -> Path:
@@ -133,6 +134,8 @@ class ProjectIndex:
         # Installed ROS packages (AMENT_PREFIX_PATH unless given) and their catalogs.
         self.ros = RosIndex(self.packages, ament_prefix_path)
         self._ros_workspace: tuple[list[Path], dict[str, Path]] | None = None
+        # Folder -> (generation, settings, its package's and its dependencies' folders).
+        self._package_folders: dict[Path, tuple[int, Settings, list[Path]]] = {}
         # Folder -> (the editor settings they were made from, the folder's settings).
         self._scoped: dict[Path, tuple[Settings, Settings]] = {}
         self._open: dict[Path, Document] = {}
@@ -263,6 +266,7 @@ class ProjectIndex:
         if not self.configs.set_text(normalize(path), text):
             return False
         self._scoped.clear()
+        self._files = None  # its exclude globs may have changed
         self.generation += 1
         return True
 
@@ -302,13 +306,18 @@ class ProjectIndex:
         if self._files is None:
             found: set[Path] = set()
             for root in self.roots:
-                for p in _walk_xml(root):
+                for p in _walk_xml(root, self.is_excluded):
                     found.add(p)
                     if len(found) >= MAX_WORKSPACE_FILES:
                         break
             found.update(self.model_files())
             self._files = sorted(found)
         return self._files
+
+    def is_excluded(self, path: Path, is_dir: bool = False) -> bool:
+        """Whether the configuration's ``exclude`` globs leave ``path`` out of the
+        workspace (a folder's globs are those of a file inside it)."""
+        return excluded(path, self.settings_for(path / "-" if is_dir else path).exclude)
 
     def model_files(self) -> list[Path]:
         """The model files named in the settings (relative to the first workspace folder)."""
@@ -320,7 +329,10 @@ class ProjectIndex:
     def bt_documents(self) -> Iterator[tuple[Path, Document]]:
         key = (self.generation, tuple(self._open))
         if self._paths is None or self._paths[0] != key:
-            self._paths = (key, sorted(set(self.files()) | set(self._open)))
+            # An open excluded file is diagnosed (it was opened) but is no more part of
+            # the workspace for the other files than when it is closed.
+            shown = {p for p in self._open if not self.is_excluded(p)}
+            self._paths = (key, sorted(set(self.files()) | shown))
         for p in self._paths[1]:
             doc = self.document(p)
             if doc is not None and (doc.is_bt or p.suffix == ".btproj"):
@@ -432,14 +444,18 @@ class ProjectIndex:
             if d is not None and p != path:
                 model_files.append((str(p), d))
         skip = set(model_paths)
-        # The catalogs of the document's ROS package and its dependencies: their models
-        # count, as another file's would (one package's catalog does not list every
-        # node the application registers, so a node missing from it is not an error).
+        # The catalogs of the document's ROS package and its dependencies: authoritative
+        # for their nodes (what the package registers), but not complete (one package's
+        # catalog does not list every node the application registers).
+        ros_models: list[tuple[str, Document]] = []
         for p in self.ros_catalogs(path):
             d = self.document(p)
             if d is not None and p != path and p not in skip and p not in in_closure:
                 skip.add(p)
-                others.append((str(p), d, False))
+                ros_models.append((str(p), d))
+        # Another workspace package's catalogs are not this document's unless it depends
+        # on that package.
+        skip.update(self.unrelated_catalogs(path))
         for p, d in self.bt_documents():
             if p == path or p in in_closure or p in skip:
                 continue
@@ -452,6 +468,7 @@ class ProjectIndex:
             path=str(path),
             ros_pkg_paths=self._ros_paths(path, doc, settings),
             model_files=model_files,
+            ros_models=ros_models,
             included_by=included_by,
             btcpp_version=self.btcpp_for(path, doc).version,
         )
@@ -479,21 +496,56 @@ class ProjectIndex:
     def ros_catalogs(self, path: Path) -> list[Path]:
         """The catalogs that the ROS package of the file at ``path`` ships and those of
         the packages its ``package.xml`` depends on (workspace or installed)."""
-        settings = self.settings_for(path)
         out: list[Path] = []
-        own = self.packages.package_of(path.parent)
-        if own is None:
-            return out
-        folders = [own.folder]
-        for dep in sorted(own.depends):
-            folder = self.ros_package(dep, settings)
-            if folder is not None and folder not in folders:
-                folders.append(folder)
-        for folder in folders:
+        for folder in self.package_folders(path):
             for p in self.ros.catalogs(folder):
                 p = normalize(p)
                 if p not in out and p != path:
                     out.append(p)
+        return out
+
+    def package_folders(self, path: Path) -> list[Path]:
+        """The folder of the ROS package of the file at ``path`` and those of the packages
+        it depends on, transitively (through each dependency's own ``package.xml``, in
+        the workspace or installed; cycles cut), breadth first; empty outside a package."""
+        settings = self.settings_for(path)
+        hit = self._package_folders.get(path.parent)
+        if hit is not None and hit[0] == self.generation and hit[1] is settings:
+            return hit[2]
+        folders = self._dependency_folders(path, settings)
+        self._package_folders[path.parent] = (self.generation, settings, folders)
+        return folders
+
+    def _dependency_folders(self, path: Path, settings: Settings) -> list[Path]:
+        own = self.packages.package_of(path.parent)
+        if own is None:
+            return []
+        folders = [own.folder]
+        seen = {own.name}
+        todo = [own]
+        while todo and len(folders) < MAX_PACKAGES:
+            m = todo.pop(0)
+            for dep in sorted(m.depends - seen):
+                seen.add(dep)
+                folder = self.ros_package(dep, settings)
+                if folder is None or folder in folders:
+                    continue
+                folders.append(folder)
+                found = self.packages.manifest(folder / "package.xml")
+                if found is not None:
+                    todo.append(found)
+        return folders
+
+    def unrelated_catalogs(self, path: Path) -> set[Path]:
+        """The catalogs shipped by the workspace packages that the package of ``path``
+        neither is nor depends on (none outside a package: a loose file sees them all)."""
+        mine = self.package_folders(path)
+        if not mine:
+            return set()
+        out: set[Path] = set()
+        for folder in self.workspace_packages().values():
+            if folder not in mine:
+                out.update(normalize(p) for p in self.ros.catalogs(folder))
         return out
 
     # -- ROS packages --------------------------------------------------------------------------
@@ -567,13 +619,22 @@ def _short(p: Path, base: Path) -> str:
         return str(p)
 
 
-def _walk_xml(root: Path) -> Iterable[Path]:
+def _walk_xml(root: Path, skip: Callable[[Path, bool], bool]) -> Iterable[Path]:
+    """The XML and ``.btproj`` files under ``root``, but what ``skip(path, is_dir)``
+    leaves out (the configuration's ``exclude``)."""
     if root.is_file():
-        if root.suffix in (".xml", ".btproj"):
+        if root.suffix in (".xml", ".btproj") and not skip(root, False):
             yield root
         return
     for dirpath, dirnames, filenames in os.walk(root):
-        dirnames[:] = sorted(d for d in dirnames if d not in SKIP_DIRS and not d.startswith("."))
+        here = Path(dirpath)
+        dirnames[:] = sorted(
+            d
+            for d in dirnames
+            if d not in SKIP_DIRS and not d.startswith(".") and not skip(here / d, True)
+        )
         for f in sorted(filenames):
             if f.endswith((".xml", ".btproj")):
-                yield normalize(Path(dirpath) / f)
+                p = normalize(here / f)
+                if not skip(p, False):
+                    yield p

@@ -88,7 +88,8 @@ class BtServer(LanguageServer):
         self.cpp = CppService(self)
         # Configuration files' errors as published, by URI (see server/project.py).
         self.config_published: dict[str, tuple[int, int, str]] = {}
-        self.versions_logged: set[Path] = set()  # folders whose version was logged
+        # Package folder (or document) -> the BehaviorTree.CPP version logged for it.
+        self.versions_logged: dict[Path, tuple[str | None, str]] = {}
         self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
 
     @property
@@ -441,8 +442,6 @@ def create_server() -> BtServer:
             if path:
                 ls.project.file_changed(path)
                 project_files = project_files or is_project_file(Path(path))
-        if project_files:
-            ls.versions_logged.clear()
         ls.refresh_all()
         if project_files:
             sync_config_diagnostics(ls)

@@ -84,7 +84,6 @@ def register(server: BtServer) -> None:
             ls.project.file_changed(path)
         ls.refresh_all()
         if path and is_project_file(Path(path)):
-            ls.versions_logged.clear()
             sync_config_diagnostics(ls)
 
     @server.feature(

@@ -93,16 +93,25 @@ def _diagnostic(ls: BtServer, uri: str, e: ConfigError) -> types.Diagnostic:
 
 
 def log_version(ls: BtServer, path: Path) -> None:
-    """Say once per package (or folder) which BehaviorTree.CPP its files are checked as."""
-    found = ls.project.btcpp_for(path)
-    where = ls.project.packages.package_of(path.parent)
+    """Say which BehaviorTree.CPP the files of a package (or folder) are checked as: once,
+    and again only when it changes.  A version read from a document's own
+    ``BTCPP_format`` is that document's, so it is logged per document."""
+    project = ls.project
+    found = project.btcpp_for(path)
+    where = project.packages.package_of(path.parent)
     folder = where.folder if where is not None else path.parent
-    if folder in ls.versions_logged:
+    of_project = (
+        project.settings_for(path).btcpp in ("3", "4")
+        or project.packages.btcpp_of(path.parent).version is not None
+    )
+    key = folder if of_project or found.version is None else path
+    value = (found.version, found.source)
+    if ls.versions_logged.get(key) == value:
         return
-    ls.versions_logged.add(folder)
+    ls.versions_logged[key] = value
     version = f"BehaviorTree.CPP {found.version}" if found.version else "BehaviorTree.CPP 4"
     why = found.source if found.version else "not detected; checked as version 4"
-    ls.log_message(f"bt-lsp: {folder}: {version} ({why})", types.MessageType.Info)
+    ls.log_message(f"bt-lsp: {key}: {version} ({why})", types.MessageType.Info)
 
 
 def document_edited(
@@ -115,7 +124,6 @@ def document_edited(
     if ls.project.config_edited(od.path, None if closed else od.doc.text):
         if closed:  # its diagnostics were cleared with the document's
             ls.config_published.pop(od.uri, None)
-        ls.versions_logged.clear()
         ls.refresh_all()
     elif opened:  # its configuration, read now: a pull client may not ask for a while
         ls.project.configs.for_path(od.path)
