@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import pytest
 
+from bt_lsp.ide.completion import complete
+from bt_lsp.ide.hover import hover_at
 from bt_lsp.rules import semantics
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.builtins_v3 import V3_BUILTINS
@@ -78,5 +80,118 @@ def test_a_v3_subtree_plus_calls_a_tree() -> None:
     assert codes('<SubTreePlus ID="Nowhere"/>', "3") == [("unknown-subtree", E)]
     # A version 4 check: a warning for a version 3 project.
     assert codes('<SubTree ID="Sub" __shared_blackboard="maybe"/>', "3") == [
+        ("invalid-port-value", W)
+    ]
+
+
+def test_the_v3_ports_are_3_8s() -> None:
+    """The 3.8 ports, as its providedPorts() declare them (not version 4's table)."""
+    ports = {
+        nid: [(p.name, p.direction, p.type, p.default) for p in m.ports]
+        for nid, m in V3_BUILTINS.items()
+    }
+    assert ports["RetryUntilSuccessful"] == [("num_attempts", "input", "int", None)]
+    assert ports["Repeat"] == [("num_cycles", "input", "int", None)]
+    assert ports["Timeout"] == [("msec", "input", "unsigned int", None)]
+    assert ports["Delay"] == [("delay_msec", "input", "unsigned int", None)]
+    assert ports["SetBlackboard"] == [
+        ("value", "input", "", None),
+        ("output_key", "inout", "", None),
+    ]
+    assert ports["Parallel"] == [
+        ("success_threshold", "input", "int", None),
+        ("failure_threshold", "input", "int", "1"),
+    ]
+    assert ports["BlackboardCheckDouble"] == [
+        ("value_A", "input", "", None),
+        ("value_B", "input", "", None),
+        ("return_on_mismatch", "input", "NodeStatus", None),
+    ]
+    assert [p[0] for p in ports["Switch3"]] == ["variable", "case_1", "case_2", "case_3"]
+    assert "RetryUntilSuccesful" not in V3_BUILTINS  # 3.8 comments that registration out
+    assert len(V3_BUILTINS) == 30
+    # Nothing of the table is version 4's object.
+    assert all(m is not BUILTINS.get(k) for k, m in V3_BUILTINS.items())
+
+
+V3_DOC = (
+    '<root main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main">\n'
+    "    <SequenceStar>\n"
+    '      <Parallel success_threshold="1"><AlwaysSuccess/></Parallel>\n'
+    "      \n"
+    "    </SequenceStar>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+
+
+def v3_context(d: Document, version: str | None = "3") -> Context:
+    return Context.combine(d, [], path="/w/t.xml", btcpp_version=version)
+
+
+def test_completion_in_a_v3_document_offers_3_8s_nodes() -> None:
+    d = Document(V3_DOC, "/w/t.xml")
+    at = V3_DOC.index("      \n") + 6
+    found = complete(d, at, v3_context(d))
+    assert found is not None
+    labels = {i.label for i in found.items}
+    assert {"SequenceStar", "BlackboardCheckInt", "RetryUntilSuccessful"} <= labels
+    assert not labels & {"Script", "Sleep", "SequenceWithMemory", "Precondition", "RunOnce"}
+    setbb = next(i for i in found.items if i.label == "SetBlackboard")
+    assert "Stores the string" in setbb.documentation
+    # The same place in a version 4 project offers version 4's.
+    found = complete(d, at, v3_context(d, "4"))
+    assert found is not None
+    labels = {i.label for i in found.items}
+    assert "Script" in labels and "SequenceStar" not in labels
+
+
+def test_hover_on_a_v3_builtin_shows_its_3_8_ports() -> None:
+    d = Document(V3_DOC, "/w/t.xml")
+    found = hover_at(d, V3_DOC.index("Parallel") + 2, v3_context(d))
+    assert found is not None
+    assert "Built-in Control of BehaviorTree.CPP 3.8" in found.text
+    assert "success_threshold" in found.text and "failure_threshold" in found.text
+    assert "success_count" not in found.text
+    found = hover_at(d, V3_DOC.index("SequenceStar") + 2, v3_context(d))
+    assert found is not None and "SequenceWithMemory" in found.text  # its description
+    found = hover_at(d, V3_DOC.index("success_threshold") + 2, v3_context(d))
+    assert found is not None and "input port, type `int`, no default" in found.text
+
+
+def test_a_v3_project_may_declare_a_node_named_like_a_4_x_builtin() -> None:
+    """A Humble application registering its own ``Sleep`` (3.8 has none): its model is
+    the one the rules and completion see."""
+    text = V3_DOC.replace("      \n", '      <Sleep seconds="1"/>\n').replace(
+        "</root>",
+        '<TreeNodesModel><Action ID="Sleep"><input_port name="seconds"/></Action>'
+        "</TreeNodesModel></root>",
+    )
+    d = Document(text, "/w/t.xml")
+    ctx = v3_context(d)
+    assert ctx.models["Sleep"].port("seconds") is not None
+    assert [x.code for x in semantics.check(d, ctx)] == []
+
+
+@pytest.mark.parametrize("fmt", ["", 'BTCPP_format="3"', 'BTCPP_format="4"'])
+def test_what_3_8_fails_on_is_an_error_in_a_v3_project(fmt: str) -> None:
+    def found(body: str) -> list[tuple[str, Severity]]:
+        d = doc(body, fmt)
+        ctx = Context.combine(d, [], path="/w/t.xml", btcpp_version="3")
+        return [(x.code, x.severity) for x in semantics.check(d, ctx)]
+
+    # 3.8's XMLParser throws for an attribute that is not a port ("Possible typo?").
+    assert found('<Delay delay_msec="1" dleay="2"><AlwaysSuccess/></Delay>') == [
+        ("undeclared-port", E)
+    ]
+    # DelayNode throws "Missing parameter [delay_msec]" when it is ticked.
+    assert found("<Delay><AlwaysSuccess/></Delay>") == [("missing-required-port", E)]
+    # A Switch without its variable ticks its default child: likely wrong, not a failure.
+    assert found("<Switch2><AlwaysSuccess/><AlwaysSuccess/><AlwaysSuccess/></Switch2>") == [
+        ("missing-required-port", W)
+    ]
+    # Literals are converted when the node reads them, not at creation: a warning.
+    assert found('<Delay delay_msec="soon"><AlwaysSuccess/></Delay>') == [
         ("invalid-port-value", W)
     ]

@@ -73,6 +73,7 @@ write(SRC / "lib" / "package.xml", manifest("lib", "nav2_behavior_tree"))
 write(SRC / "app" / "package.xml", manifest("app", "lib"))
 write(SRC / "app" / "old" / "legacy.xml", LEGACY)
 write(SRC / "v3pkg" / "package.xml", manifest("v3pkg", "behaviortree_cpp_v3"))
+write(SRC / "humble_app" / "package.xml", manifest("humble_app", "behaviortree_cpp_v3"))
 CATALOG = write(_TMP / "catalogs" / "app_nodes.xml", APP_CATALOG)
 write(WS / "bt-lsp.toml", 'exclude = ["src/app/old/**"]\n')
 
@@ -225,6 +226,48 @@ async def test_model_files_and_btcpp_through_workspace_configuration(client: BtC
     finally:
         configure(client, {"debounceMs": 0})
     await until(client, uri, lambda f: f == before, "the findings without the settings")
+
+
+HUMBLE = (
+    '<root main_tree_to_execute="T">\n'
+    '  <BehaviorTree ID="T">\n'
+    "    <SequenceStar>\n"
+    '      <Parallel success_threshold="1"><AlwaysSuccess/></Parallel>\n'
+    '      <Script code="x := 1"/>\n'
+    "      \n"
+    "    </SequenceStar>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+
+
+async def test_a_v3_package_gets_3_8s_nodes_in_diagnostics_completion_and_hover(
+    client: BtClient,
+) -> None:
+    uri = open_file(client, SRC / "humble_app" / "trees" / "t.xml", HUMBLE)
+    diags = await client.pushed(uri, 1)
+    # No advice to add BTCPP_format="4"; SequenceStar and Parallel's thresholds are
+    # 3.8's; Script is version 4's only.
+    assert found(diags) == {("unknown-node", Sev.Warning)}
+    [d] = diags
+    assert "'Script'" in d.message and "BehaviorTree.CPP 3" in d.message
+    at = HUMBLE.index("      \n") + 6
+    result = await client.text_document_completion_async(
+        types.CompletionParams(
+            text_document=types.TextDocumentIdentifier(uri=uri),
+            position=client.pos(HUMBLE, at),
+        )
+    )
+    items = result.items if isinstance(result, types.CompletionList) else result or []
+    labels = {i.label for i in items}
+    assert {"SequenceStar", "BlackboardCheckString"} <= labels
+    assert not labels & {"Script", "SequenceWithMemory", "Sleep"}
+    hover = await client.hover(uri, client.pos(HUMBLE, HUMBLE.index("Parallel") + 1))
+    assert hover is not None and isinstance(hover.contents, types.MarkupContent)
+    text = hover.contents.value
+    assert "BehaviorTree.CPP 3.8" in text
+    assert "success_threshold" in text and "failure_threshold" in text
+    assert "success_count" not in text
 
 
 async def test_the_version_is_logged_once_per_change(client: BtClient) -> None:

@@ -19,8 +19,7 @@ from bt_lsp.ide.completion_items import (
     tree_id,
     tree_ids,
 )
-from bt_lsp.ide.ports import ports_of
-from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.ide.ports import builtins_in, ports_of
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
 from bt_lsp.syntax.document import Document
@@ -175,7 +174,7 @@ def attribute_value(
             items.append(Item(tid, ItemKind.TREE, f"BehaviorTree ({where})", insert=attr_text(tid)))
         return Completions(vs, ve, "value", items)
     if el.zone == Zone.NODE and el.name in EXPLICIT_TAGS and a.name == "ID":
-        for nid, b in sorted(BUILTINS.items()):
+        for nid, b in sorted(builtins_in(ctx).items()):
             if b.category == el.name:
                 items.append(
                     Item(nid, ItemKind.MODEL, f"{b.category} (built-in)", b.description, nid)

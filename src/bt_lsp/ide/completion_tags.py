@@ -19,7 +19,7 @@ from bt_lsp.ide.completion_items import (
     tree_ids,
     with_ports,
 )
-from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.ide.ports import builtins_in
 from bt_lsp.rules.context import Context, source_label
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Zone
@@ -104,7 +104,7 @@ def _fits(doc: Document, ctx: Context, parent: int) -> bool:
     node_id = el.node_id
     if el.name == "SubTree" or node_id is None:
         return el.name != "SubTree"
-    b = BUILTINS.get(node_id)
+    b = builtins_in(ctx).get(node_id)
     if b is not None:
         most = b.max_children
     elif node_id in ctx.models:
@@ -191,7 +191,7 @@ def _node_items(ctx: Context, bare: bool, current_tree: str | None) -> Iterable[
             snippet=snip if bare else None,
             sort=f"0{mid}",
         )
-    for nid, b in sorted(BUILTINS.items()):
+    for nid, b in sorted(builtins_in(ctx).items()):
         if b.category == "SubTree":
             continue  # offered below, with an ID
         leaf = b.max_children == 0

@@ -14,8 +14,9 @@ from dataclasses import dataclass
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
 from bt_lsp.ide.name_edits import elsewhere, occurrences
 from bt_lsp.ide.name_fixes import preferred_renaming
-from bt_lsp.ide.ports import ports_of
-from bt_lsp.rules.builtins import BUILTINS, PortModel
+from bt_lsp.ide.ports import builtins_in, ports_of
+from bt_lsp.rules.builtins import PortModel
+from bt_lsp.rules.builtins_v3 import V3_BUILTINS
 from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.diagnostics import name_violations
 from bt_lsp.rules.names import RULES
@@ -102,7 +103,7 @@ def _what(w: _Writer, ref: NameRef) -> str:
 
 def _port_item(w: _Writer, p: PortModel) -> str:
     default = "no default" if p.default is None else f"default {w.code(p.default)}"
-    item = f"{w.code(p.name)}: {p.direction}, {w.code(p.type)}, {default}"
+    item = f"{w.code(p.name)}: {p.direction}, {w.code(p.type or 'any type')}, {default}"
     desc = w.prose(" ".join(p.description.split()))
     return f"{item}; {desc}" if desc else item
 
@@ -120,9 +121,11 @@ def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     sym = ref.symbol
     if sym is None or sym.kind == "port":
         return
-    if sym.kind == "model" and sym.name in BUILTINS:
-        b = BUILTINS[sym.name]
-        w.para(f"Built-in {b.category} of BehaviorTree.CPP: {w.prose(b.description)}")
+    builtins = builtins_in(ctx)
+    if sym.kind == "model" and sym.name in builtins:
+        b = builtins[sym.name]
+        of = "BehaviorTree.CPP 3.8" if builtins is V3_BUILTINS else "BehaviorTree.CPP"
+        w.para(f"Built-in {b.category} of {of}: {w.prose(b.description)}")
         _ports(w, b.ports)
         return
     if ctx is None:
@@ -146,15 +149,16 @@ def _port_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
         return
     port: PortModel | None = None
     owner = sym.owner
-    if sym.owner_kind == "model" and owner in BUILTINS:
-        port = BUILTINS[owner].port(sym.name)
+    builtins = builtins_in(ctx)
+    if sym.owner_kind == "model" and owner in builtins:
+        port = builtins[owner].port(sym.name)
     elif ctx is not None:
         decl = ctx.models.get(owner) if sym.owner_kind == "model" else ctx.subtree_models.get(owner)
         port = decl.port(sym.name) if decl is not None else None
     if port is None:
         return
     default = "no default" if port.default is None else f"default {w.code(port.default)}"
-    w.para(f"{port.direction} port, type {w.code(port.type)}, {default}.")
+    w.para(f"{port.direction} port, type {w.code(port.type or 'any')}, {default}.")
     if port.description:
         w.para(w.prose(port.description))
 
@@ -167,7 +171,7 @@ def _where_defined(
     sym = ref.symbol
     if sym is None or ref.role == Role.INSTANCE or sym.kind == "port":
         return
-    if sym.kind == "model" and sym.name in BUILTINS:
+    if sym.kind == "model" and sym.name in builtins_in(ctx):
         return
     if sym.kind == "tree":
         found = ctx.workspace_trees.get(sym.name) if ctx is not None else None
@@ -248,8 +252,8 @@ def _key_hover(w: _Writer, doc: Document, key: KeyRef, ctx: Context | None) -> N
             # An unknown model: which way the value flows is not known here.
             read.append(f"{where}, direction unknown")
             continue
-        where += f", {w.code(port.type)}"
-        if port.type not in types:
+        where += f", {w.code(port.type or 'any type')}"
+        if port.type and port.type not in types:
             types.append(port.type)
         if port.direction in ("output", "inout"):
             written.append(where)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 from bt_lsp.ide.places import element_end
-from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.ide.ports import builtins_in
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Role, Zone
@@ -42,7 +42,7 @@ class DocSymbol:
 def _category(node_id: str | None, ctx: Context | None) -> str:
     if node_id is None:
         return ""
-    b = BUILTINS.get(node_id)
+    b = builtins_in(ctx).get(node_id)
     if b is not None:
         return b.category
     if ctx is not None:

@@ -23,7 +23,8 @@ from operator import is_not, itemgetter, ne, or_
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Final, Literal, NamedTuple, TypeVar, cast
 
-from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
+from bt_lsp.rules.builtins import Category, Direction, PortModel
+from bt_lsp.rules.builtins_v3 import builtins_for
 from bt_lsp.syntax.elements import Element, Zone
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
@@ -325,7 +326,9 @@ class Context:
         has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
         return cls(
             path=own_path,
-            models=MappingProxyType(_first_by_id([*authoritative, *advisory], BUILTINS)),
+            models=MappingProxyType(
+                _first_by_id([*authoritative, *advisory], builtins_for(btcpp_version))
+            ),
             subtree_models=MappingProxyType(_first_by_id(subtree_models)),
             trees=MappingProxyType(_all_by_id(trees)),
             workspace_trees=MappingProxyType(_all_by_id(workspace_trees)),

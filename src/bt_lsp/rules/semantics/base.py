@@ -70,6 +70,14 @@ class Resolved:
         """Whether BehaviorTree.CPP is known to use exactly this model."""
         return self.origin != "custom" or self.authoritative
 
+#: Of those, what BehaviorTree.CPP 3.8 fails on as well: its XMLParser throws at tree
+#: creation for an attribute that is not in the node's manifest ("Possible typo? ...") and
+#: for a blackboard entry declared with two port types, and its built-ins throw when they
+#: read a port that is missing ("Missing parameter [delay_msec] in DelayNode").
+V3_CREATION_RULES: Final[frozenset[str]] = frozenset(
+    {"undeclared-port", "missing-required-port", "blackboard-type-mismatch"}
+)
+
 
 def resolve_builtin(type_id: str) -> Resolved | None:
     m = BUILTINS.get(type_id)
@@ -150,7 +158,12 @@ class State:
         data: FixData | None = None,
     ) -> None:
         sev = defined(code).severity if severity is None else severity
-        if sev == Severity.ERROR and not self.v4 and code in VERSION_4_RULES:
+        if (
+            sev == Severity.ERROR
+            and not self.v4
+            and code in VERSION_4_RULES
+            and not (self.v3 and code in V3_CREATION_RULES)
+        ):
             sev = Severity.WARNING
             if self.v3:
                 message += " (a check BehaviorTree.CPP 4 makes; this project builds against 3)"

@@ -95,7 +95,8 @@ def check_root(st: State) -> None:
     else:
         declared = root.attr("BTCPP_format") is not None
         version = st.ctx.btcpp_version
-        st.v4 = declared or version == "4"
+        # A BTCPP_format in a version 3 project is a note for a later move to 4.
+        st.v4 = (declared and version != "3") or version == "4"
         st.v3 = version == "3"
         # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only.
         if not declared and version != "3":

@@ -346,6 +346,10 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         st.add(s, e, "undeclared-port", message, Severity.WARNING)
 
 
+def _is_switch(type_id: str) -> bool:
+    return type_id.startswith("Switch") and type_id[6:].isdigit()
+
+
 def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: bool) -> None:
     if not res.required or (res.origin == "subtree" and (autoremap or st.v3)):
         return  # BehaviorTree.CPP 3 does not check a SubTree model's ports
@@ -360,6 +364,19 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
             'this call neither remaps it nor sets _autoremap="true"'
         )
         severity = None
+    elif res.origin == "builtin" and _is_switch(res.id):
+        # SwitchN reads its ports with getInput and goes on: no variable ticks the default
+        # child, a case without a value never matches (both versions' switch_node.h).
+        effect = (
+            "so it always ticks the default (last) child"
+            if "variable" in missing
+            else f"and {'those cases' if plural else 'that case'} never match"
+        )
+        message = (
+            f"{quoted(res.id)} is not given port{plural} {shown}; BehaviorTree.CPP reads "
+            f"{'them' if plural else 'it'} as optional, {effect}"
+        )
+        severity = Severity.WARNING
     elif res.origin == "builtin":
         message = (
             f"{quoted(res.id)} needs port{plural} {shown} (no default); the node fails when "
