@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import pytest
 
+from bt_lsp.ide.catalog import BUILTIN_CATALOG_V3, builtin_catalog
 from bt_lsp.ide.completion import complete
+from bt_lsp.ide.definition import definition
 from bt_lsp.ide.hover import hover_at
 from bt_lsp.rules import semantics
+from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.builtins_v3 import V3_BUILTINS
 from bt_lsp.rules.codes import Severity
@@ -192,6 +195,19 @@ def test_what_3_8_fails_on_is_an_error_in_a_v3_project(fmt: str) -> None:
         ("missing-required-port", W)
     ]
     # Literals are converted when the node reads them, not at creation: a warning.
-    assert found('<Delay delay_msec="soon"><AlwaysSuccess/></Delay>') == [
-        ("invalid-port-value", W)
-    ]
+    assert found('<Delay delay_msec="soon"><AlwaysSuccess/></Delay>') == [("invalid-port-value", W)]
+
+
+def test_definition_in_a_v3_document_leads_to_the_3_8_catalog() -> None:
+    d = Document(V3_DOC, "/w/t.xml")
+    cat = builtin_catalog("3")
+    assert analyze(Document(cat.text)) == []
+    assert "BehaviorTree.CPP 3.8" in cat.text and 'ID="Script"' not in cat.text
+    (place,) = definition(d, V3_DOC.index("SequenceStar") + 3, ctx=v3_context(d))
+    assert place.path == BUILTIN_CATALOG_V3
+    assert cat.text[place.start : place.end] == "SequenceStar"
+    (place,) = definition(d, V3_DOC.index("success_threshold") + 3, ctx=v3_context(d))
+    assert place.path == BUILTIN_CATALOG_V3
+    assert cat.text[place.start : place.end] == "success_threshold"
+    # Version 4 has neither.
+    assert definition(d, V3_DOC.index("SequenceStar") + 3, ctx=v3_context(d, "4")) == []

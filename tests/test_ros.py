@@ -241,3 +241,21 @@ def test_excluded_files_are_not_part_of_the_workspace(tmp_path: Path) -> None:
     # Editing the configuration brings them back.
     ws.config_edited(tmp_path / "bt-lsp.toml", "exclude = []\n")
     assert ws.files() == [tmp_path / "old" / "models.xml", scratch, kept]
+
+
+def test_catalogs_are_found_up_to_three_folders_down(tmp_path: Path) -> None:
+    share = tmp_path / "opt" / "share" / "lib"
+    write(share / "package.xml", manifest("lib"))
+    deep = write(share / "config" / "bt" / "models" / "nodes.xml", LIB_CATALOG)
+    write(share / "a" / "b" / "c" / "d" / "too_deep.xml", LIB_CATALOG)
+    write(share / "build" / "copied.xml", LIB_CATALOG)
+    write(share / "trees" / "tree.xml", SUB)  # a tree file, not a catalog
+    app = tmp_path / "ws" / "app"
+    write(app / "package.xml", manifest("app", "lib"))
+    tree = write(app / "t.xml", MAIN.replace("ComputePathToPose", "LibNode"))
+    ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(tmp_path / "opt")])
+    assert ws.catalog_files(tree) == [deep]
+    # A catalog added deep inside is heard.
+    later = write(share / "x" / "y" / "more.xml", CATALOG)
+    ws.file_changed(later)
+    assert ws.catalog_files(tree) == [later, deep]

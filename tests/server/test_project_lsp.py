@@ -268,6 +268,16 @@ async def test_a_v3_package_gets_3_8s_nodes_in_diagnostics_completion_and_hover(
     assert "BehaviorTree.CPP 3.8" in text
     assert "success_threshold" in text and "failure_threshold" in text
     assert "success_count" not in text
+    # Go to definition leads to 3.8's built-in catalog.
+    defined = await client.text_document_definition_async(
+        types.DefinitionParams(
+            text_document=types.TextDocumentIdentifier(uri=uri),
+            position=client.pos(HUMBLE, HUMBLE.index("SequenceStar") + 2),
+        )
+    )
+    assert isinstance(defined, list) and len(defined) == 1
+    assert isinstance(defined[0], types.Location)
+    assert defined[0].uri.endswith("/builtins-v3.xml")
 
 
 async def test_the_version_is_logged_once_per_change(client: BtClient) -> None:

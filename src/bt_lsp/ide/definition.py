@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
+from bt_lsp.ide.catalog import builtin_catalog, catalog_path
 from bt_lsp.ide.places import IncludeLink, Place
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
@@ -66,16 +66,23 @@ def _model_definition(
     found = _declarations(doc, others, sym, Role.MODEL_DEF)
     if found:
         return found
-    span = builtin_catalog().spans.get(sym)
-    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+    return _builtin_place(ctx, sym)
 
 
-def _port_definition(doc: Document, others: Mapping[str, Document], sym: PortSymbol) -> list[Place]:
+def _builtin_place(ctx: Context | None, sym: Symbol) -> list[Place]:
+    """The symbol in the built-in catalog of the document's BehaviorTree.CPP version."""
+    version = ctx.btcpp_version if ctx is not None else None
+    span = builtin_catalog(version).spans.get(sym)
+    return [Place(catalog_path(version), *span)] if span is not None else []
+
+
+def _port_definition(
+    doc: Document, others: Mapping[str, Document], ctx: Context | None, sym: PortSymbol
+) -> list[Place]:
     found = _declarations(doc, others, sym, Role.PORT_DECL)
     if found:
         return found
-    span = builtin_catalog().spans.get(sym)
-    return [Place(BUILTIN_CATALOG, *span)] if span is not None else []
+    return _builtin_place(ctx, sym)
 
 
 def definition(
@@ -104,7 +111,7 @@ def definition(
         return [Place(None, ref.start, ref.end)]
     sym = ref.symbol
     if sym.kind == "port":
-        return _port_definition(doc, others, sym)
+        return _port_definition(doc, others, ctx, sym)
     if sym.kind == "tree":
         return _tree_definition(doc, others, ctx, sym.name)
     return _model_definition(doc, others, ctx, sym.name)

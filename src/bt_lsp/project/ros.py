@@ -7,8 +7,8 @@ under each prefix of ``AMENT_PREFIX_PATH``.  That is where ``<include ros_pkg="n
 leads (ROS resolves it to the package's share folder, which installs what the source
 folder holds).
 
-A package's catalogs are the XML files at the top of its folder (or one folder down)
-whose ``<root>`` holds a ``<TreeNodesModel>`` and no ``<BehaviorTree>``: what
+A package's catalogs are the XML files of its folder (up to three folders down) whose
+``<root>`` holds a ``<TreeNodesModel>`` and no ``<BehaviorTree>``: what
 BehaviorTree.CPP's ``writeTreeNodesModelXML`` writes, e.g. Nav2's
 ``share/nav2_behavior_tree/nav2_tree_nodes.xml``.  A document's catalogs in scope are its
 own package's and those of the packages its ``package.xml`` depends on.
@@ -28,6 +28,10 @@ from bt_lsp.project.sniff import head_of, top_element
 __all__ = ["RosIndex", "is_catalog"]
 
 MAX_CATALOG_FILES: Final = 64  # per package
+CATALOG_DEPTH: Final = 3  # folders below a package's folder searched for catalogs
+MAX_EXAMINED: Final = 2000  # XML files looked at per package
+# Folders of a source package that hold no catalog it ships.
+_NOT_SHIPPED: Final = frozenset({"build", "install", "log", "node_modules", "__pycache__"})
 MAX_INSTALLED: Final = 10_000
 # Enough of a file to see whether it declares trees.
 CATALOG_SNIFF_BYTES: Final = 256 * 1024
@@ -82,7 +86,7 @@ class RosIndex:
         return self.installed().get(name)
 
     def catalogs(self, folder: Path) -> tuple[Path, ...]:
-        """The catalog files a package folder ships (its top folder and one below)."""
+        """The catalog files a package folder ships (up to three folders down)."""
         hit = self._catalogs.get(folder)
         if hit is not None:
             return hit
@@ -98,9 +102,11 @@ class RosIndex:
 
     def file_changed(self, path: Path) -> None:
         """An XML file changed: forget the catalogs of the package folders it may be in
-        (the top folder or one below)."""
-        for folder in (path.parent, path.parent.parent):
+        (up to three folders above it)."""
+        folder = path.parent
+        for _ in range(CATALOG_DEPTH + 1):
             self._catalogs.pop(folder, None)
+            folder = folder.parent
 
     def changed(self) -> None:
         self._installed = None
@@ -108,27 +114,29 @@ class RosIndex:
 
 
 def _xml_near(folder: Path) -> list[Path]:
-    """The ``*.xml`` files of ``folder`` and of its subfolders (not deeper), sorted."""
+    """The ``*.xml`` files under ``folder``, at most :data:`CATALOG_DEPTH` folders down
+    (hidden and build folders skipped, at most :data:`MAX_EXAMINED` files), sorted by
+    depth, then by path."""
     out: list[Path] = []
-    try:
-        entries = sorted(os.scandir(folder), key=lambda e: e.name)
-    except (OSError, ValueError):
-        return out
-    subfolders: list[Path] = []
-    for e in entries:
-        if e.name.startswith("."):
-            continue
-        try:
-            if e.is_file() and e.name.endswith(".xml"):
-                out.append(Path(e.path))
-            elif e.is_dir():
-                subfolders.append(Path(e.path))
-        except OSError:
-            continue
-    for sub in subfolders:
-        try:
-            names = sorted(os.listdir(sub))
-        except (OSError, ValueError):
-            continue
-        out.extend(sub / n for n in names if n.endswith(".xml") and is_file(sub / n))
+    level = [folder]
+    for _ in range(CATALOG_DEPTH + 1):
+        below: list[Path] = []
+        for here in level:
+            try:
+                entries = sorted(os.scandir(here), key=lambda e: e.name)
+            except (OSError, ValueError):
+                continue
+            for e in entries:
+                if e.name.startswith("."):
+                    continue
+                try:
+                    if e.is_file() and e.name.endswith(".xml"):
+                        out.append(Path(e.path))
+                        if len(out) >= MAX_EXAMINED:
+                            return out
+                    elif e.is_dir() and e.name not in _NOT_SHIPPED:
+                        below.append(Path(e.path))
+                except OSError:
+                    continue
+        level = below
     return out

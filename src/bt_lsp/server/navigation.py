@@ -17,7 +17,7 @@ from pygls.exceptions import JsonRpcException
 from pygls.uris import from_fs_path
 
 from bt_lsp import __version__
-from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
+from bt_lsp.ide.catalog import BUILTIN_CATALOG, BUILTIN_CATALOG_V3, builtin_catalog
 from bt_lsp.ide.definition import definition as find_definition
 from bt_lsp.ide.folding import folding_ranges, linked_editing_ranges
 from bt_lsp.ide.places import Place
@@ -64,7 +64,7 @@ class RequestFailed(JsonRpcException):
 
 # --- the built-in catalog file ------------------------------------------------------------
 
-_catalog: tuple[str, LineIndex] | None = None
+_catalogs: dict[str, tuple[str, LineIndex]] = {}  # by place path
 
 
 def _catalog_dirs() -> list[Path]:
@@ -72,17 +72,19 @@ def _catalog_dirs() -> list[Path]:
     return [Path(cache) / "bt-lsp" / __version__]
 
 
-def catalog_file() -> tuple[str, LineIndex] | None:
-    """The URI and line index of the built-in catalog, written once per process to the
-    user's cache folder (or a private temporary folder) so that editors can open it."""
-    global _catalog
-    if _catalog is not None:
-        return _catalog
-    text = builtin_catalog().text
+def catalog_file(place: str = BUILTIN_CATALOG) -> tuple[str, LineIndex] | None:
+    """The URI and line index of a built-in catalog (``place`` names it: 4.x's or
+    3.8's), written once per process to the user's cache folder (or a private temporary
+    folder) so that editors can open it."""
+    hit = _catalogs.get(place)
+    if hit is not None:
+        return hit
+    name = place.split(":", 1)[1]
+    text = builtin_catalog("3" if place == BUILTIN_CATALOG_V3 else None).text
     for folder in _catalog_dirs():
         try:
             folder.mkdir(parents=True, exist_ok=True)
-            path = folder / "builtins.xml"
+            path = folder / name
             if not path.is_file() or path.read_text(encoding="utf-8") != text:
                 path.write_text(text, encoding="utf-8")
             break
@@ -90,15 +92,15 @@ def catalog_file() -> tuple[str, LineIndex] | None:
             continue
     else:
         try:
-            path = Path(tempfile.mkdtemp(prefix="bt-lsp-")) / "builtins.xml"
+            path = Path(tempfile.mkdtemp(prefix="bt-lsp-")) / name
             path.write_text(text, encoding="utf-8")
         except OSError:
             return None
     uri = from_fs_path(str(path))
     if uri is None:
         return None
-    _catalog = (uri, LineIndex(text))
-    return _catalog
+    _catalogs[place] = (uri, LineIndex(text))
+    return _catalogs[place]
 
 
 # --- conversions --------------------------------------------------------------------------
@@ -112,8 +114,8 @@ def _locations(
     for p in places:
         if p.path is None:
             uri, lines = od.uri, od.doc.lines
-        elif p.path == BUILTIN_CATALOG:
-            found = catalog_file()
+        elif p.path in (BUILTIN_CATALOG, BUILTIN_CATALOG_V3):
+            found = catalog_file(p.path)
             if found is None:
                 continue
             uri, lines = found

@@ -70,6 +70,7 @@ class Resolved:
         """Whether BehaviorTree.CPP is known to use exactly this model."""
         return self.origin != "custom" or self.authoritative
 
+
 #: Of those, what BehaviorTree.CPP 3.8 fails on as well: its XMLParser throws at tree
 #: creation for an attribute that is not in the node's manifest ("Possible typo? ...") and
 #: for a blackboard entry declared with two port types, and its built-ins throw when they
