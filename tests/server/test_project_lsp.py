@@ -159,9 +159,7 @@ async def test_an_installed_dependency_catalog_is_authoritative(client: BtClient
     assert "goal_checker" in d.message
     hover = await client.hover(uri, client.pos(FOLLOW, FOLLOW.index("FollowPath") + 2))
     assert hover is not None and isinstance(hover.contents, types.MarkupContent)
-    assert "the node catalog an installed ROS package ships (authoritative)" in (
-        hover.contents.value
-    )
+    assert "the node catalog a ROS package ships (authoritative)" in (hover.contents.value)
     close(client, uri)
     # A package that does not depend on nav2 does not see its nodes.
     other = open_file(client, SRC / "v3pkg" / "trees" / "follow.xml", FOLLOW)

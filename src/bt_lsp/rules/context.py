@@ -48,7 +48,7 @@ __all__ = [
 #: registers: ``catalog`` (a file named in ``models``/``modelFiles``/``--models``),
 #: ``generated`` (a workspace file that is nothing but a ``<TreeNodesModel>``, as
 #: ``writeTreeNodesModelXML`` writes it: see :func:`is_generated_catalog`), ``ros`` (the
-#: shipped model of an installed ROS package) and ``cpp`` (the project's C++
+#: shipped model of a ROS package the document depends on) and ``cpp`` (the project's C++
 #: registrations).  Advisory ones say what an author or an editor wrote: ``tree`` (a
 #: ``<TreeNodesModel>`` inside a tree file) and ``palette`` (a Groot2 ``.btproj``).
 ModelSource = Literal["tree", "palette", "generated", "catalog", "ros", "cpp"]
@@ -59,7 +59,7 @@ _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
         "palette": "a Groot2 palette (advisory: BehaviorTree.CPP reads the C++)",
         "generated": "a catalog exported by BehaviorTree.CPP (authoritative)",
         "catalog": "a node catalog named in the settings (authoritative)",
-        "ros": "the node catalog an installed ROS package ships (authoritative)",
+        "ros": "the node catalog a ROS package ships (authoritative)",
         "cpp": "the project's C++ registration (authoritative)",
     }
 )
