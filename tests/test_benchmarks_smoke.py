@@ -178,3 +178,21 @@ def test_soak_runs_a_short_session(tmp_path: Path, capsys: pytest.CaptureFixture
     assert result["edits"] == 10 and result["rss_start_kib"] > 0 and result["rss_end_kib"] > 0
     assert set(result["request_ms"]) == set(bench_soak.REQUESTS)
     assert all(s["p50"] > 0 for s in result["request_ms"].values())
+
+
+def test_scale_times_the_outline_and_a_publication(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import scale as bench_scale  # type: ignore[import-not-found]
+
+    out = tmp_path / "scale.json"
+    argv = ["--sizes", "6K", "--repeat", "2", "--edits", "4", "--publication-size", "30K"]
+    assert bench_scale.main([*argv, "--json", str(out)]) == 0
+    assert "documentSymbol (ms):" in capsys.readouterr().out
+    result = json.loads(out.read_text(encoding="utf-8"))
+    (outline,) = result["outline"]
+    assert outline["symbols"] > 10 and outline["after_edit_ms"]["p50"] > 0
+    # The document of the publication is full of port problems, as intended.
+    publication = result["publication"]
+    assert publication["edits"] == 4 and publication["diagnostics"] > 50
+    assert publication["edit_ms"]["p50"] > 0

@@ -446,3 +446,23 @@ def test_positions_in_one_pass_are_position_of_each(
 ) -> None:
     lines = LineIndex(text)
     assert lines.positions(offsets, encoding) == {o: lines.position(o, encoding) for o in offsets}
+
+
+@settings(max_examples=300)
+@given(
+    st.text(st.sampled_from(list("ab\n\t ")), max_size=60),
+    st.lists(st.integers(-3, 65), max_size=30),
+    st.sampled_from(["utf-8", "utf-16", "utf-32"]),
+    st.integers(0, 60),
+)
+def test_positions_of_ascii_text_are_position_of_each(
+    text: str, offsets: list[int], encoding: Encoding, cut: int
+) -> None:
+    """Without a CR or a non-ASCII character a column is the distance from the line
+    start (the fast path), also after an edit (line starts in shifted blocks)."""
+    lines = LineIndex(text)
+    cut = min(cut, len(text))
+    edited_text = text[:cut] + "x\ny" + text[cut:]
+    edited = lines.edited(cut, cut, "x\ny", edited_text)
+    for idx in (lines, edited):
+        assert idx.positions(offsets, encoding) == {o: idx.position(o, encoding) for o in offsets}

@@ -6,10 +6,14 @@ import json
 
 from lsprotocol import types
 
+from bt_lsp.rules.codes import FixData, Severity
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.text import Encoding, LineIndex
+
+# What a diagnostic's JSON says apart from its range.
+_TailKey = tuple[str, str, Severity, FixData | None]
 
 
 def to_range(lines: LineIndex, start: int, end: int, enc: Encoding) -> types.Range:
@@ -115,18 +119,23 @@ class DiagnosticJson:
     Converting every diagnostic to lsprotocol objects and unstructuring them again on each
     edit cost most of a publication (2,000 diagnostics of a 200 KB document: 157 ms).
     The part of a diagnostic that does not move with edits (message, code, severity,
-    data) is written once and kept for as long as the core keeps the same
-    :class:`Diagnostic` object (an unchanged section keeps its diagnostics); the range is
-    written each time, its positions found in one pass (:meth:`LineIndex.positions`)."""
+    data) is written once and reused for as long as a diagnostic with the same content
+    is published: the core makes its diagnostics anew in document coordinates on every
+    version, but those of an unchanged section keep their content, so an edit writes only
+    the parts of the diagnostics it changed.  The range is written each time, its
+    positions found in one pass (:meth:`LineIndex.positions`).  ``converted`` counts the
+    parts written (what reuse saves)."""
 
     def __init__(self) -> None:
-        self._tails: dict[int, tuple[Diagnostic, str]] = {}
+        self._tails: dict[_TailKey, str] = {}
         self.described = True  # with codeDescription links (the client shows them)
+        self.converted = 0
 
     def tail(self, d: Diagnostic) -> str:
-        kept = self._tails.get(id(d))
-        if kept is not None and kept[0] is d:
-            return kept[1]
+        key = (d.code, d.message, d.severity, d.data)
+        kept = self._tails.get(key)
+        if kept is not None:
+            return kept
         info = CODES.get(d.code) if self.described else None
         fields: dict[str, object] = {
             "message": d.message,
@@ -139,25 +148,27 @@ class DiagnosticJson:
         if d.data is not None:
             fields["data"] = d.data.as_json()
         text = json.dumps(fields)[1:]  # without its "{": it follows the range
-        self._tails[id(d)] = (d, text)
+        self._tails[key] = text
+        self.converted += 1
         return text
 
     def array(
         self, lines: LineIndex, diags: list[Diagnostic], enc: Encoding, described: bool = True
     ) -> str:
-        """The JSON array of ``diags``; forgets the tails of diagnostics not among them."""
+        """The JSON array of ``diags``; forgets the parts of diagnostics not among them."""
         if described != self.described:
             self._tails.clear()
             self.described = described
         at = lines.positions([o for d in diags for o in (d.start, d.end)], enc)
+        tail = self.tail
         parts = []
         for d in diags:
             (sl, sc), (el, ec) = at[d.start], at[d.end]
             parts.append(
                 f'{{"range": {{"start": {{"line": {sl}, "character": {sc}}}, '
-                f'"end": {{"line": {el}, "character": {ec}}}}}, {self.tail(d)}'
+                f'"end": {{"line": {el}, "character": {ec}}}}}, {tail(d)}'
             )
         if len(self._tails) > len(diags):
-            keep = {id(d) for d in diags}
+            keep = {(d.code, d.message, d.severity, d.data) for d in diags}
             self._tails = {k: v for k, v in self._tails.items() if k in keep}
         return "[" + ", ".join(parts) + "]"
