@@ -3,7 +3,7 @@ entries and ports, the includes) and the workspace symbol search."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -12,6 +12,7 @@ from bt_lsp.ide.ports import builtins_in
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Role, Zone
+from bt_lsp.syntax.sections import Section
 
 
 class SymbolKind(StrEnum):
@@ -39,17 +40,22 @@ class DocSymbol:
     children: list[DocSymbol] = field(default_factory=list)
 
 
-def _category(node_id: str | None, ctx: Context | None) -> str:
+def _category(node_id: str | None, ctx: Context | None, used: dict[str, str] | None = None) -> str:
+    """The category of a node type; a custom type's is recorded in ``used`` (what an
+    outline kept for later versions depends on in the context)."""
     if node_id is None:
         return ""
     b = builtins_in(ctx).get(node_id)
     if b is not None:
         return b.category
+    found = ""
     if ctx is not None:
         decl = ctx.models.get(node_id)
         if decl is not None:
-            return decl.category
-    return ""
+            found = decl.category
+    if used is not None:
+        used[node_id] = found
+    return found
 
 
 def _id_span(el: Element) -> tuple[str, int, int]:
@@ -60,7 +66,9 @@ def _id_span(el: Element) -> tuple[str, int, int]:
     return "", el.name_start, el.name_end
 
 
-def _symbol_of(el: Element, ctx: Context | None) -> DocSymbol | None:
+def _symbol_of(
+    el: Element, ctx: Context | None, used: dict[str, str] | None = None
+) -> DocSymbol | None:
     zone = el.zone
     if zone == Zone.TREE:
         tid, s, e = _id_span(el)
@@ -77,7 +85,7 @@ def _symbol_of(el: Element, ctx: Context | None) -> DocSymbol | None:
             detail = f"{el.name} {nid}".strip()
         else:
             nid, s, e = el.name, el.name_start, el.name_end
-            detail = _category(nid, ctx)
+            detail = _category(nid, ctx, used)
             detail = f"{detail} {nid}".strip() if label else detail
         return DocSymbol(label or nid or el.name, detail, SymbolKind.NODE, 0, 0, s, e)
     if zone == Zone.MODELS:
@@ -106,20 +114,21 @@ def _symbol_of(el: Element, ctx: Context | None) -> DocSymbol | None:
     return None
 
 
-def document_symbols(doc: Document, ctx: Context | None = None) -> list[DocSymbol]:
-    """The outline: the trees with their nodes as a hierarchy, the ``<TreeNodesModel>``
-    with its entries and their ports, and the includes.  A symbol's range holds its
-    children's ranges; names are never empty."""
-    model = doc.model
-    if ctx is None:
-        ctx = Context.from_document(doc)
+def _outline(
+    items: Iterable[tuple[int, Element]],
+    ctx: Context | None,
+    end_of: Callable[[Element], int],
+    used: dict[str, str] | None = None,
+) -> list[DocSymbol]:
+    """The symbols of ``items`` (index, element) as a hierarchy; an element whose parent
+    is not among them (or is no symbol) is at the top."""
     made: dict[int, DocSymbol] = {}
     top: list[DocSymbol] = []
-    for i, el in enumerate(model.elements):
-        sym = _symbol_of(el, ctx)
+    for i, el in items:
+        sym = _symbol_of(el, ctx, used)
         if sym is None:
             continue
-        sym.start, sym.end = el.token_start, element_end(doc, el)
+        sym.start, sym.end = el.token_start, end_of(el)
         made[i] = sym
         parent = made.get(el.parent)
         (parent.children if parent is not None else top).append(sym)
@@ -129,6 +138,90 @@ def document_symbols(doc: Document, ctx: Context | None = None) -> list[DocSymbo
         for c in sym.children:
             sym.end = max(sym.end, c.end)
     return top
+
+
+def document_symbols(doc: Document, ctx: Context | None = None) -> list[DocSymbol]:
+    """The outline: the trees with their nodes as a hierarchy, the ``<TreeNodesModel>``
+    with its entries and their ports, and the includes.  A symbol's range holds its
+    children's ranges; names are never empty."""
+    if ctx is None:
+        ctx = Context.from_document(doc)
+    return _outline(enumerate(doc.model.elements), ctx, lambda el: element_end(doc, el))
+
+
+@dataclass(slots=True)
+class SectionOutline:
+    """The outline of one section, in its coordinates (offsets from its start), and the
+    categories of the custom node types it shows (looked up in the context)."""
+
+    symbols: list[DocSymbol]
+    categories: dict[str, str]
+
+
+@dataclass(slots=True)
+class OutlinePart:
+    """A piece of the outline in document order: the symbols of one section (``section``
+    set, offsets from ``origin``) or of the document's head or tail (in document
+    coordinates, ``origin`` 0)."""
+
+    origin: int
+    section: Section | None
+    outline: SectionOutline
+
+
+def section_outline(doc: Document, k: int, ctx: Context) -> SectionOutline:
+    """The outline of section ``k`` of ``doc``'s model, kept on the section (which later
+    versions share while it is unchanged) for as long as the categories it shows are the
+    context's: an outline after an edit costs the sections the edit changed."""
+    model = doc.model
+    sec = model.sections[k]
+    found: SectionOutline | None = sec.cache.get("outline")
+    if found is not None and all(_category(n, ctx) == c for n, c in found.categories.items()):
+        return found
+    tokens = doc.scan.tokens
+    tok_origin = model.firsts[k]
+
+    def end_of(el: Element) -> int:
+        if el.end >= 0:
+            return el.end
+        return el.token_start + tokens[el.token_index + tok_origin].length
+
+    used: dict[str, str] = {}
+    # Local element j + 1 is sec.elements[j]; local 0 (the root) is never a symbol.
+    symbols = _outline(enumerate(sec.elements, 1), ctx, end_of, used)
+    found = sec.cache["outline"] = SectionOutline(symbols, used)
+    return found
+
+
+def outline_parts(doc: Document, ctx: Context | None = None) -> list[OutlinePart]:
+    """:func:`document_symbols` in pieces: the head's symbols, each section's (kept
+    between versions, see :func:`section_outline`) and the tail's.  A model that is not
+    made of sections is one piece."""
+    if ctx is None:
+        ctx = Context.from_document(doc)
+    model = doc.model
+    if model.head is None:
+        return [OutlinePart(0, None, SectionOutline(document_symbols(doc, ctx), {}))]
+    els = model.elements
+
+    def end_of(el: Element) -> int:
+        return element_end(doc, el)
+
+    def loose(first: int, stop: int) -> OutlinePart | None:
+        found = _outline(((i, els[i]) for i in range(first, stop)), ctx, end_of)
+        return OutlinePart(0, None, SectionOutline(found, {})) if found else None
+
+    out: list[OutlinePart] = []
+    head = loose(1, 1 + len(model.head.elements))
+    if head is not None:
+        out.append(head)
+    for k, (sec, origin) in enumerate(zip(model.sections, model.origins, strict=True)):
+        out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx)))
+    if model.tail is not None:
+        tail = loose(model.tail_base, model.tail_base + len(model.tail.elements))
+        if tail is not None:
+            out.append(tail)
+    return out
 
 
 @dataclass(frozen=True, slots=True)

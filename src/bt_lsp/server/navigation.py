@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -26,8 +26,9 @@ from bt_lsp.ide.references import references as find_references
 from bt_lsp.ide.rename import RenameRefused
 from bt_lsp.ide.rename import prepare_rename as rename_target
 from bt_lsp.ide.rename import rename as plan_rename
-from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
+from bt_lsp.ide.symbols import DocSymbol, SymbolKind, outline_parts, workspace_symbols
 from bt_lsp.project.index import links
+from bt_lsp.rules.context import Context
 from bt_lsp.server.convert import RawJson, to_range, to_text_edit, workspace_edit
 from bt_lsp.server.lookup import (
     Source,
@@ -38,6 +39,7 @@ from bt_lsp.server.lookup import (
     workspace_sources,
 )
 from bt_lsp.server.state import OpenDocument
+from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.text import Encoding, LineIndex
 
@@ -158,10 +160,8 @@ def rename_edit(
 MAX_SYMBOL_DEPTH = 64
 
 
-def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> RawJson:
-    """The outline as the JSON text of LSP DocumentSymbols, written in one pre-order walk
-    without recursion: building lsprotocol objects and unstructuring them cost ten times
-    the outline itself on a large document."""
+def _pre_order(top: Sequence[DocSymbol]) -> list[tuple[DocSymbol, int]]:
+    """The symbols with their depth (from 1), in document order, without recursion."""
     order: list[tuple[DocSymbol, int]] = []
     stack = [(s, 1) for s in reversed(top)]
     while stack:
@@ -169,18 +169,14 @@ def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encod
         order.append((s, depth))
         below = min(depth + 1, MAX_SYMBOL_DEPTH)
         stack.extend((c, below) for c in reversed(s.children))
-    at = lines.positions(
-        [o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)], enc
-    )
+    return order
 
-    def rng(start: int, end: int) -> str:
-        (sl, sc), (el, ec) = at[start], at[end]
-        return (
-            f'{{"start": {{"line": {sl}, "character": {sc}}}, '
-            f'"end": {{"line": {el}, "character": {ec}}}}}'
-        )
 
-    out = ["["]
+def _write(
+    order: list[tuple[DocSymbol, int]], out: list[str], rng: Callable[[int, int], None]
+) -> None:
+    """Append the symbols of ``order`` to ``out`` as the JSON of LSP DocumentSymbols,
+    separated by commas, without the enclosing brackets; ``rng`` appends a range."""
     first = [True] * (MAX_SYMBOL_DEPTH + 2)  # no symbol yet in the open list at a depth
     open_depth = 0
     for s, depth in order:
@@ -193,14 +189,124 @@ def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encod
         detail = f'"detail": {json.dumps(s.detail)}, ' if s.detail else ""
         out.append(
             f'{{"name": {json.dumps(s.name)}, {detail}"kind": {int(_SYMBOL_KINDS[s.kind])}, '
-            f'"range": {rng(s.start, s.end)}, '
-            f'"selectionRange": {rng(s.sel_start, s.sel_end)}, "children": ['
+            '"range": '
         )
+        rng(s.start, s.end)
+        out.append(', "selectionRange": ')
+        rng(s.sel_start, s.sel_end)
+        out.append(', "children": [')
         first[depth + 1] = True
         open_depth = depth
     out.append("]}" * open_depth)
-    out.append("]")
-    return RawJson("".join(out))
+
+
+def _symbols_text(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> str:
+    """The symbols of ``top`` (document coordinates) as comma-separated JSON objects."""
+    order = _pre_order(top)
+    at = lines.positions(
+        [o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)], enc
+    )
+    out: list[str] = []
+
+    def rng(start: int, end: int) -> None:
+        (sl, sc), (el, ec) = at[start], at[end]
+        out.append(
+            f'{{"start": {{"line": {sl}, "character": {sc}}}, '
+            f'"end": {{"line": {el}, "character": {ec}}}}}'
+        )
+
+    _write(order, out, rng)
+    return "".join(out)
+
+
+def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> RawJson:
+    """The outline as the JSON text of LSP DocumentSymbols, written in one pre-order walk
+    without recursion: building lsprotocol objects and unstructuring them cost ten times
+    the outline itself on a large document."""
+    return RawJson(f"[{_symbols_text(lines, top, enc)}]")
+
+
+# Marks a number of a template in its JSON text (``json.dumps`` never writes a raw NUL).
+_MARK = "\x00"
+
+
+class _Template:
+    """A section's symbols as JSON text with its line numbers (and the columns on its
+    first line) left open: ``texts`` are the pieces between the numbers, each number
+    relative to the section's first line (``2k``) or to its first column (``2k + 1``).
+    Rendered for where the section is; the last rendering is kept, so that a section an
+    edit did not move costs nothing."""
+
+    __slots__ = ("at", "numbers", "text", "texts")
+
+    def __init__(self, marked: str) -> None:
+        pieces = marked.split(_MARK)
+        self.texts = pieces[0::2]
+        self.numbers = list(map(int, pieces[1::2]))
+        self.at: tuple[int, int] | None = None
+        self.text = ""
+
+    def render(self, line: int, column: int) -> str:
+        if self.at != (line, column):
+            base = (line, column)
+            texts = self.texts
+            out = [texts[0]]
+            for k, n in enumerate(self.numbers, 1):
+                out.append(str((n >> 1) + base[n & 1]))
+                out.append(texts[k])
+            self.text = "".join(out)
+            self.at = base
+        return self.text
+
+
+def _template(lines: LineIndex, origin: int, top: Sequence[DocSymbol], enc: Encoding) -> _Template:
+    order = _pre_order(top)
+    at = lines.positions(
+        [origin + o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)] + [origin],
+        enc,
+    )
+    line0, col0 = at[origin]
+    out: list[str] = []
+
+    def pos(offset: int) -> str:
+        line, col = at[origin + offset]
+        if line == line0:
+            return (
+                f'{{"line": {_MARK}0{_MARK}, "character": {_MARK}{(col - col0) << 1 | 1}{_MARK}}}'
+            )
+        return f'{{"line": {_MARK}{(line - line0) << 1}{_MARK}, "character": {col}}}'
+
+    def rng(start: int, end: int) -> None:
+        out.append(f'{{"start": {pos(start)}, "end": {pos(end)}}}')
+
+    _write(order, out, rng)
+    return _Template("".join(out))
+
+
+def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
+    """:func:`document_symbols_json` of the document's outline, made of its sections'
+    pieces: a section's JSON is kept on it (with its outline, see
+    :func:`bt_lsp.ide.symbols.section_outline`) and only re-rendered where it moved to a
+    new line or first column, so that the outline after an edit costs what the edit
+    changed."""
+    lines = doc.lines
+    texts: list[str] = []
+    parts = outline_parts(doc, ctx)
+    origins = lines.positions([p.origin for p in parts if p.section is not None], enc)
+    for part in parts:
+        sec = part.section
+        if not part.outline.symbols:
+            continue
+        if sec is None:
+            texts.append(_symbols_text(lines, part.outline.symbols, enc))
+            continue
+        kept = sec.cache.get("outline-json")
+        if kept is None or kept[0] is not part.outline or kept[1] != enc:
+            kept = (part.outline, enc, _template(lines, part.origin, part.outline.symbols, enc))
+            sec.cache["outline-json"] = kept
+        template: _Template = kept[2]
+        texts.append(template.render(*origins[part.origin]))
+    return RawJson("[" + ", ".join(texts) + "]")
 
 
 # --- features -----------------------------------------------------------------------------
@@ -303,9 +409,7 @@ def register(server: BtServer) -> None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
-        enc = ls.encoding
-        symbols = document_symbols(od.doc, context_of(ls, od))
-        return document_symbols_json(od.doc.lines, symbols, enc)
+        return outline_json(od.doc, context_of(ls, od), ls.encoding)
 
     @server.feature(types.WORKSPACE_SYMBOL)
     def workspace_symbol(

@@ -194,6 +194,15 @@ class Offsets(Sequence[int]):
             return 0
         return self._firsts[b] + bisect_left(self._blocks[b], offset - self._bases[b])
 
+    def floor(self, offset: int) -> tuple[int, int]:
+        """The index and value of the last offset at or before ``offset`` (which must not
+        be before the first): both found by C searches, over the blocks' bases and then
+        in one block."""
+        b = bisect_right(self._bases, offset) - 1
+        base, block = self._bases[b], self._blocks[b]
+        j = bisect_right(block, offset - base) - 1
+        return self._firsts[b] + j, base + block[j]
+
     def index_at(self, offset: int) -> int:
         """Index of the last offset at or before ``offset`` (-1 if none)."""
         return self.bisect_right(offset) - 1
@@ -232,13 +241,15 @@ class LineIndex:
     one is empty when the text ends with a line end. A ``\\r\\n`` pair is one line end.
     """
 
-    __slots__ = ("_starts", "_text")
+    __slots__ = ("_plain", "_starts", "_text")
 
     _text: str
     _starts: Offsets  # an edit moves blocks of them, not each of them
+    _plain: bool | None  # no CR and only ASCII (found when first asked)
 
     def __init__(self, text: str) -> None:
         self._text = text
+        self._plain = None
         starts = [0]
         starts.extend(_line_starts(text))
         self._starts = Offsets.of(starts)
@@ -248,6 +259,7 @@ class LineIndex:
         index = cls.__new__(cls)
         index._text = text
         index._starts = starts
+        index._plain = None
         return index
 
     def __eq__(self, other: object) -> bool:
@@ -338,26 +350,26 @@ class LineIndex:
         out: dict[int, tuple[int, int]] = {}
         if not offs:
             return out
-        starts = self._starts.tolist()
-        nstarts = len(starts)
-        line = 0
-        if "\r" not in text and (encoding == "utf-32" or text.isascii()):
+        floor = self._starts.floor  # line starts are in blocks: no list of them is made
+        nlines = len(self._starts)
+        if self._plain is None:
+            self._plain = text.isascii() and "\r" not in text
+        if self._plain or (encoding == "utf-32" and "\r" not in text):
             # A column is the distance from the line start.
             for o in offs:
                 at = n if o > n else max(o, 0)
-                line = bisect_right(starts, at, line) - 1
-                out[o] = (line, at - starts[line])
+                line, start = floor(at)
+                out[o] = (line, at - start)
             return out
-        at = column = 0
+        at = column = line = 0
         limit = -1  # where the current line's successor starts
         for o in offs:
             clamped = min(max(o, 0), n)
             if 0 < clamped < n and text[clamped - 1] == "\r" and text[clamped] == "\n":
                 clamped -= 1  # between "\r" and "\n": the end of the line
             if clamped >= limit:
-                line = bisect_right(starts, clamped, line) - 1
-                start = starts[line]
-                limit = starts[line + 1] if line + 1 < nstarts else n + 1
+                line, start = floor(clamped)
+                limit = self._starts[line + 1] if line + 1 < nlines else n + 1
                 column = _column(text, start, clamped, encoding)
             else:
                 column += _column(text, at, clamped, encoding)
