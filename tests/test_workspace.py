@@ -111,3 +111,32 @@ def test_include_closure_is_bounded_and_iterative(tmp_path: Path) -> None:
     write(tmp_path / f"f{n}.xml", tree())
     ws = ProjectIndex([tmp_path])
     assert len(ws.include_closure(normalize(tmp_path / "f0.xml"))) == n
+
+
+def test_revalidate_finds_files_created_and_deleted_in_the_workspace(tmp_path: Path) -> None:
+    """Without file-change notifications, a file created or deleted in a walked folder
+    (its modification time changes) is found on the next revalidation; a temporary file
+    that is no BT file changes nothing."""
+    import os
+
+    a = write(tmp_path / "a.xml", tree())
+    ws = ProjectIndex([tmp_path])
+    assert ws.files() == [a]
+    assert not ws.revalidate()
+
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    generation = ws.generation
+    assert not ws.revalidate()  # walked again, no BT file more: nothing changed
+    assert ws.files() == [a] and ws.generation == generation
+    b = write(sub / "b.xml", tree())
+    assert ws.revalidate() and ws.files() == [a, b] and ws.generation > generation
+
+    swap = sub / ".b.xml.swp"  # an editor's temporary file: the same BT files
+    swap.write_text("x", encoding="utf-8")
+    generation = ws.generation
+    assert not ws.revalidate() and ws.generation == generation
+
+    ws.document(b)  # read, then deleted
+    os.remove(b)
+    assert ws.revalidate() and ws.files() == [a] and ws.document(b) is None

@@ -156,3 +156,65 @@ def _close(client: Client, uri: str) -> None:
     client.text_document_did_close(
         types.DidCloseTextDocumentParams(text_document=types.TextDocumentIdentifier(uri=uri))
     )
+
+
+NEW_CALLER = """<root BTCPP_format="4" main_tree_to_execute="Caller">
+  <BehaviorTree ID="Caller">
+    <SubTree ID="Created"/>
+  </BehaviorTree>
+</root>
+"""
+CREATED = """<root BTCPP_format="4">
+  <BehaviorTree ID="Created">
+    <AlwaysSuccess/>
+  </BehaviorTree>
+</root>
+"""
+
+
+async def _subtree_message(client: Client, uri: str, has: str) -> None:
+    """Wait until the unknown-subtree message published for ``uri`` says ``has``
+    (``""``: says no file defines the tree)."""
+
+    def message() -> str:
+        found = [d.message for d in client.diagnostics.get(uri, []) if d.code == "unknown-subtree"]
+        return found[0] if found else ""
+
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + TIMEOUT
+    while (
+        (has not in message()) if has else ("but no tree with that ID is defined" not in message())
+    ):
+        assert loop.time() < deadline, f"{uri}: {message()!r}"
+        await asyncio.sleep(0.05)
+
+
+async def test_a_file_created_or_deleted_on_disk_is_seen(client: Client) -> None:
+    """A tree file created after the workspace was first walked, in a new folder, is
+    found: the caller's hint says which file defines the tree it calls; deleting the file
+    makes the tree unknown everywhere again."""
+    (client.ws / "caller.xml").write_text(NEW_CALLER, encoding="utf-8")
+    caller = _uri(client, "caller.xml")
+    _open(client, caller, NEW_CALLER)
+    await _subtree_message(client, caller, "")
+
+    made = client.ws / "trees" / "created.xml"
+    made.parent.mkdir()
+    made.write_text(CREATED, encoding="utf-8")
+    await asyncio.sleep(1.2)  # the server compares with the disk at most once a second
+    _change(client, caller, 2, NEW_CALLER + "\n")
+    await _subtree_message(client, caller, "defined in created.xml")
+
+    made.unlink()
+    await asyncio.sleep(1.2)
+    _change(client, caller, 3, NEW_CALLER)
+    await _subtree_message(client, caller, "")
+
+    # Created again in the folder that is now known (its modification time changes, not
+    # the workspace folder's).
+    made.write_text(CREATED, encoding="utf-8")
+    await asyncio.sleep(1.2)
+    _change(client, caller, 4, NEW_CALLER + "\n")
+    await _subtree_message(client, caller, "defined in created.xml")
+    _close(client, caller)
+    made.unlink()

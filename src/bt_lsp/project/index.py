@@ -141,6 +141,9 @@ class ProjectIndex:
         self._open: dict[Path, Document] = {}
         self._disk: dict[Path, tuple[tuple[int, int], Document | None, str | None]] = {}
         self._files: list[Path] | None = None
+        # The folders walked for _files, with their modification times: a file created,
+        # deleted or renamed in one changes its folder's (see revalidate).
+        self._folders: dict[str, int] = {}
         self._includes: dict[Path, tuple[Model, Settings, list[Include]]] = {}
         self._paths: tuple[tuple[int, tuple[Path, ...]], list[Path]] | None = None
         self.generation = 0  # bumps whenever a file other than an edited open one changes
@@ -215,11 +218,21 @@ class ProjectIndex:
         self.generation += 1
 
     def revalidate(self) -> bool:
-        """Forget the files whose modification time or size changed since they were read
-        (for clients that do not report file changes); ``True`` if any did."""
+        """Forget the files whose modification time or size changed since they were read,
+        and find the workspace's files again when a file was created or deleted in one of
+        its folders (for clients that do not report file changes); ``True`` if any was."""
         changed = [p for p, (stamp, _, _) in self._disk.items() if _stamp(p) != stamp]
         for p in changed:
             self.file_changed(p)
+        if self._files is not None and any(_folder_stamp(d) != t for d, t in self._folders.items()):
+            before = self._files
+            self._files = None
+            now = self.files()
+            if now != before:
+                for p in set(before).symmetric_difference(now):
+                    self.file_changed(p)  # a catalog, a package.xml: forgotten
+                self._files = now
+                return True
         return bool(changed)
 
     def refresh(self) -> None:
@@ -305,8 +318,9 @@ class ProjectIndex:
         settings (sorted; a bounded number, skipping build and VCS folders)."""
         if self._files is None:
             found: set[Path] = set()
+            self._folders = {}
             for root in self.roots:
-                for p in _walk_xml(root, self.is_excluded):
+                for p in _walk_xml(root, self.is_excluded, self._folders):
                     found.add(p)
                     if len(found) >= MAX_WORKSPACE_FILES:
                         break
@@ -619,13 +633,27 @@ def _short(p: Path, base: Path) -> str:
         return str(p)
 
 
-def _walk_xml(root: Path, skip: Callable[[Path, bool], bool]) -> Iterable[Path]:
+def _folder_stamp(folder: str) -> int:
+    """A folder's modification time (-1 if it is gone)."""
+    try:
+        return os.stat(folder).st_mtime_ns
+    except (OSError, ValueError):
+        return -1
+
+
+def _walk_xml(
+    root: Path, skip: Callable[[Path, bool], bool], folders: dict[str, int] | None = None
+) -> Iterable[Path]:
     """The XML and ``.btproj`` files under ``root``, but what ``skip(path, is_dir)``
-    leaves out (the configuration's ``exclude``)."""
+    leaves out (the configuration's ``exclude``); each folder walked is recorded in
+    ``folders`` with its modification time, taken before it is listed (a file created
+    meanwhile shows)."""
     if root.is_file():
         if root.suffix in (".xml", ".btproj") and not skip(root, False):
             yield root
         return
+    if folders is not None:
+        folders[str(root)] = _folder_stamp(str(root))
     for dirpath, dirnames, filenames in os.walk(root):
         here = Path(dirpath)
         dirnames[:] = sorted(
@@ -633,6 +661,10 @@ def _walk_xml(root: Path, skip: Callable[[Path, bool], bool]) -> Iterable[Path]:
             for d in dirnames
             if d not in SKIP_DIRS and not d.startswith(".") and not skip(here / d, True)
         )
+        if folders is not None:
+            for d in dirnames:
+                path = os.path.join(dirpath, d)
+                folders[path] = _folder_stamp(path)
         for f in sorted(filenames):
             if f.endswith((".xml", ".btproj")):
                 p = normalize(here / f)
