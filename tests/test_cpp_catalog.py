@@ -62,7 +62,8 @@ def test_limits_say_why() -> None:
     assert "expression" in notes["Wait"]
     assert "also registered" in notes["Twin"]
     by_id = catalog.by_id
-    assert by_id["Wait"].authoritative  # a default written as an expression is still a default
+    # Every flag makes a node advisory, a default written as an expression too.
+    assert not by_id["Wait"].authoritative
     assert not by_id["Built"].authoritative
     assert not by_id["Twin"].authoritative
     # A registration inside a template helper names its ID by a parameter: not guessed.

@@ -44,8 +44,11 @@ FLAG_KIND_UNKNOWN: Final = "kind-unknown"
 FLAG_PORTS_INCOMPLETE: Final = "ports-incomplete"
 FLAG_DEFAULT_EXPRESSION: Final = "default-expression"
 FLAG_DUPLICATE_ID: Final = "duplicate-id"
-# The flags that make a node advisory (a default written as an expression still is one).
-_ADVISORY: Final = frozenset({FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE, FLAG_DUPLICATE_ID})
+# The flags that make a node advisory: every one (a default written as an expression is
+# text bt-lsp cannot show as BehaviorTree.CPP would).
+_ADVISORY: Final = frozenset(
+    {FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE, FLAG_DUPLICATE_ID, FLAG_DEFAULT_EXPRESSION}
+)
 
 # BehaviorTree.CPP's base classes (4.x and 3.x names) and the kind each gives.
 LIBRARY_KINDS: Final[dict[str, str]] = {

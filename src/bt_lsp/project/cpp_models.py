@@ -12,27 +12,32 @@ modification time or size changed, for the command line); their facts come from 
 content-keyed cache of :mod:`bt_lsp.project.cpp_scan`.  The nodes become
 :class:`~bt_lsp.rules.context.ModelDecl` values whose path is the C++ file and whose span
 is the ID's string literal, in code points.
+
+A BT file's registrations are *all known* (so a node type missing from them is an error,
+as BehaviorTree.CPP fails with "Node not recognized") only when nothing outside the C++
+read can register a node for it: see :meth:`CppModels.completeness`.
 """
 
 from __future__ import annotations
 
 import glob
 import os
+import re
 import threading
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Final, cast
+from typing import Final, NamedTuple
 
 from bt_lsp.cpp.catalog import Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
-from bt_lsp.project.packages import Manifest, Packages, is_file
+from bt_lsp.project.packages import BTCPP_PACKAGES, Manifest, Packages, is_file
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
-from bt_lsp.rules.context import Context, ModelDecl
+from bt_lsp.rules.context import Context, ModelDecl, ModelSource
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import Diagnostic
 
@@ -40,6 +45,56 @@ MAX_CPP_FILES: Final = 20000
 _SKIP: Final = frozenset({"build", "install", "log", "node_modules", "__pycache__"})
 
 Progress = Callable[[int, int], None]
+#: A dependency that is not in the workspace: its manifest (``None`` when it is not found)
+#: and the node catalogs it ships.
+Resolve = Callable[[str], tuple[Manifest | None, Sequence[Path]]]
+
+# C++ that registers nodes chosen at run time: plugin libraries named by a parameter.
+_DYNAMIC: Final = re.compile(
+    rb"\b(?:registerFromPlugin|registerFromROSPlugins|RegisterRosNode|"
+    rb"BT_RegisterRosNodeFromPlugin|plugin_lib_names|SharedLibrary)\b"
+)
+# Dependencies that cannot register BehaviorTree.CPP nodes, found or not: generated
+# interface packages, build tools and the ROS client and transform libraries.
+_NO_NODES_SUFFIXES: Final = ("_msgs", "_srvs", "_interfaces", "_cmake", "_cmake_module")
+_NO_NODES_PREFIXES: Final = ("ament_", "rosidl_", "ament_cmake")
+_NO_NODES: Final = frozenset(
+    {
+        "rclcpp",
+        "rclcpp_action",
+        "rclcpp_components",
+        "rclcpp_lifecycle",
+        "rclpy",
+        "rcutils",
+        "rcpputils",
+        "rmw",
+        "tf2",
+        "tf2_ros",
+        "tf2_eigen",
+        "tf2_geometry_msgs",
+        "eigen",
+        "eigen3",
+        "boost",
+        "yaml-cpp",
+        "yaml_cpp_vendor",
+        "launch",
+        "launch_ros",
+        "ros2launch",
+        "rosbag2_cpp",
+        "gtest",
+        "gmock",
+    }
+)
+
+
+class Completeness(NamedTuple):
+    """Whether a BT file's registrations are all known; if not, ``why`` (for messages).
+    ``shipped`` are the node catalogs that stand for dependencies whose C++ is not
+    visible."""
+
+    complete: bool
+    why: str = ""
+    shipped: frozenset[str] = frozenset()
 
 
 class CppModels:
@@ -72,6 +127,9 @@ class CppModels:
         # server reads them in a thread, then refreshes the diagnostics).
         self.mode = "sync"
         self.on_missing: Callable[[Path], None] | None = None
+        # Called while a catalog is read in "sync" mode (the command line's progress line).
+        self.progress: Progress | None = None
+        self._complete: dict[tuple[Path, tuple[Path, ...]], tuple[int, Completeness]] = {}
 
     # --- which files ---------------------------------------------------------------------
 
@@ -183,7 +241,7 @@ class CppModels:
             if hit is not None and hit[0] == self.generation:
                 return hit[1]
             generation = self.generation
-        cat = scan(list(files), self.scanner, read=self._read, progress=progress)
+        cat = scan(list(files), self.scanner, read=self._read, progress=progress or self.progress)
         with self._lock:
             kept = self._catalogs.get(files)
             if kept is None or kept[0] <= generation:
@@ -241,28 +299,121 @@ class CppModels:
 
     # --- as models -----------------------------------------------------------------------
 
-    def context_with_models(self, ctx: Context, path: Path, settings: Settings) -> Context:
-        """``ctx`` with the C++ nodes ``path`` sees among its models.
+    def context_with_models(
+        self, ctx: Context, path: Path, settings: Settings, resolve: Resolve | None = None
+    ) -> Context:
+        """``ctx`` with the C++ nodes ``path`` sees among its models, and whether they are
+        all the nodes registered (see :meth:`completeness`; ``resolve`` finds the
+        dependencies that are not in the workspace).
 
         A node read completely (authoritative) wins over a ``<TreeNodesModel>``
         declaration of the same ID; one with flags only fills a gap.
         """
+        files = self.files_for(path, settings.sources, settings.exclude)
         if self.mode == "sync":
-            cat: Catalog | None = self.catalog_for(path, settings.sources, settings.exclude)
+            cat: Catalog | None = self.catalog(files)
         else:  # the last catalog read, while a newer one is read in the background
-            cat, fresh = self._latest(self.files_for(path, settings.sources, settings.exclude))
+            cat, fresh = self._latest(files)
             if not fresh and self.on_missing is not None:
                 self.on_missing(path)
-        if cat is None or not cat.nodes:
+        if cat is None:
             return ctx
+        known = self.completeness(path, files, cat, resolve)
         decls = self.decls(cat)
         merged = dict(ctx.models)
         for id_, d in decls.items():
             if id_ not in merged or cat.by_id[id_].authoritative:
                 merged[id_] = d
+        registered: frozenset[str] | None = None
+        if known.complete:
+            # The C++ nodes (those of unknown kind too) and what catalogs say is registered
+            # (those of the packages whose C++ is not visible among them).
+            registered = frozenset(n.id for n in cat.nodes if n.id not in BUILTINS) | {
+                i for i, d in ctx.models.items() if d.authoritative or d.path in known.shipped
+            }
         return replace(
-            ctx, models=MappingProxyType(merged), sources=(*ctx.sources, ("cpp", id(decls)))
+            ctx,
+            models=MappingProxyType(merged),
+            registered=registered,
+            incomplete=known.why,
+            sources=(*ctx.sources, ("cpp", id(decls), known)),
         )
+
+    def completeness(
+        self, path: Path, files: tuple[Path, ...], cat: Catalog, resolve: Resolve | None = None
+    ) -> Completeness:
+        """Whether the C++ read is every registration the BT file at ``path`` can meet.
+
+        It is when the file's ROS package has C++ that creates a ``BehaviorTreeFactory``
+        (the application is here, not in a package that loads these trees from elsewhere),
+        no C++ read loads plugin libraries chosen at run time (``registerFromPlugin``,
+        Nav2's ``plugin_lib_names``) or registers an ID that is not a literal, and every
+        dependency of the package and of its workspace dependencies that depends on
+        BehaviorTree.CPP is resolved: its C++ is in the workspace, or it ships a node
+        catalog.  A dependency that is not found counts as unresolved, but for those that
+        cannot register nodes (``*_msgs``, ``ament_*``, ``rclcpp``, ...).
+        """
+        key = (path.parent, files)
+        with self._lock:
+            hit = self._complete.get(key)
+            if hit is not None and hit[0] == self.generation:
+                return hit[1]
+            generation = self.generation
+        found = self._completeness(path, files, cat, resolve)
+        with self._lock:
+            if len(self._complete) > 256:
+                self._complete.clear()
+            self._complete[key] = (generation, found)
+        return found
+
+    def _completeness(
+        self, path: Path, files: tuple[Path, ...], cat: Catalog, resolve: Resolve | None
+    ) -> Completeness:
+        own = self.packages.package_of(path.parent)
+        if own is None:
+            return Completeness(False, "the file is in no ROS package")
+        pkgs = self.visible_packages(path) or [own]
+        texts = [(f, self._read(f) or b"") for f in files]
+        if not any(b"BehaviorTreeFactory" in d for f, d in texts if _under(f, own.folder)):
+            return Completeness(
+                False,
+                f"no C++ of package {own.name} creates a BehaviorTreeFactory: its trees run "
+                "in an application bt-lsp does not see",
+            )
+        for f, d in texts:
+            if _DYNAMIC.search(d):
+                return Completeness(False, f"{self.shown(f)} loads node plugins chosen at run time")
+        if cat.unresolved:
+            u = cat.unresolved[0]
+            where = f"{self.shown(Path(u.path))}:{u.span[0] + 1}"
+            return Completeness(False, f"the ID registered at {where} is not known statically")
+        names = {m.name for m in pkgs}
+        shipped: set[str] = set()
+        for m in pkgs:
+            for dep in sorted(m.depends - names):
+                if dep in BTCPP_PACKAGES or _registers_no_nodes(dep):
+                    continue
+                manifest, catalogs = resolve(dep) if resolve is not None else (None, ())
+                if manifest is None:
+                    return Completeness(False, f"dependency {dep} of {m.name} is not found")
+                if not manifest.depends & BTCPP_PACKAGES.keys():
+                    continue
+                if not catalogs:
+                    return Completeness(
+                        False,
+                        f"dependency {dep} of {m.name} depends on BehaviorTree.CPP, and "
+                        "neither its C++ nor a node catalog it ships is visible",
+                    )
+                shipped.update(str(c) for c in catalogs)
+        return Completeness(True, "", frozenset(shipped))
+
+    def shown(self, path: Path) -> str:
+        """``path`` relative to the workspace folder that holds it (as given otherwise)."""
+        for root in self.roots:
+            folder = root if root.is_dir() else root.parent
+            if _under(path, folder):
+                return path.relative_to(folder).as_posix()
+        return str(path)
 
     def decls(self, catalog: Catalog) -> MappingProxyType[str, ModelDecl]:
         """The catalog's nodes as models by ID (built-ins and nodes of unknown kind left
@@ -290,12 +441,11 @@ class CppModels:
             PortModel(p.name, _direction(p.direction), p.type, p.default, p.description)
             for p in n.ports
         )
-        decl = ModelDecl(n.id, _category(n.kind), ports, n.path, start, end)
-        if n.authoritative and "source" in ModelDecl._fields:
-            # Models that say where they come from: a node read completely is what
-            # BehaviorTree.CPP registers (authoritative); one with flags stays advisory.
-            decl = cast(Any, decl)._replace(source="cpp")
-        return decl
+        # A node read completely is what BehaviorTree.CPP registers (authoritative); one
+        # with flags stays advisory.
+        source: ModelSource = "cpp" if n.authoritative else "cpp-partial"
+        where = f"{self.shown(Path(n.path))}:{n.id_span[0] + 1}"
+        return ModelDecl(n.id, _category(n.kind), ports, n.path, start, end, source, where)
 
     def offsets(self, path: Path, span: Span) -> tuple[int, int]:
         """The code-point offsets of ``span`` in the file at ``path``."""
@@ -333,6 +483,12 @@ def _category(kind: str | None) -> Category:
     if kind == "Decorator":
         return "Decorator"
     return "Action"
+
+
+def _registers_no_nodes(dep: str) -> bool:
+    return (
+        dep in _NO_NODES or dep.endswith(_NO_NODES_SUFFIXES) or dep.startswith(_NO_NODES_PREFIXES)
+    )
 
 
 def _direction(d: str) -> Direction:

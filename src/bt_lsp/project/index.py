@@ -20,7 +20,7 @@ from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer, excl
 from bt_lsp.project.cpp_models import CppModels, cpp_diagnostics
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError, read_text
-from bt_lsp.project.packages import Detected, Packages
+from bt_lsp.project.packages import Detected, Manifest, Packages
 from bt_lsp.project.ros import RosIndex
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules import analysis
@@ -487,8 +487,18 @@ class ProjectIndex:
             btcpp_version=self.btcpp_for(path, doc).version,
         )
         if self.cpp is not None:
-            ctx = self.cpp.context_with_models(ctx, path, settings)
+            ctx = self.cpp.context_with_models(
+                ctx, path, settings, lambda name: self._dependency(name, settings)
+            )
         return ctx
+
+    def _dependency(self, name: str, settings: Settings) -> tuple[Manifest | None, list[Path]]:
+        """A ROS package outside the workspace C++: its manifest and shipped catalogs."""
+        folder = self.ros_package(name, settings)
+        manifest = self.packages.manifest(folder / "package.xml") if folder else None
+        if folder is None or manifest is None:
+            return None, []
+        return manifest, [normalize(p) for p in self.ros.catalogs(folder)]
 
     def catalog_files(self, path: Path) -> list[Path]:
         """The node catalog files in scope for the document at ``path``: the ``models``

@@ -50,8 +50,9 @@ __all__ = [
 #: ``writeTreeNodesModelXML`` writes it: see :func:`is_generated_catalog`), ``ros`` (the
 #: shipped model of a ROS package the document depends on) and ``cpp`` (the project's C++
 #: registrations).  Advisory ones say what an author or an editor wrote: ``tree`` (a
-#: ``<TreeNodesModel>`` inside a tree file) and ``palette`` (a Groot2 ``.btproj``).
-ModelSource = Literal["tree", "palette", "generated", "catalog", "ros", "cpp"]
+#: ``<TreeNodesModel>`` inside a tree file), ``palette`` (a Groot2 ``.btproj``) and
+#: ``cpp-partial`` (a C++ registration whose kind, ports or defaults could not all be read).
+ModelSource = Literal["tree", "palette", "generated", "catalog", "ros", "cpp", "cpp-partial"]
 AUTHORITATIVE: Final[frozenset[str]] = frozenset({"generated", "catalog", "ros", "cpp"})
 _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
     {
@@ -61,6 +62,8 @@ _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
         "catalog": "a node catalog named in the settings (authoritative)",
         "ros": "the node catalog a ROS package ships (authoritative)",
         "cpp": "the project's C++ registration (authoritative)",
+        "cpp-partial": "the project's C++ registration (advisory: a static reading could not "
+        "know all of it)",
     }
 )
 
@@ -92,6 +95,8 @@ class ModelDecl(NamedTuple):
     ``start``/``end`` the code-point span of the entry's ``ID`` value (its tag name when it
     has no ``ID``).  ``source`` says where the model comes from and so whether it is
     authoritative (what BehaviorTree.CPP registers) or advisory (what someone wrote).
+    ``where`` says where a model learned from C++ is registered, for people
+    (``src/nodes.cpp:42``, relative to the workspace folder); empty for the others.
     """
 
     id: str
@@ -101,6 +106,7 @@ class ModelDecl(NamedTuple):
     start: int
     end: int
     source: ModelSource = "tree"
+    where: str = ""
 
     @property
     def authoritative(self) -> bool:
@@ -198,6 +204,9 @@ class Context:
     * ``btcpp_version``: the BehaviorTree.CPP major version the document is built for,
       ``"3"`` or ``"4"``, as the project layer detected or configured it (``None`` when
       unknown: the document's own ``BTCPP_format`` is all there is).
+    * ``registered``: when every package that can register nodes for this document was
+      read (its C++ catalog is complete), the custom node IDs the application registers;
+      ``None`` when that is not known, and ``incomplete`` then says why, for messages.
     """
 
     path: str | None = None
@@ -221,6 +230,8 @@ class Context:
     btcpp_version: str | None = None
     included: tuple[str, ...] = ()  # the paths of this document's include closure
     workspace_files: int = 0  # how many other workspace documents were looked at
+    registered: frozenset[str] | None = None
+    incomplete: str = ""
     # What the context was combined from besides its own document's declarations (the
     # other documents' declarations, by identity, and the settings): equal sources mean
     # that only this document's own declarations can differ (see semantics/sections.py).
@@ -569,7 +580,7 @@ def _extract_all(
 
 
 _new = tuple.__new__
-_FIELDS = tuple(itemgetter(i) for i in range(7))
+_FIELDS = tuple(itemgetter(i) for i in range(8))
 
 
 class _Mover(NamedTuple):

@@ -64,6 +64,7 @@ class Resolved:
     max_children: int | None
     required: tuple[str, ...] = ()  # ports that must be given (see ports.py)
     authoritative: bool = False  # a custom model from an authoritative source
+    where: str = ""  # where a model learned from C++ is registered (ModelDecl.where)
 
     @property
     def exact(self) -> bool:
@@ -201,6 +202,7 @@ class State:
                 hi,
                 required,
                 decl.authoritative,
+                decl.where,
             )
             self.made["model", type_id] = (decl, res)
         self._types[type_id] = res

@@ -6,18 +6,20 @@
   ("Attribute [ID] is not allowed").  Range: the attribute name.  Fix: remove it.
 * ``unknown-node``: a compact element name or explicit ``ID`` that is neither a built-in
   nor declared in a ``<TreeNodesModel>`` of the context ("Node not recognized").  An error
-  when a catalog of the custom nodes is configured (``ctx.workspace_has_custom_models``),
-  and then also for a type that only advisory models declare (a tree file's own
-  ``<TreeNodesModel>``, a palette: BehaviorTree.CPP registers from C++ alone); else a
-  warning when the type is one edit away from a known model (very likely a typo), and a
-  hint otherwise: nodes registered only in C++ are normal.  BehaviorTree.CPP 3 names
-  (``SequenceStar``, ``SubTreePlus``), the ``RetryUntilSuccesful`` typo and tree IDs used
-  as node types are errors in a document with ``BTCPP_format`` and warnings without; a
-  case-insensitive match of a built-in is an error; the version 3 built-ins
-  ``BlackboardCheck*`` follow the general rule (version 4 still ships the class for users
-  to register).  Range: the element name (compact) or the ``ID`` value (explicit).
-  Fixes: rename to the suggested type, call a tree with ``<SubTree>``, declare the node in
-  ``<TreeNodesModel>``.  Names that break the name rules are left to those.
+  when a catalog of the custom nodes is configured (``ctx.workspace_has_custom_models``)
+  or the C++ registrations are all known (``ctx.registered``: see
+  :mod:`bt_lsp.project.cpp_models`), and then also for a type that only advisory models
+  declare (a tree file's own ``<TreeNodesModel>``, a palette: BehaviorTree.CPP registers
+  from C++ alone); else a warning when the type is one edit away from a known model (very
+  likely a typo), and a hint otherwise: nodes registered only in C++ are
+  normal.  BehaviorTree.CPP 3 names (``SequenceStar``, ``SubTreePlus``), the
+  ``RetryUntilSuccesful`` typo and tree IDs used as node types are errors in a document
+  with ``BTCPP_format`` and warnings without; a case-insensitive match of a built-in is an
+  error; the version 3 built-ins ``BlackboardCheck*`` follow the general rule (version 4
+  still ships the class for users to register).  Range: the element name (compact) or the
+  ``ID`` value (explicit). Fixes: rename to the suggested type, call a tree with
+  ``<SubTree>``, declare the node in ``<TreeNodesModel>``.  Names that break the name rules
+  are left to those.
 * ``child-count`` (error): built-in child rules (decorators 1, controls 1 or more, leaves
   and ``<SubTree>`` 0, ``TryCatch`` 2 or more, ``IfThenElse``/``WhileDoElse`` 2 or 3,
   ``SwitchN`` N+1); for declared custom nodes the rule of their category.  Range: the
@@ -42,6 +44,7 @@ from typing import Final
 
 from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
 from bt_lsp.rules.codes import BT, FixData, Severity, define
+from bt_lsp.rules.context import Context
 from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
@@ -169,7 +172,7 @@ def check_node(st: State, el: Element) -> Resolved | None:
     if res is None:
         _unknown(st, el, type_id, start, end, name in EXPLICIT_TAGS)
         return None
-    if res.origin == "custom" and not res.authoritative and st.ctx.workspace_has_custom_models:
+    if res.origin == "custom" and not res.authoritative and _unregistered_here(st.ctx, res.id):
         _unregistered(st, type_id, start, end, name in EXPLICIT_TAGS)
         return None
     _children(st, el, res)
@@ -224,7 +227,7 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             "unknown-node",
             f"{quoted(type_id)} was a built-in node of BehaviorTree.CPP 3; version 4 does not "
             f"register it by default (register it in C++, or use {V3_ONLY[type_id]})",
-            None if ctx.workspace_has_custom_models else Severity.HINT,
+            None if _complete(ctx) else Severity.HINT,
             data,
         )
         return
@@ -251,8 +254,19 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             data,
         )
         return
+    if ctx.registered is not None and type_id in ctx.registered:
+        st.add(
+            start,
+            end,
+            "unknown-node",
+            f"Node type {quoted(type_id)} is registered in the project's C++, but its base "
+            "class is not among the sources read: its kind and ports are unknown",
+            Severity.HINT,
+            data,
+        )
+        return
     suggestion = _closest(st, type_id)
-    if ctx.workspace_has_custom_models:
+    if _complete(ctx):
         severity = None
     elif suggestion is not None and edit_distance(type_id, suggestion, 1) <= 1:
         severity = Severity.WARNING  # one typo away from a known model: very likely wrong
@@ -264,6 +278,17 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
         message = (
             f"Node type {quoted(type_id)} is not a built-in node and is not declared in any "
             "<TreeNodesModel> of the workspace"
+        )
+    elif ctx.registered is not None:
+        message = (
+            f"Node type {quoted(type_id)} is not registered: it is not a built-in node, and "
+            "the C++ of this package and of its dependencies registers no such node "
+            "(BehaviorTree.CPP fails with 'Node not recognized')"
+        )
+    elif ctx.incomplete:
+        message = (
+            f"Node type {quoted(type_id)} is not a built-in node and not registered in the "
+            f"C++ that was read; it may be registered where bt-lsp cannot see ({ctx.incomplete})"
         )
     else:
         message = (
@@ -281,16 +306,34 @@ def _unregistered(st: State, type_id: str, start: int, end: int, explicit: bool)
     fails with 'Node not recognized'."""
     decl = st.ctx.models.get(type_id)
     where = "this document" if decl is None or st.ctx.is_own(decl) else _base(decl.path)
+    catalog = (
+        "the node catalog"
+        if st.ctx.workspace_has_custom_models
+        else "the C++ of this package and of its dependencies"
+    )
     st.add(
         start,
         end,
         "unknown-node",
-        f"Node type {quoted(type_id)} is not in the node catalog; only the <TreeNodesModel> "
+        f"Node type {quoted(type_id)} is not in {catalog}; only the <TreeNodesModel> "
         f"of {where} declares it, and BehaviorTree.CPP registers nodes from C++ alone, so it "
         "fails with 'Node not recognized'",
         Severity.ERROR,
         UnknownNodeData(type_id, explicit),
     )
+
+
+def _complete(ctx: Context) -> bool:
+    """Whether every node the application registers is known: a catalog is named, or the
+    C++ of every package that can register nodes was read."""
+    return ctx.workspace_has_custom_models or ctx.registered is not None
+
+
+def _unregistered_here(ctx: Context, type_id: str) -> bool:
+    """Whether a type that only advisory models declare is known not to be registered."""
+    if ctx.workspace_has_custom_models:
+        return True
+    return ctx.registered is not None and type_id not in ctx.registered
 
 
 def _base(path: str | None) -> str:

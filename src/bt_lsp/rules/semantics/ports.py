@@ -285,6 +285,8 @@ def _owner(res: Resolved) -> str:
     if res.origin == "subtree":
         return f"The <SubTree> model of tree {quoted(res.id)}"
     if res.origin == "custom":
+        if res.where:  # learned from the C++
+            return f"The C++ node {quoted(res.id)} (registered in {res.where})"
         if res.authoritative:
             return f"The node catalog's model of {quoted(res.id)}"
         return f"The <TreeNodesModel> entry of {quoted(res.id)}"
@@ -316,7 +318,8 @@ def _check_port(
             s,
             e,
             "invalid-port-value",
-            f"The value of port {quoted(a.name)} cannot be converted to {port.type}: {problem}",
+            f"The value of port {quoted(a.name)} cannot be converted to {port.type}: {problem}"
+            + (f" (a port of {quoted(res.id)}, registered in {res.where})" if res.where else ""),
             None if res.exact else Severity.WARNING,
         )
 
@@ -334,7 +337,13 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         )
         st.add(s, e, "undeclared-port", message, Severity.WARNING)
         return
-    message = f"{_owner(res)} has no port {quoted(a.name)} (ports: {declared}){hint}"
+    if res.where:
+        message = (
+            f"{quoted(res.id)} declares no port {quoted(a.name)} (registered in {res.where}; "
+            f"ports{'' if res.exact else ' read'}: {declared}){hint}"
+        )
+    else:
+        message = f"{_owner(res)} has no port {quoted(a.name)} (ports: {declared}){hint}"
     if res.exact:
         message += (
             "; BehaviorTree.CPP refuses to create the tree: the attribute is not in the "
@@ -342,7 +351,12 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         )
         st.add(s, e, "undeclared-port", message)
     else:
-        message += "; BehaviorTree.CPP rejects it unless the C++ node declares it"
+        message += (
+            "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
+            "could not all be read statically)"
+            if res.where
+            else "; BehaviorTree.CPP rejects it unless the C++ node declares it"
+        )
         st.add(s, e, "undeclared-port", message, Severity.WARNING)
 
 

@@ -128,6 +128,8 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
     settings = (
         ctx.path,
         ctx.workspace_has_custom_models,
+        ctx.registered,
+        ctx.incomplete,
         tuple(sorted(ctx.ros_pkg_paths.items())),
         ctx.included_by,
         ctx.included,

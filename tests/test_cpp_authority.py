@@ -1,0 +1,178 @@
+"""Authority of the nodes learned from C++, and when their registrations are all known.
+
+``tests/data/cpp_app``: ``robot_app`` creates the factory and registers its nodes, and
+every dependency that could register more is visible, so a node type it lacks is an error
+(BehaviorTree.CPP fails with "Node not recognized"); ``robot_ext`` also depends on a
+package that is nowhere to be found, so the same types are hints or warnings.  A node whose
+port list could not be read completely stays advisory in both.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from bt_lsp.cli.main import main
+from bt_lsp.project.cpp_models import CppModels
+from bt_lsp.project.cpp_scan import Scanner
+
+WS = Path(__file__).parent / "data" / "cpp_app"
+APP = WS / "src" / "robot_app"
+EXT = WS / "src" / "robot_ext"
+
+Finding = tuple[str, str, str]  # severity, code, message
+
+
+@pytest.fixture(autouse=True)
+def _cache(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+
+
+def _check(capsys: pytest.CaptureFixture[str], ws: Path, name: str) -> dict[int, Finding]:
+    main(["check", str(ws)])
+    out: dict[int, Finding] = {}
+    for line in capsys.readouterr().out.splitlines():
+        m = re.match(r"(.*?):(\d+):\d+: (\w+) ([\w-]+) (.*)", line)
+        if m and m.group(1).endswith(name):
+            out[int(m.group(2))] = (m.group(3), m.group(4), m.group(5))
+    return out
+
+
+def test_complete_registrations_make_unknown_nodes_errors(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    found = _check(capsys, WS, "app.xml")
+    # <Dock station="A" speed="1.0"/>: BehaviorTree.CPP 4 throws at createTree.
+    assert found[4] == (
+        "error",
+        "undeclared-port",
+        "'Dock' declares no port 'speed' (registered in src/robot_app/src/main.cpp:21; ports: "
+        "station, timeout); BehaviorTree.CPP refuses to create the tree: the attribute is not "
+        "in the node's providedPorts()",
+    )
+    assert found[5][:2] == ("error", "invalid-port-value")
+    assert "(a port of 'Dock', registered in src/robot_app/src/main.cpp:21)" in found[5][2]
+    # A typo gets "did you mean" from the real catalog, and is an error.
+    assert found[6][:2] == ("error", "unknown-node")
+    assert "did you mean 'Charge'?" in found[6][2]
+    assert 7 not in found  # <Charge until_percent="80"/>, registered by robot_lib
+    # <Scan range="5"/>: Scan's port list is built by code: advisory.
+    assert found[8][:2] == ("warning", "undeclared-port")
+    assert "ports read: none" in found[8][2]
+    # Only the tree file's own <TreeNodesModel> declares Ghost: not registered.
+    assert found[9][:2] == ("error", "unknown-node")
+    assert "not in the C++ of this package and of its dependencies" in found[9][2]
+    assert found[10] == (
+        "error",
+        "unknown-node",
+        "Node type 'Teleport' is not registered: it is not a built-in node, and the C++ of "
+        "this package and of its dependencies registers no such node (BehaviorTree.CPP fails "
+        "with 'Node not recognized')",
+    )
+
+
+def test_a_dependency_not_visible_keeps_unknown_nodes_advisory(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    found = _check(capsys, WS, "ext.xml")
+    assert found[4][:2] == ("error", "undeclared-port")  # Dock itself is read completely
+    # One typo away from a known C++ node: a warning; anything else a hint.
+    assert found[6][:2] == ("warning", "unknown-node")
+    assert "did you mean 'Charge'?" in found[6][2]
+    assert found[10][0] == "hint"
+    assert "(dependency vendor_nodes of robot_ext is not found)" in found[10][2]
+    assert 9 not in found  # Ghost may be one of vendor_nodes' nodes
+
+
+def _ws(tmp_path: Path, main_cpp: str, depends: str = "") -> Path:
+    pkg = tmp_path / "ws" / "src" / "app"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        "<package><name>app</name><depend>behaviortree_cpp</depend>"
+        f"<depend>geometry_msgs</depend><exec_depend>ament_index_cpp</exec_depend>{depends}"
+        "</package>"
+    )
+    (pkg / "src" / "main.cpp").write_text(
+        "struct A : BT::SyncActionNode { static BT::PortsList providedPorts() { return {}; } };\n"
+        + main_cpp
+    )
+    return pkg / "t.xml"
+
+
+def _completeness(tree: Path, resolve=None):  # type: ignore[no-untyped-def]
+    models = CppModels([tree.parents[2]], scanner=Scanner(None))
+    files = models.files_for(tree)
+    return models.completeness(tree, files, models.catalog(files), resolve)
+
+
+FACTORY = 'int main() { BT::BehaviorTreeFactory f; f.registerNodeType<A>("A"); }\n'
+
+
+def test_what_makes_the_registrations_all_known(tmp_path: Path) -> None:
+    assert _completeness(_ws(tmp_path / "1", FACTORY)).complete
+    # A plugin without the application: the trees run where bt-lsp does not look.
+    plugin_cpp = 'BT_REGISTER_NODES(f) { f.registerNodeType<A>("A"); }'
+    plugin = _completeness(_ws(tmp_path / "2", plugin_cpp))
+    assert not plugin.complete and "creates a BehaviorTreeFactory" in plugin.why
+    loads = 'void g() { f.registerFromPlugin("x.so"); }'
+    dynamic = _completeness(_ws(tmp_path / "3", FACTORY + loads))
+    assert not dynamic.complete and "loads node plugins chosen at run time" in dynamic.why
+    helper = _completeness(
+        _ws(
+            tmp_path / "4",
+            FACTORY + "template <class T> void reg(BT::BehaviorTreeFactory& f, const char* name)"
+            " { f.registerNodeType<T>(name); }",
+        )
+    )
+    assert not helper.complete and "is not known statically" in helper.why
+
+
+def test_dependencies_outside_the_workspace(tmp_path: Path) -> None:
+    from bt_lsp.project.packages import Manifest
+
+    tree = _ws(tmp_path, FACTORY, "<depend>nav_plugins</depend><depend>utils</depend>")
+    none: tuple[Path, ...] = ()
+    found = {
+        "utils": (Manifest("utils", tmp_path, frozenset({"rclcpp"})), none),
+        "nav_plugins": (Manifest("nav_plugins", tmp_path, frozenset({"behaviortree_cpp"})), none),
+    }
+    missing = _completeness(tree)
+    assert not missing.complete and "nav_plugins" in missing.why
+    no_catalog = _completeness(tree, lambda name: found[name])
+    assert not no_catalog.complete
+    assert "nav_plugins of app depends on BehaviorTree.CPP" in no_catalog.why
+    catalog = tmp_path / "nav_plugins.xml"
+    found["nav_plugins"] = (found["nav_plugins"][0], (catalog,))
+    shipped = _completeness(tree, lambda name: found[name])
+    assert shipped.complete and shipped.shipped == {str(catalog)}
+
+
+def test_an_installed_dependency_counts_through_its_shipped_catalog(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _ws(tmp_path, FACTORY, "<depend>nav_plugins</depend>")
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Spin spin_dist="1.57"/>\n<A/>\n<Teleport/>\n'
+        "</Sequence></BehaviorTree></root>\n"
+    )
+    share = tmp_path / "install" / "share" / "nav_plugins"
+    share.mkdir(parents=True)
+    (share / "package.xml").write_text(
+        "<package><name>nav_plugins</name><depend>behaviortree_cpp</depend></package>"
+    )
+    (share / "nav_plugins.xml").write_text(
+        '<root BTCPP_format="4"><TreeNodesModel><Action ID="Spin">'
+        '<input_port name="spin_dist" type="double"/></Action></TreeNodesModel></root>'
+    )
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "install"))
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert 2 not in found and 3 not in found  # Spin from the catalog, A from the C++
+    assert found[4][:2] == ("error", "unknown-node")
+    # Without the installed package, its nodes may be anything: not an error.
+    monkeypatch.delenv("AMENT_PREFIX_PATH")
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert found[4][0] == "hint" and "nav_plugins of app is not found" in found[4][2]
