@@ -112,3 +112,28 @@ def test_a_bad_call_of_a_tree_defined_elsewhere_says_why_there_is_no_fix() -> No
         "there); rename it where it is defined first, then this reference."
     )
     assert "Suggested replacement" not in text
+
+
+def test_a_node_learned_from_cpp_says_where_relative_with_a_link() -> None:
+    from dataclasses import replace
+    from types import MappingProxyType
+
+    from bt_lsp.rules.context import ModelDecl
+
+    text = '<root BTCPP_format="4"><BehaviorTree ID="T"><Dock/></BehaviorTree></root>\n'
+    doc = Document(text, "/ws/trees/a.xml")
+    decl = ModelDecl(
+        "Dock", "Action", (), "/ws/src/app/src/main.cpp", 0, 6, "cpp", "src/app/src/main.cpp:21"
+    )
+    ctx = replace(Context.from_document(doc), models=MappingProxyType({"Dock": decl}))
+    at = text.index("Dock") + 1
+    md = hover_at(doc, at, ctx, markdown=True)
+    assert md is not None
+    assert (
+        "Action registered in [src/app/src/main.cpp:21](file:///ws/src/app/src/main.cpp#L21)."
+        in md.text
+    )
+    plain = hover_at(doc, at, ctx, markdown=False)
+    assert plain is not None
+    assert "Action registered in src/app/src/main.cpp:21." in plain.text
+    assert "/ws/src" not in plain.text

@@ -105,7 +105,11 @@ async def test_hover_shows_the_cpp_declaration(cpp_client: BtClient) -> None:
     hover = await cpp_client.hover(uri, _pos(MAIN, "DriveTo", 'DriveTo target="dock"'))
     assert hover is not None and isinstance(hover.contents, types.MarkupContent)
     text = hover.contents.value
-    assert "Action registered in src/robot_nodes/src/register.cpp:6" in text
+    # Relative to the workspace folder, a link to the line for a Markdown client.
+    link = f"[src/robot_nodes/src/register.cpp:6]({REGISTER.as_uri()}#L6)"
+    assert f"Action registered in {link}." in text
+    assert f"C++: Action registered in {link} (class" in text
+    assert str(WS) not in text.replace(WS.as_uri(), "")  # no absolute path shown as text
     assert "robot_nodes::DriveTo" in text and "nodes.hpp:6" in text
     assert "max_speed" in text  # the port inherited from robot_base's providedBasicPorts
     port = await cpp_client.hover(uri, _pos(MAIN, "target", 'DriveTo target="dock"'))

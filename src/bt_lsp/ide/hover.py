@@ -7,9 +7,11 @@ no tables), and narrow either way: lists rather than wide tables, which a hover 
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
 from bt_lsp.ide.name_edits import elsewhere, occurrences
@@ -46,6 +48,17 @@ def _visible(text: str) -> str:
 _INLINE_CODE_RE = re.compile(r"`+ ?([^`]*?) ?`+")
 
 
+def file_link(shown: str, path: str | None) -> str:
+    """A Markdown link to ``path`` at the line ``shown`` ends with (``…:42``), which
+    VS Code and other clients open at that line (``file:///…#L42``)."""
+    if path is None or not os.path.isabs(path):
+        return shown
+    line = shown.rpartition(":")[2]
+    anchor = f"#L{line}" if line.isdigit() else ""
+    label = shown.replace("[", "\\[").replace("]", "\\]")
+    return f"[{label}]({Path(path).as_uri()}{anchor})"
+
+
 class _Writer:
     """Markup for one hover: inline code and a title in Markdown, quotes in plain text."""
 
@@ -67,6 +80,11 @@ class _Writer:
         if self.markdown:
             return text
         return _INLINE_CODE_RE.sub(r"'\1'", text).replace("**", "")
+
+    def link(self, shown: str, path: str | None) -> str:
+        """``shown`` (``src/nodes.cpp:42``) as a link to that line of the file at ``path``
+        in Markdown, as it is in plain text."""
+        return file_link(shown, path) if self.markdown else shown
 
     def title(self, text: str) -> None:
         self.lines.append(f"**{text}**" if self.markdown else text)
@@ -134,11 +152,12 @@ def _node_info(w: _Writer, ref: NameRef, ctx: Context | None) -> None:
     if decl is None:
         return
     where = "this document" if ctx.is_own(decl) else (decl.path or "another document")
-    w.para(
-        f"{decl.category} registered in the C++ of {where}."
-        if where.endswith(_CPP_SUFFIXES)  # learned from C++ (the server says where)
-        else f"{decl.category} declared in the TreeNodesModel of {where}."
-    )
+    if decl.where:  # learned from C++: where, relative to the workspace folder
+        w.para(f"{decl.category} registered in {w.link(decl.where, decl.path)}.")
+    elif where.endswith(_CPP_SUFFIXES):
+        w.para(f"{decl.category} registered in the C++ of {where}.")
+    else:
+        w.para(f"{decl.category} declared in the TreeNodesModel of {where}.")
     w.para(f"Model from {source_label(decl.source)}.")
     _ports(w, decl.ports)
 

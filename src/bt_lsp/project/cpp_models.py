@@ -319,6 +319,8 @@ class CppModels:
         if cat is None:
             return ctx
         known = self.completeness(path, files, cat, resolve)
+        if not cat.nodes and not known.complete:
+            return ctx  # no C++ nodes: the messages need not say what was not read
         decls = self.decls(cat)
         merged = dict(ctx.models)
         for id_, d in decls.items():

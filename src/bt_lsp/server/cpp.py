@@ -24,6 +24,7 @@ from pygls.uris import from_fs_path
 
 from bt_lsp.cpp.catalog import Catalog, CppNode, CppPort
 from bt_lsp.cpp.facts import Span
+from bt_lsp.ide.hover import file_link
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
@@ -203,18 +204,16 @@ class CppService:
                 return (node, port) if port is not None else None
         return None
 
-    def _where(self, path: str, span: Span) -> str:
-        shown = path
-        for root in self.ls.project.roots:
-            try:
-                shown = os.path.relpath(path, root)
-                break
-            except ValueError:
-                continue
-        return f"{shown}:{span[0] + 1}"
+    def _where(self, path: str, span: Span, markdown: bool = True) -> str:
+        """``path`` relative to the workspace folder, with the line: a link to it in
+        Markdown."""
+        shown = self.models.shown(Path(path)) if self.models is not None else path
+        shown = f"{shown}:{span[0] + 1}"
+        return file_link(shown, path) if markdown else shown
 
-    def hover_markdown(self, od: OpenDocument, offset: int) -> str | None:
-        """What the C++ says of the node or port at ``offset``: kind, class, where."""
+    def hover_markdown(self, od: OpenDocument, offset: int, markdown: bool = True) -> str | None:
+        """What the C++ says of the node or port at ``offset``: kind, class, where (linked
+        when ``markdown``)."""
         found = self.lookup(od, offset)
         if found is None:
             return None
@@ -227,7 +226,7 @@ class CppService:
                 default += " (an expression, evaluated at run time)"
             lines.append(
                 f"C++: {p.direction} port `{p.name}` of `{node.id}`, type `{p.type}`, "
-                f"{default}; declared in {self._where(p.path, p.span)}."
+                f"{default}; declared in {self._where(p.path, p.span, markdown)}."
             )
             if p.description:
                 lines += ["", p.description]
@@ -235,10 +234,10 @@ class CppService:
         kind = node.kind or "node of unknown kind"
         cls = f" (class `{node.cls}`" if node.cls else ""
         if node.cls and node.class_path is not None and node.class_span is not None:
-            cls += f", declared in {self._where(node.class_path, node.class_span)}"
+            cls += f", declared in {self._where(node.class_path, node.class_span, markdown)}"
         cls += ")" if node.cls else ""
         lines.append(
-            f"C++: {kind} registered in {self._where(node.path, node.id_span)}{cls} "
+            f"C++: {kind} registered in {self._where(node.path, node.id_span, markdown)}{cls} "
             f"with `{node.form}`."
         )
         if node.authoritative:

@@ -48,7 +48,7 @@ def register(server: BtServer) -> None:
             found = root_hover(od.doc, offset, detected.version, detected.source, markdown)
         if found is None:
             return None
-        learned = ls.cpp.hover_markdown(od, offset)  # where the C++ declares it
+        learned = ls.cpp.hover_markdown(od, offset, found.markdown)  # where the C++ declares it
         text = found.text
         if learned is not None:
             if not found.markdown:
