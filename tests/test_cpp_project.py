@@ -100,3 +100,26 @@ def test_a_changed_cpp_file_is_read_again(tmp_path: Path) -> None:
     assert sc.parsed == 2
     models.set_open(cpp, cpp.read_text().replace('"B"', '"C"'))
     assert {n.id for n in models.catalog_for(tree).nodes} == {"C"}
+
+
+def test_check_shows_the_cpp_scan_on_a_terminal(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import json
+    import sys
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    main(["check", "--format", "json", str(WS)])
+    captured = capsys.readouterr()
+    # robot_nodes' trees read three files that may declare nodes (the others lazily).
+    for i in (1, 2, 3):
+        assert f"\rreading C++: {i}/3 files" in captured.err
+    assert "reading C++" not in captured.out
+    json.loads(captured.out)  # the report itself is untouched
+    # Cleared like the files' bar: nothing of it is left on the last line.
+    assert captured.err.rpartition("\r")[2] == ""
+
+
+def test_no_cpp_progress_off_a_terminal(capsys: pytest.CaptureFixture[str]) -> None:
+    main(["check", str(WS)])
+    assert "reading C++" not in capsys.readouterr().err

@@ -243,7 +243,12 @@ class Progress:
         shown_path = visible(path)
         if len(shown_path) > room:
             shown_path = "..." + shown_path[-max(room - 3, 0) :] if room > 3 else ""
-        line += shown_path
+        self.line(line + shown_path)
+
+    def line(self, line: str) -> None:
+        """Draw ``line`` in place of the last one (the C++ scan's ``reading C++: 3/40``)."""
+        if not self.enabled:
+            return
         pad = " " * max(self._shown - len(line), 0)
         write(self.stream, f"\r{line}{pad}")
         self.stream.flush()
@@ -282,6 +287,11 @@ def run(
     if options.cpp:
         files += [str(f) for p in paths if os.path.isdir(p) for f in find_cpp_files([p])]
     progress = Progress(err, len(files), options.progress and len(files) > 1 and _isatty(err))
+    if project.cpp is not None and progress.enabled:
+        # The C++ is read when the first file of a package needs it: say so meanwhile.
+        project.cpp.progress = lambda done, total: progress.line(
+            f"reading C++: {done}/{total} files"
+        )
 
     def say(stream: TextIO, text: str) -> None:
         progress.clear()
