@@ -281,6 +281,7 @@ def measure(tree: Tree, cache: Path) -> dict[str, float]:
     # As the server keeps it: the files' bytes kept by modification time and size, and a
     # change reported for one file (watched files, or an open document's edit).
     models = CppModels([tree.root], scanner=Scanner(cache))
+    models.watched = True  # the editor reports every change (watched files)
     scope = tuple(files)
     models.catalog(scope)
     text = tree.changed.read_text()

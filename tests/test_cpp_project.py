@@ -123,3 +123,52 @@ def test_check_shows_the_cpp_scan_on_a_terminal(
 def test_no_cpp_progress_off_a_terminal(capsys: pytest.CaptureFixture[str]) -> None:
     main(["check", str(WS)])
     assert "reading C++" not in capsys.readouterr().err
+
+
+def _copy_ws(tmp_path: Path) -> Path:
+    import shutil
+
+    ws = tmp_path / "ws"
+    shutil.copytree(WS, ws)
+    return ws
+
+
+def test_a_change_links_again_only_the_nodes_it_touches(tmp_path: Path) -> None:
+    from bt_lsp.cpp.catalog import link
+    from bt_lsp.cpp.library import library_facts
+
+    ws = _copy_ws(tmp_path)
+    tree = ws / "src" / "robot_nodes" / "trees" / "main.xml"
+    models = CppModels([ws], scanner=Scanner(None))
+    first = models.catalog_for(tree)
+    assert models.scanner.memo.made == 2  # DriveTo, BatteryOk
+    # A port added to the base class of DriveTo (another package): DriveTo alone again.
+    base = ws / "src" / "robot_base" / "include" / "robot_base" / "motion.hpp"
+    base.write_text(
+        base.read_text().replace(
+            'BT::InputPort<double>("max_speed", 0.5, "Speed limit in m/s")',
+            'BT::InputPort<double>("max_speed", 0.5, "Speed limit in m/s"), '
+            'BT::InputPort<bool>("reverse", false, "Drive backwards")',
+        )
+    )
+    models.file_changed(base)
+    again = models.catalog_for(tree)
+    assert models.scanner.memo.made == 1
+    assert [p.name for p in again.by_id["DriveTo"].ports] == [
+        "max_speed",
+        "reverse",
+        "target",
+        "distance",
+    ]
+    assert again.by_id["BatteryOk"] is first.by_id["BatteryOk"]  # kept as it was
+    # A line added above the registrations moves both of them: both made again.
+    reg = ws / "src" / "robot_nodes" / "src" / "register.cpp"
+    reg.write_text("// moved\n" + reg.read_text())
+    models.file_changed(reg)
+    moved = models.catalog_for(tree)
+    assert models.scanner.memo.made == 2
+    assert moved.by_id["DriveTo"].id_span[0] == first.by_id["DriveTo"].id_span[0] + 1
+    # Whatever was kept, the catalog is the one a fresh link makes.
+    sc = models.scanner
+    facts = sorted((str(f), sc.facts(str(f), f.read_bytes())) for f in models.files_for(tree))
+    assert link(facts, library_facts()) == moved

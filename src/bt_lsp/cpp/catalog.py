@@ -159,22 +159,71 @@ class _Ports:
         self.missing.extend(other.missing)
 
 
+class LinkMemo:
+    """What the last link made of each registration, to link again only what a change
+    touches: a node is made again when its registration changed or when a changed file
+    defines (or defined) a name its making looked up (a class, a ``providedPorts``
+    function, a constant, a macro); any other is kept as it was."""
+
+    def __init__(self) -> None:
+        self.facts: dict[str, FileFacts] = {}
+        # (path, index of the registration) -> (registration, ID, node, names, missing)
+        self.nodes: dict[tuple[str, int], _Made] = {}
+        self.made = 0  # nodes made (not kept) by the last link, for tests and benchmarks
+
+
+class _Made(NamedTuple):
+    reg: Registration
+    id: str
+    node: CppNode
+    names: frozenset[str]
+    missing: frozenset[str]
+
+
+def _defined(f: FileFacts) -> set[str]:
+    """The names a file defines, as :class:`_Linker` notes its lookups."""
+    out = {"c:" + c.name for c in f.classes}
+    out.update(f"f:{last_name(fn.owner)}::{fn.name}" for fn in f.fns)
+    out.update("k:" + k for k in f.constants)
+    out.update("m:" + m.name for m in f.macros)
+    return out
+
+
 def link(
-    files: Iterable[tuple[str, FileFacts]], library: Iterable[tuple[str, FileFacts]] = ()
+    files: Iterable[tuple[str, FileFacts]],
+    library: Iterable[tuple[str, FileFacts]] = (),
+    memo: LinkMemo | None = None,
 ) -> Catalog:
     """The catalog of the nodes registered in ``files``.
 
     ``library`` files (known bases of libraries that are not in the sources) resolve
-    classes after the project's own and never register anything.
+    classes after the project's own and never register anything.  With a ``memo`` of
+    the last link, the nodes no change touches are kept (and the memo is updated).
     """
-    return _Linker(list(files), list(library)).run()
+    return _Linker(list(files), list(library), memo).run()
 
 
 class _Linker:
     def __init__(
-        self, files: list[tuple[str, FileFacts]], library: list[tuple[str, FileFacts]]
+        self,
+        files: list[tuple[str, FileFacts]],
+        library: list[tuple[str, FileFacts]],
+        memo: LinkMemo | None = None,
     ) -> None:
         self.files = files
+        self.memo = memo
+        # The names the node being made looked up, and those it found missing.
+        self._names: set[str] = set()
+        self._missing: set[str] = set()
+        self._stale: set[str] = set()  # names that changed files define or defined
+        if memo is not None:
+            now = dict(files)
+            for path in now.keys() | memo.facts.keys():
+                old, new = memo.facts.get(path), now.get(path)
+                if old is not new:
+                    for f in (old, new):
+                        if f is not None:
+                            self._stale.update(_defined(f))
         self.classes: dict[str, list[_Class]] = {}
         self.fns: dict[tuple[str, str], list[tuple[str, PortsFn]]] = {}
         self.file_constants: dict[str, dict[str, str]] = {}
@@ -183,7 +232,9 @@ class _Linker:
         # Class and constant names looked up and not found: the project layer reads the
         # files that may define them (lazily: most files declare no node) and links again.
         self.missing: set[str] = set()
-        self._resolved: dict[tuple[str, int, str], _Resolved] = {}
+        self._resolved: dict[
+            tuple[str, int, str], tuple[_Class | _Lib | None, dict[str, str], frozenset[str]]
+        ] = {}
         for path, f in [*files, *library]:
             for c in f.classes:
                 self.classes.setdefault(c.name, []).append(_Class(path, c))
@@ -202,13 +253,16 @@ class _Linker:
         nodes: list[CppNode] = []
         unresolved: list[Unresolved] = []
         by_id: dict[str, CppNode] = {}
+        made: dict[tuple[str, int], _Made] = {}
+        if self.memo is not None:
+            self.memo.made = 0
         for path, f in self.files:
-            for reg in self._registrations(f):
+            for i, reg in enumerate(self._registrations(f)):
                 id_ = reg.id if reg.id is not None else self._constant(reg.id_ref or "", None, path)
                 if id_ is None:
                     unresolved.append(Unresolved(path, reg.id_span, reg.form, reg.id_ref or ""))
                     continue
-                node = self._node(path, reg, id_)
+                node = self._kept_or_made(path, i, reg, id_, made)
                 first = by_id.get(id_)
                 if first is not None:
                     note = f"ID {id_!r} is also registered at {_where(first.path, first.id_span)}"
@@ -222,12 +276,39 @@ class _Linker:
                 else:
                     by_id[id_] = node
                 nodes.append(node)
+        if self.memo is not None:
+            self.memo.facts = dict(self.files)
+            self.memo.nodes = made
         return Catalog(tuple(nodes), tuple(unresolved), by_id, frozenset(self.missing))
+
+    def _kept_or_made(
+        self, path: str, i: int, reg: Registration, id_: str, made: dict[tuple[str, int], _Made]
+    ) -> CppNode:
+        """The node of a registration: the last link's when nothing it rests on changed."""
+        if self.memo is None:
+            return self._node(path, reg, id_)
+        last = self.memo.nodes.get((path, i))
+        if last is not None and last.id == id_ and last.reg == reg and not last.names & self._stale:
+            self.missing.update(last.missing)
+            made[path, i] = last
+            return last.node
+        self._names, self._missing = set(), set()
+        node = self._node(path, reg, id_)
+        made[path, i] = _Made(reg, id_, node, frozenset(self._names), frozenset(self._missing))
+        self.memo.made += 1
+        return node
+
+    def _note(self, name: str) -> None:
+        self._names.add(name)
+
+    def _miss(self, name: str) -> None:
+        self.missing.add(name)
+        self._missing.add(name)
 
     def _registrations(self, f: FileFacts) -> list[Registration]:
         regs = list(f.registrations)
         for call in f.macro_calls:
-            m = self.macros.get(call.name)
+            m = self.macros.get(call.name)  # a change of it changes the registration
             if m is None or len(call.args) != len(m.params) or m.cls_param >= len(call.args):
                 continue
             cls = call.args[m.cls_param]
@@ -304,7 +385,12 @@ class _Linker:
         key = (ref, id(ctx.facts) if ctx is not None else 0, path)
         hit = self._resolved.get(key)
         if hit is None:
-            hit = self._resolved[key] = self._resolve_uncached(ref, ctx, path, depth)
+            outer = self._names
+            self._names = set()
+            found = self._resolve_uncached(ref, ctx, path, depth)
+            hit = self._resolved[key] = (found[0], found[1], frozenset(self._names))
+            self._names = outer
+        self._names.update(hit[2])  # what resolving it looked up, for the memo
         return hit[0], dict(hit[1])
 
     def _resolve_uncached(self, ref: str, ctx: _Class | None, path: str, depth: int) -> _Resolved:
@@ -316,11 +402,12 @@ class _Linker:
             if alias is not None and alias != ref:
                 return self._resolve(alias, None, path, depth + 1)
         last = last_name(base)
+        self._note("c:" + last)
         cands = self.classes.get(last, [])
         if last in LIBRARY_KINDS:  # BehaviorTree.CPP's own bases end every lineage
             return _Lib(LIBRARY_KINDS[last]), {}
         if not cands:
-            self.missing.add(last)
+            self._miss(last)
             return None, {}
         chosen = self._choose(cands, base, ctx, path)
         args = _args_of_last(ref)
@@ -373,6 +460,7 @@ class _Linker:
         return None, why
 
     def _fn(self, cls: _Class, name: str) -> tuple[str, PortsFn] | None:
+        self._note(f"f:{cls.facts.name}::{name}")
         found = self.fns.get((cls.facts.name, name), [])
         q = cls.facts.qualname
         for path, fn in found:
@@ -503,6 +591,7 @@ class _Linker:
             target, _ = self._resolve(scope, cls, path)
             if isinstance(target, _Class) and name in target.facts.constants:
                 return target.facts.constants[name]
+            self._note("k:" + name)
             return self.constants.get(name)
         seen = 0
         cur: _Class | None = cls
@@ -517,11 +606,12 @@ class _Linker:
                     break
             cur = nxt
             seen += 1
+        self._note("k:" + ref)
         own = self.file_constants.get(path, {})
         if ref in own:
             return own[ref]
         if ref not in self.constants:
-            self.missing.add(ref)
+            self._miss(ref)
         return self.constants.get(ref)
 
 

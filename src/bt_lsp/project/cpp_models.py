@@ -129,6 +129,9 @@ class CppModels:
         self.on_missing: Callable[[Path], None] | None = None
         # Called while a catalog is read in "sync" mode (the command line's progress line).
         self.progress: Progress | None = None
+        # True when every change of a file is reported (the editor watches them): a file
+        # read once is not looked at again until :meth:`file_changed`.
+        self.watched = False
         self._complete: dict[tuple[Path, tuple[Path, ...]], tuple[int, Completeness]] = {}
 
     # --- which files ---------------------------------------------------------------------
@@ -219,6 +222,10 @@ class CppModels:
             over = self._overlay.get(path)
             if over is not None:
                 return over
+            if self.watched:
+                kept = self._bytes.get(path)
+                if kept is not None:
+                    return kept[1]
             try:
                 st = path.stat()
             except (OSError, ValueError):

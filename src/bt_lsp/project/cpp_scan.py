@@ -25,7 +25,7 @@ from typing import Final
 import tree_sitter
 
 from bt_lsp import __version__
-from bt_lsp.cpp.catalog import Catalog, link
+from bt_lsp.cpp.catalog import Catalog, LinkMemo, link
 from bt_lsp.cpp.extract import extract, may_declare_nodes, parser
 from bt_lsp.cpp.facts import FileFacts, from_json, to_json
 from bt_lsp.cpp.library import library_facts
@@ -84,6 +84,11 @@ class Scanner:
     parsed: int = 0  # files parsed (not found in memory or on disk), for benchmarks and tests
     # The last catalog linked and what it was linked from (facts and bytes, by identity).
     _linked: tuple[object, Catalog] | None = field(default=None, repr=False)
+    # What the last link made of each registration (linked again only where a change
+    # touches it), and the files it read lazily (read again first, so that the link
+    # sees the same files and keeps what it can).
+    memo: LinkMemo = field(default_factory=LinkMemo, repr=False)
+    _lazy: set[str] = field(default_factory=set, repr=False)
 
     def facts(self, path: str, data: bytes) -> FileFacts:
         """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse.
@@ -209,7 +214,12 @@ def _link_lazily(
     sc: Scanner, texts: dict[str, bytes], read_facts: dict[str, FileFacts], rest: list[str]
 ) -> Catalog:
     """Link, then read the other files that name what the catalog misses, and again."""
-    catalog = link(sorted(read_facts.items()), library_facts())
+    eager = set(read_facts)
+    again = [p for p in rest if p in sc._lazy]
+    for p in again:
+        read_facts[p] = sc.facts(p, texts[p])
+    rest = [p for p in rest if p not in sc._lazy]
+    catalog = link(sorted(read_facts.items()), library_facts(), sc.memo)
     for _ in range(_LAZY_ROUNDS):
         names = set(catalog.missing)
         names.update(m.name for f in read_facts.values() for m in f.macros)
@@ -225,5 +235,6 @@ def _link_lazily(
             read_facts[p] = sc.facts(p, texts[p])
         more_set = set(more)
         rest = [p for p in rest if p not in more_set]
-        catalog = link(sorted(read_facts.items()), library_facts())
+        catalog = link(sorted(read_facts.items()), library_facts(), sc.memo)
+    sc._lazy = {p for p in read_facts if p not in eager}
     return catalog

@@ -427,6 +427,8 @@ def create_server() -> BtServer:
                 )
             except Exception:
                 ls.log_error("registering for watched-file changes")
+                if ls.project.cpp is not None:
+                    ls.project.cpp.watched = False  # changes on disk are not reported
         if ls.configuration_support:
             await ls.fetch_settings()
             ls.settings_changed()

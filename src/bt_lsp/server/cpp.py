@@ -65,6 +65,9 @@ class CppService:
         self.progress_support = bool(window and window.work_done_progress)
         models = CppModels(self.ls.project.roots, self.ls.project.packages)
         models.mode = "background"
+        ws = params.capabilities.workspace
+        watch = ws.did_change_watched_files if ws is not None else None
+        models.watched = bool(watch and watch.dynamic_registration)  # changes are reported
         models.on_missing = self.request
         self.ls.project.cpp = models
         self.models = models
