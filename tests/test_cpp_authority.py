@@ -176,3 +176,12 @@ def test_an_installed_dependency_counts_through_its_shipped_catalog(
     monkeypatch.delenv("AMENT_PREFIX_PATH")
     found = _check(capsys, tree.parents[2], "t.xml")
     assert found[4][0] == "hint" and "nav_plugins of app is not found" in found[4][2]
+
+
+def test_a_registering_macro_not_read_leaves_the_registrations_unknown(tmp_path: Path) -> None:
+    read = "#define REG(T) f.registerNodeType<T>(#T);\n"
+    assert _completeness(_ws(tmp_path / "1", read + FACTORY)).complete
+    composed = "#define REG_NS(ns, Name) \\\n  f.registerNodeType<ns::Name>(#Name);\n"
+    found = _completeness(_ws(tmp_path / "2", composed + FACTORY))
+    assert not found.complete
+    assert found.why == "macro REG_NS of src/app/src/main.cpp registers nodes in a form not read"

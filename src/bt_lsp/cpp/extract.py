@@ -74,12 +74,30 @@ _CONST_STRING: Final = re.compile(rb"\b(?:const|constexpr)\b[^;{}\n]*?(\")")
 _CLASS_TYPES: Final = frozenset({"class_specifier", "struct_specifier"})
 
 # Invocations of macros that may register nodes (ALL_CAPS names, or names that say so),
-# with one or two arguments: a type and maybe a string.  Found in the text, because a
-# macro invoked without a trailing semicolon parses as anything.
+# with one to four arguments: a type, then strings or names (an ID, constructor
+# arguments such as ``params``; more than two but for logging and test macros).  Found
+# in the text, because a macro invoked without a trailing semicolon parses as anything.
+# The macros of logging and test libraries, which take several arguments and register
+# nothing (most ALL_CAPS calls with more than two arguments in real code).
+_NOT_REGISTRARS: Final = (
+    "RCLCPP_",
+    "RCUTILS_",
+    "ROS_",
+    "RMW_",
+    "EXPECT_",
+    "ASSERT_",
+    "SPDLOG_",
+    "LOG_",
+    "BOOST_",
+    "TEST",
+    "INSTANTIATE_",
+    "PLUGINLIB_",
+    "CLASS_LOADER_",
+)
+_MACRO_ARG: Final = rb"(?:,[ \t\r\n]*(\"(?:[^\"\\\n]|\\.)*\"|[A-Za-z0-9_][\w:.]*))?[ \t\r\n]*"
 _MACRO_CALL: Final = re.compile(
     rb"\b([A-Z][A-Z0-9_]{2,}|\w*(?:[Rr]egist|Plugin)\w*)[ \t]*\([ \t\r\n]*"
-    rb"([A-Za-z_][\w:]*(?:<[^()<>;\n]*>)?)[ \t]*"
-    rb"(?:,[ \t\r\n]*(\"(?:[^\"\\\n]|\\.)*\"|[A-Za-z_][\w:]*))?[ \t\r\n]*\)"
+    rb"([A-Za-z_][\w:]*(?:<[^()<>;\n]*>)?)[ \t\r\n]*" + _MACRO_ARG * 3 + rb"\)"
 )
 _MACRO_BODY: Final = re.compile(
     r"(registerNodeType|registerBuilder)\s*<\s*([A-Za-z_]\w*)\s*>\s*\(\s*"
@@ -620,17 +638,20 @@ class _Reader:
         )
 
     def _macro_calls(self, root: Node) -> Iterator[MacroCall]:
+        own = {m.name for m in self.macros}
         for m in _MACRO_CALL.finditer(self.src):
             name = m.group(1).decode()
             if name in _SIMPLE_REGISTRARS or name in _TEMPLATE_REGISTRARS:
                 continue
+            groups = [g for g in (2, 3, 4, 5) if m.group(g) is not None]
+            if len(groups) > 2 and name not in own and name.startswith(_NOT_REGISTRARS):
+                continue  # RCLCPP_INFO(logger, "...", x): logging, not registering
             at = root.descendant_for_byte_range(m.start(1), m.end(1))
             if at is None or at.type in ("comment", "string_content", "preproc_arg"):
                 continue
             p = at.parent
             if p is not None and p.type in ("preproc_function_def", "preproc_def"):
                 continue
-            groups = [g for g in (2, 3) if m.group(g) is not None]
             yield MacroCall(
                 name,
                 tuple(m.group(g).decode("utf-8", "replace") for g in groups),

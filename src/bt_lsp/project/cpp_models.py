@@ -54,6 +54,11 @@ _DYNAMIC: Final = re.compile(
     rb"\b(?:registerFromPlugin|registerFromROSPlugins|RegisterRosNode|"
     rb"BT_RegisterRosNodeFromPlugin|plugin_lib_names|SharedLibrary)\b"
 )
+# A function-like macro whose body registers nodes (its continuation lines included).
+_REGISTERING_MACRO: Final = re.compile(
+    rb"#[ \t]*define[ \t]+(\w+)\((?:[^\n]*\\\r?\n)*[^\n]*"
+    rb"\b(?:registerNodeType|registerBuilder|registerSimple\w*)\b"
+)
 # Dependencies that cannot register BehaviorTree.CPP nodes, found or not: generated
 # interface packages, build tools and the ROS client and transform libraries.
 _NO_NODES_SUFFIXES: Final = ("_msgs", "_srvs", "_interfaces", "_cmake", "_cmake_module")
@@ -392,6 +397,11 @@ class CppModels:
         for f, d in texts:
             if _DYNAMIC.search(d):
                 return Completeness(False, f"{self.shown(f)} loads node plugins chosen at run time")
+            unread = self._unread_macro(f, d)
+            if unread is not None:
+                return Completeness(
+                    False, f"macro {unread} of {self.shown(f)} registers nodes in a form not read"
+                )
         if cat.unresolved:
             u = cat.unresolved[0]
             where = f"{self.shown(Path(u.path))}:{u.span[0] + 1}"
@@ -415,6 +425,18 @@ class CppModels:
                     )
                 shipped.update(str(c) for c in catalogs)
         return Completeness(True, "", frozenset(shipped))
+
+    def _unread_macro(self, path: Path, data: bytes) -> str | None:
+        """A macro of ``data`` whose body registers nodes but that the reader did not
+        understand (``registerNodeType<ns::Name>``): its registrations are unknown."""
+        if b"define" not in data:
+            return None
+        names = {m.group(1).decode() for m in _REGISTERING_MACRO.finditer(data)}
+        if not names:
+            return None
+        read = {m.name for m in self.scanner.facts(str(path), data).macros}
+        unread = sorted(names - read)
+        return unread[0] if unread else None
 
     def shown(self, path: Path) -> str:
         """``path`` relative to the workspace folder that holds it (as given otherwise)."""

@@ -33,7 +33,7 @@ from bt_lsp.cpp.library import library_facts
 CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp"})
 SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules", "__pycache__"})
 # Bumped whenever the facts' shape or meaning changes, so old cache entries are not read.
-_FORMAT: Final = "1"
+_FORMAT: Final = "2"
 _LAZY_ROUNDS: Final = 3
 
 

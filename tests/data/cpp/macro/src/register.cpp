@@ -5,8 +5,12 @@
     return std::make_unique<Name>(n, c);                                      \
   });
 
+// Three arguments: the class, the ID and a constructor argument.
+#define REGISTER_WITH(Type, Id, Arg) factory.registerNodeType<Type>(Id, Arg);
+
 BT_REGISTER_NODES(factory)
 {
   REGISTER_NODE(Dock)
   REGISTER_NODE(Undock)
+  REGISTER_WITH(Charge, "ChargeSlowly", 2)
 }

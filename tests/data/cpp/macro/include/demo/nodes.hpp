@@ -12,3 +12,10 @@ class Undock : public BT::StatefulActionNode
 public:
   static BT::PortsList providedPorts() { return {}; }
 };
+
+class Charge : public BT::SyncActionNode
+{
+public:
+  Charge(const std::string& name, const BT::NodeConfig& config, int rate);
+  static BT::PortsList providedPorts() { return { BT::InputPort<int>("percent", 90, "Stop here") }; }
+};
