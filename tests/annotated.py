@@ -41,6 +41,7 @@ from pathlib import Path
 
 from bt_lsp.ide.fix import Fix
 from bt_lsp.ide.name_fixes import fixes_for_name
+from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.ide.semantic_fixes import fixes_for_rule
 from bt_lsp.project.config import CONFIG_NAMES, ConfigError
 from bt_lsp.project.index import ProjectIndex, normalize
@@ -176,7 +177,7 @@ def _analyze(f: Fixture, text: str) -> tuple[Document, list[Diagnostic]]:
     limit = f.directives.get("max-document-bytes")
     if limit is not None and doc.utf8_size > limit:
         return doc, size_limited(doc, limit)
-    diags = analyze(doc)
+    diags = with_targets(doc, analyze(doc))
     maximum = f.directives.get("max-diagnostics")
     return doc, limited(diags, maximum) if maximum is not None else diags
 

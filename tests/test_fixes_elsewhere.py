@@ -10,12 +10,15 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any, cast
 
 import pytest
 
 from bt_lsp.cli.main import main
 from bt_lsp.ide.name_fixes import fix_all, fixes_for_name
+from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.ide.rename import RenameRefused, rename
+from bt_lsp.rules.context import ModelDecl
 from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
@@ -150,8 +153,8 @@ def test_fix_all_renames_only_names_with_their_targets() -> None:
         "left 'target.pose' as it is: the tree 'Move To Pose' is not defined in the "
         "workspace (it comes from elsewhere, such as an installed package, and keeps its ID "
         "there); rename it where it is defined first, then this reference",
-        "left 'Say.Hi' as it is: the node type 'Say.Hi' is registered in code bt-lsp cannot "
-        "see (no <TreeNodesModel> entry in the workspace declares it); its registration "
+        "left 'Say.Hi' as it is: the node type 'Say.Hi' is registered in C++ that bt-lsp "
+        "cannot see (no <TreeNodesModel> of the workspace declares it); its registration "
         "must be renamed too",
     ]
 
@@ -212,3 +215,74 @@ def test_check_fix_of_one_file_leaves_calls_into_files_not_checked(
         '"Pick Object"', '"Pick_Object"'
     )
     assert "left 'Pick Object Helper' as it is" in capsys.readouterr().err
+
+
+# -- the diagnostic says where the name must change first ----------------------------------
+
+
+def _cpp_model(node_id: str, path: str, source: str = "cpp") -> dict[str, ModelDecl]:
+    return {node_id: ModelDecl(node_id, "Action", (), path, 0, len(node_id), cast(Any, source))}
+
+
+def test_a_node_type_registered_in_the_workspaces_cpp_is_renamed_there_first() -> None:
+    # Declared in a <TreeNodesModel> of the workspace, but registered in the project's C++,
+    # which bt-lsp reads and does not rewrite: renaming the XML alone breaks the node.
+    doc = Document(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Say.Hi/></BehaviorTree>'
+        '<TreeNodesModel><Action ID="Say.Hi"/></TreeNodesModel></root>',
+        "/ws/pick.xml",
+    )
+    registered = _cpp_model("Say.Hi", "/ws/src/say_hi.cpp")
+    found = fixes_for_name(doc, _diag(doc, "Say.Hi"), {}, registered)
+    assert found and not any(f.preferred for f in found)
+    assert found[0].title == (
+        "Rename 'Say.Hi' to 'Say_Hi' (2 places); the node type 'Say.Hi' is registered in C++ "
+        "in say_hi.cpp: rename it there too"
+    )
+    fixed = fix_all(doc, own_diagnostics(doc), {}, registered)
+    assert fixed.edits == []
+    assert fixed.notes == [
+        "left 'Say.Hi' as it is: the node type 'Say.Hi' is registered in C++ in "
+        "/ws/src/say_hi.cpp, which bt-lsp does not rename; its registration must be renamed too"
+    ]
+    (diag, *_) = with_targets(doc, own_diagnostics(doc), {}, registered)
+    assert diag.message.endswith(
+        "; the node type is registered in C++ in /ws/src/say_hi.cpp: rename it there first; "
+        "fix-all leaves this name until then"
+    )
+    # Without the C++ model the workspace's declaration is the target: renamed with it.
+    (fix, *_) = fixes_for_name(doc, _diag(doc, "Say.Hi"), {})
+    assert fix.preferred and fix.title == "Rename 'Say.Hi' to 'Say_Hi' (2 places)"
+
+
+def test_a_node_type_of_an_installed_catalog_is_renamed_there_first() -> None:
+    doc = Document(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Say.Hi/></BehaviorTree></root>',
+        "/ws/pick.xml",
+    )
+    registered = _cpp_model("Say.Hi", "/opt/ros/share/talk/nodes.xml", "ros")
+    (fix, *_) = fixes_for_name(doc, _diag(doc, "Say.Hi"), {}, registered)
+    assert not fix.preferred
+    assert fix.title.endswith(
+        "; the node type 'Say.Hi' is declared in nodes.xml, outside the workspace: "
+        "rename it there too"
+    )
+    (diag, *_) = with_targets(doc, own_diagnostics(doc), {}, registered)
+    assert diag.message.endswith(
+        "; the node type is declared in the node catalog /opt/ros/share/talk/nodes.xml, "
+        "outside the workspace: rename it there first; fix-all leaves this name until then"
+    )
+
+
+def test_check_reports_where_a_name_must_change_first(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (work / "pick.xml").write_text(OBJECTIVE, encoding="utf-8")
+    main(["check", "pick.xml"])
+    out = capsys.readouterr().out
+    assert (
+        "error model-name-forbidden-char Model name 'Open Right Gripper' contains 2 "
+        "forbidden characters: ' ' (space) at columns 5 and 11; whitespace breaks XML "
+        "element/attribute names; the tree is not defined in this workspace: rename it "
+        "where it is defined first; this call keeps its ID until then\n"
+    ) in out

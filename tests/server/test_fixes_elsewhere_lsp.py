@@ -5,6 +5,7 @@ and Neovim 0.11's (plain ``changes``)."""
 
 from __future__ import annotations
 
+import asyncio
 from collections.abc import AsyncIterator
 
 import pytest
@@ -77,6 +78,40 @@ async def _actions(
 async def test_a_call_of_a_tree_defined_elsewhere_gets_no_fix(lsp: NavClient) -> None:
     actions = await _actions(lsp, "Open Right Gripper")
     assert [a.title for a in actions if "Open Right Gripper" in a.title] == []
+
+
+async def test_the_diagnostic_says_where_the_name_must_change_first(lsp: NavClient) -> None:
+    uri = lsp.uri("pick.xml")
+    caps = pytest_lsp.client_capabilities(lsp.spec.replace("eglot-plain", "emacs"))
+    if caps.text_document is not None and caps.text_document.diagnostic is not None:
+        report = await lsp.text_document_diagnostic_async(
+            types.DocumentDiagnosticParams(text_document=ident(uri))
+        )
+        assert isinstance(report, types.RelatedFullDocumentDiagnosticReport)
+        found = report.items
+    else:
+        for _ in range(100):  # published after the debounce (0 ms here)
+            if lsp.diagnostics.get(uri):
+                break
+            await asyncio.sleep(0.05)
+        found = lsp.diagnostics.get(uri, [])
+    messages = {
+        d.message.split(" contains ")[0]: d.message
+        for d in found
+        if d.code == "model-name-forbidden-char"
+    }
+    assert messages["Model name 'Open Right Gripper'"].endswith(
+        "; the tree is not defined in this workspace: rename it where it is defined first; "
+        "this call keeps its ID until then"
+    )
+    assert messages["Model name 'Say.Hi'"].endswith(
+        "; the node type is registered in C++ that bt-lsp cannot see (no <TreeNodesModel> of "
+        "the workspace declares it): rename it there first; fix-all leaves this name until then"
+    )
+    # The workspace's own tree, defined in helper.xml: renamed with its call, no clause.
+    assert messages["Model name 'Pick Object Helper'"].endswith(
+        "whitespace breaks XML element/attribute names"
+    )
 
 
 async def test_rename_of_a_call_of_a_tree_defined_elsewhere_is_refused(lsp: NavClient) -> None:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from bt_lsp.cli.results import analyze
 from bt_lsp.ide import name_fixes as fixes
 from bt_lsp.project.fileio import Decoded
-from bt_lsp.project.index import ProjectIndex
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules.codes import XML, defined
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
@@ -80,7 +80,12 @@ def fix_document(
     fix).  ``others`` are the other files of the workspace as they were before any was
     fixed: a name is renamed only with its target, and every file's fixes give a symbol
     the same new name."""
-    fix_all = fixes.fix_all(doc, diags, others)
+    registered = (
+        project.context_for(normalize(doc.path), doc).models
+        if project is not None and doc.path is not None
+        else None
+    )
+    fix_all = fixes.fix_all(doc, diags, others, registered)
     edits = fix_all.edits
     if not edits:
         return None

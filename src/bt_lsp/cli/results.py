@@ -8,6 +8,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Final
 
+from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.project.fileio import FileError
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules import analysis
@@ -56,7 +57,7 @@ def analyze(doc: Document, project: ProjectIndex | None = None) -> list[Diagnost
     """Every diagnostic of ``doc``, before severity settings; with a project index, its
     includes, models and trees count too."""
     if project is None or doc.path is None:
-        return analysis.analyze(doc)
+        return with_targets(doc, analysis.analyze(doc))
     return project.diagnostics(normalize(doc.path), doc)
 
 

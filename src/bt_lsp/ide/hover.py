@@ -213,7 +213,13 @@ def _where_defined(
         )
 
 
-def _bad_name(w: _Writer, doc: Document, ref: NameRef, others: Mapping[str, Document]) -> None:
+def _bad_name(
+    w: _Writer,
+    doc: Document,
+    ref: NameRef,
+    others: Mapping[str, Document],
+    ctx: Context | None = None,
+) -> None:
     violations = name_violations(ref)
     assert ref.kind is not None
     title = _KIND_TITLE[str(ref.kind)]
@@ -231,9 +237,10 @@ def _bad_name(w: _Writer, doc: Document, ref: NameRef, others: Mapping[str, Docu
                 f"{c.category}: {c.reason}"
             )
         w.items(items)
-    fix = preferred_renaming(doc, ref, others)
+    registered = ctx.models if ctx is not None else None
+    fix = preferred_renaming(doc, ref, others, registered)
     if fix is None:
-        away = elsewhere(ref.symbol, [doc.model, *(d.model for d in others.values())])
+        away = elsewhere(ref.symbol, [doc.model, *(d.model for d in others.values())], registered)
         if away is not None and away.refuse:
             w.para(f"No quick fix renames it: {away.why}.")
         return
@@ -307,7 +314,7 @@ def hover_at(
         _key_hover(w, doc, key, ctx)
         return HoverText(w.text(), key.start, key.end, markdown)
     if name_violations(ref):
-        _bad_name(w, doc, ref, others)
+        _bad_name(w, doc, ref, others, ctx)
     else:
         w.title(_what(w, ref))
         decl = [r for r in occurrences(model, ref) if r.role in DECLARING_ROLES]

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from typing import NamedTuple
 
+from bt_lsp.rules.context import ModelDecl
 from bt_lsp.syntax.edits import TextEdit, escape_value
 from bt_lsp.syntax.elements import NameRef, Role, Symbol
 from bt_lsp.syntax.model import Model
@@ -91,21 +92,50 @@ class Elsewhere(NamedTuple):
     target with the old one.  ``refuse``: no rename may touch it (a tree's ID stays where
     the tree is defined, so a call renamed alone calls nothing); otherwise a rename is
     possible but not safe on its own (a node type's registration in C++ must follow).
-    ``why`` says it, in a sentence that completes "... : why"."""
+    ``why`` says it, in a sentence that completes "... : why"; ``where`` is where the
+    target is (``"registered in C++ in nodes.cpp"``), and ``first`` what a name
+    diagnostic adds to its message: where the name must change first."""
 
     what: str
     why: str
     refuse: bool
+    where: str = "outside the workspace"
+    first: str = ""
 
 
-def elsewhere(symbol: Symbol | None, models: Iterable[Model]) -> Elsewhere | None:
+def _file(path: str) -> str:
+    """A file's name, for titles (the full path is in the message and the hover)."""
+    return path.replace("\\", "/").rsplit("/", 1)[-1] or path
+
+
+def _registered_where(decl: ModelDecl | None) -> tuple[str, str] | None:
+    """Where a node type that bt-lsp does not rename is registered: (for a title, for a
+    message), from its model's source; ``None`` when no model says."""
+    if decl is None or decl.path is None:
+        return None
+    if decl.source == "cpp":
+        return f"registered in C++ in {_file(decl.path)}", f"registered in C++ in {decl.path}"
+    return (
+        f"declared in {_file(decl.path)}, outside the workspace",
+        f"declared in the node catalog {decl.path}, outside the workspace",
+    )
+
+
+def elsewhere(
+    symbol: Symbol | None,
+    models: Iterable[Model],
+    registered: Mapping[str, ModelDecl] | None = None,
+) -> Elsewhere | None:
     """Whether ``symbol``'s target is outside the documents of ``models`` (the workspace):
 
     * a tree (``<SubTree ID>``, ``main_tree_to_execute``, a port of a ``<SubTree>`` call)
       whose ``<BehaviorTree ID>`` none of them defines: it comes from elsewhere (an
       installed package, a file outside the folder), where its ID stays;
     * a node type (or a port of one) that no ``<TreeNodesModel>`` entry declares: it is
-      registered in code bt-lsp cannot see, which keeps the old name.
+      registered in code bt-lsp cannot see, which keeps the old name;
+    * a node type that the project's C++ registers (``registered``, the context's models,
+      say so): bt-lsp does not rewrite C++, so even a ``<TreeNodesModel>`` entry of the
+      workspace renamed with it would leave the registration with the old name.
 
     ``None`` when the target is here, or when there is none: an instance name, and an
     empty name (nothing is registered or defined under it, so no reference works)."""
@@ -121,21 +151,48 @@ def elsewhere(symbol: Symbol | None, models: Iterable[Model]) -> Elsewhere | Non
     if owner.kind == "tree":
         if any(r.role == Role.TREE_DEF for m in models for r in m.refs_to(owner)):
             return None
+        tree = shown(owner.name)
         return Elsewhere(
-            f"{subject}the tree '{shown(owner.name)}'",
-            f"the tree '{shown(owner.name)}' is not defined in the workspace (it comes from "
+            f"{subject}the tree '{tree}'",
+            f"the tree '{tree}' is not defined in the workspace (it comes from "
             "elsewhere, such as an installed package, and keeps its ID there); rename it "
             "where it is defined first, then this reference",
             refuse=True,
+            first=(
+                "the tree is not defined in this workspace: rename it where it is defined "
+                "first; this call keeps its ID until then"
+                if not subject
+                else f"the tree '{tree}' is not defined in this workspace: rename the port "
+                "where the tree is defined first; this call keeps it until then"
+            ),
         )
     if owner.kind == "model":
-        if any(r.role == Role.MODEL_DEF for m in models for r in m.refs_to(owner)):
+        node = shown(owner.name)
+        decl = registered.get(owner.name) if registered is not None else None
+        in_cpp = decl is not None and decl.source == "cpp" and decl.path is not None
+        if not in_cpp and any(r.role == Role.MODEL_DEF for m in models for r in m.refs_to(owner)):
             return None
+        found = _registered_where(decl)
+        short, full = (
+            found
+            if found is not None
+            else (
+                "registered outside the workspace",
+                "registered in C++ that bt-lsp cannot see (no <TreeNodesModel> of the workspace "
+                "declares it)",
+            )
+        )
+        subject_first = f"the node type '{node}'" if subject else "the node type"
         return Elsewhere(
-            f"{subject}the node type '{shown(owner.name)}'",
-            f"the node type '{shown(owner.name)}' is registered in code bt-lsp cannot see (no "
-            "<TreeNodesModel> entry in the workspace declares it); its registration must be "
-            "renamed too",
+            f"{subject}the node type '{node}'",
+            f"the node type '{node}' is {full}"
+            + (", which bt-lsp does not rename" if found is not None else "")
+            + "; its registration must be renamed too",
             refuse=False,
+            where=short,
+            first=(
+                f"{subject_first} is {full}: rename {'the port' if subject else 'it'} there "
+                "first; fix-all leaves this name until then"
+            ),
         )
     return None

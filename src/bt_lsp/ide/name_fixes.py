@@ -24,7 +24,7 @@ Pure: these functions return edits; the front ends decide whether to apply them.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Hashable, Iterable, Iterator, Mapping
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass, field
 
@@ -39,18 +39,24 @@ from bt_lsp.ide.name_edits import (
 )
 from bt_lsp.ide.rename import RenamePlan, Renamer, RenameRefused, combined
 from bt_lsp.ide.sanitize import candidates, sanitize
+from bt_lsp.rules.context import ModelDecl
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.names import NAME_FIX_TITLES
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.elements import NameRef, Symbol
+from bt_lsp.syntax.elements import NameRef
+from bt_lsp.syntax.model import Model
 
 __all__ = [
     "Fix",
     "FixAll",
     "Renaming",
+    "WorkspaceFix",
+    "WorkspaceRename",
+    "edits_in",
     "escape_value",
     "fix_all",
+    "fix_workspace",
     "fixes_for_name",
     "occurrences",
     "other_file_edits",
@@ -149,11 +155,7 @@ class _With(AbstractSet[str]):
 
 def _renaming(renamer: Renamer, ref: NameRef, new: str, taken: AbstractSet[str]) -> Renaming | None:
     away = renamer.elsewhere(ref.symbol)
-    caution = (
-        None
-        if away is None
-        else f"{away.what} is registered outside the workspace: rename it there too"
-    )
+    caution = None if away is None else f"{away.what} is {away.where}: rename it there too"
     try:
         return Renaming(ref.text, new, renamer.plan(ref, new, taken=taken), caution=caution)
     except RenameRefused as e:
@@ -214,20 +216,26 @@ def _name_ref(doc: Document, diag: Diagnostic) -> NameRef | None:
 
 
 def preferred_renaming(
-    doc: Document, ref: NameRef, others: Mapping[str, Document] | None = None
+    doc: Document,
+    ref: NameRef,
+    others: Mapping[str, Document] | None = None,
+    registered: Mapping[str, ModelDecl] | None = None,
 ) -> Renaming | None:
     """The renaming of the preferred fix for the bad name ``ref``."""
     others = others or {}
     taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
-    return next(renamings(Renamer(doc, others), ref, taken), None)
+    return next(renamings(Renamer(doc, others, registered), ref, taken), None)
 
 
 def fixes_for_name(
-    doc: Document, diag: Diagnostic, others: Mapping[str, Document] | None = None
+    doc: Document,
+    diag: Diagnostic,
+    others: Mapping[str, Document] | None = None,
+    registered: Mapping[str, ModelDecl] | None = None,
 ) -> list[Fix]:
     """Quick fixes for one name diagnostic: the preferred rename first, then alternatives.
     ``others`` are the other workspace documents, by path: references there are renamed
-    too."""
+    too; ``registered`` (the context's models) says where node types are registered."""
     ref = _name_ref(doc, diag)
     if ref is None:
         return []
@@ -235,7 +243,7 @@ def fixes_for_name(
     taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
     return [
         Fix(r.title, r.plan.edits, i == 0 and r.caution is None, diag, r.plan.other_edits)
-        for i, r in enumerate(renamings(Renamer(doc, others), ref, taken))
+        for i, r in enumerate(renamings(Renamer(doc, others, registered), ref, taken))
     ]
 
 
@@ -251,37 +259,31 @@ class FixAll:
     other_edits: Mapping[str, tuple[TextEdit, ...]] = field(default_factory=dict)
 
 
-def fix_all(
-    doc: Document, diags: Iterable[Diagnostic], others: Mapping[str, Document] | None = None
-) -> FixAll:
-    """Every preferred name fix at once, consistently: one new name per symbol, all
-    distinct from each other and from the names that stay in the workspace.  Each symbol
-    is renamed as a rename renames it (its keys included), in the document and in the
-    ``others`` (the other workspace documents, by path), which a tree defined here and
-    called there needs, so that the call follows.  A name whose target is outside the
-    workspace is left as it is, with a note: a call of a tree defined elsewhere, and a node
-    type (or its port) that no ``<TreeNodesModel>`` of the workspace declares.
-
-    ``bt-lsp check --fix`` fixes the files of a folder one after the other, each against
-    ``others`` as they were before any file was fixed: each file's fixes then choose the
-    same new name for a symbol, and each file renames its own occurrences."""
-    others = others or {}
-    model = doc.model
-    renamer = Renamer(doc, others)
-    done: set[Symbol | tuple[int, int]] = set()
-    plans: list[RenamePlan] = []
-    notes: list[str] = []
-    taken_by_ns: dict[tuple[str, ...], set[str]] = {}
-    for m in (model, *(d.model for d in others.values())):
+def _taken_by_namespace(models: Iterable[Model]) -> dict[tuple[str, ...], set[str]]:
+    taken: dict[tuple[str, ...], set[str]] = {}
+    for m in models:
         for sym in m.by_symbol:
-            taken_by_ns.setdefault(namespace(sym), set()).add(sym.name)
+            taken.setdefault(namespace(sym), set()).add(sym.name)
+    return taken
+
+
+def _choose(
+    doc: Document,
+    renamer: Renamer,
+    diags: Iterable[Diagnostic],
+    done: set[Hashable],
+    taken_by_ns: dict[tuple[str, ...], set[str]],
+    notes: list[str],
+) -> Iterator[Renaming]:
+    """The preferred renaming of each bad name of ``doc`` not ``done`` yet (by symbol, or
+    by ``(path, start, end)`` for a name without one), each new name added to the names
+    taken in its namespace; a name whose target is outside the workspace is left, with a
+    note."""
     for diag in diags:
         ref = _name_ref(doc, diag)
         if ref is None:
             continue
-        key: Symbol | tuple[int, int] = (
-            ref.symbol if ref.symbol is not None else (ref.start, ref.end)
-        )
+        key: Hashable = ref.symbol if ref.symbol is not None else (doc.path, ref.start, ref.end)
         if key in done:
             continue
         done.add(key)
@@ -299,8 +301,94 @@ def fix_all(
             continue
         if names is not None:
             names.add(r.new)
-        plans.append(r.plan)
         if r.note is not None:
             notes.append(r.note)
-    plan = combined(plans)
+        yield r
+
+
+def fix_all(
+    doc: Document,
+    diags: Iterable[Diagnostic],
+    others: Mapping[str, Document] | None = None,
+    registered: Mapping[str, ModelDecl] | None = None,
+) -> FixAll:
+    """Every preferred name fix at once, consistently: one new name per symbol, all
+    distinct from each other and from the names that stay in the workspace.  Each symbol
+    is renamed as a rename renames it (its keys included), in the document and in the
+    ``others`` (the other workspace documents, by path), which a tree defined here and
+    called there needs, so that the call follows.  A name whose target is outside the
+    workspace is left as it is, with a note: a call of a tree defined elsewhere, and a node
+    type (or its port) that no ``<TreeNodesModel>`` of the workspace declares or that the
+    project's C++ registers (``registered``: the context's models).
+
+    ``bt-lsp check --fix`` plans a whole folder at once instead (:func:`fix_workspace`)."""
+    others = others or {}
+    renamer = Renamer(doc, others, registered)
+    notes: list[str] = []
+    taken_by_ns = _taken_by_namespace([doc.model, *(d.model for d in others.values())])
+    chosen = list(_choose(doc, renamer, diags, set(), taken_by_ns, notes))
+    plan = combined([r.plan for r in chosen])
     return FixAll(list(plan.edits), notes, plan.other_edits)
+
+
+@dataclass(frozen=True, slots=True)
+class WorkspaceRename:
+    """One name's rename in a fix of a whole workspace: its edits in every file it
+    touches, by path.  The files are written all together or not at all."""
+
+    renaming: Renaming
+    edits: Mapping[str, tuple[TextEdit, ...]]
+    written_out: frozenset[tuple[str, int, int]]
+
+    @property
+    def paths(self) -> frozenset[str]:
+        return frozenset(p for p, e in self.edits.items() if e)
+
+
+@dataclass(frozen=True, slots=True)
+class WorkspaceFix:
+    """The renames of every preferred name fix of a workspace, and by path the notes of
+    the names left as they are (see :class:`FixAll`)."""
+
+    renames: list[WorkspaceRename]
+    notes: Mapping[str, list[str]]
+
+
+def fix_workspace(
+    docs: Mapping[str, Document],
+    diags: Mapping[str, Iterable[Diagnostic]],
+    registered: Mapping[str, Mapping[str, ModelDecl]] | None = None,
+) -> WorkspaceFix:
+    """Every preferred name fix of the documents ``docs`` (by path) at once: one decision
+    per symbol for the whole workspace, so that two bad names that sanitize to the same
+    new name get the same new names in every file, and each rename carries its edits in
+    all the files it touches (see :func:`edits_in`).  ``diags`` are each document's
+    diagnostics, ``registered`` each document's context models, by path."""
+    taken_by_ns = _taken_by_namespace(d.model for d in docs.values())
+    done: set[Hashable] = set()
+    renames: list[WorkspaceRename] = []
+    notes: dict[str, list[str]] = {}
+    for path, doc in docs.items():
+        others = {p: d for p, d in docs.items() if p != path}
+        renamer = Renamer(doc, others, (registered or {}).get(path))
+        left = notes.setdefault(path, [])
+        for r in _choose(doc, renamer, diags.get(path, ()), done, taken_by_ns, left):
+            plan = r.plan
+            edits = {path: plan.edits, **plan.other_edits}
+            out = frozenset((p if p is not None else path, s, e) for p, s, e in plan.written_out)
+            renames.append(WorkspaceRename(r, edits, out))
+    return WorkspaceFix(renames, notes)
+
+
+def edits_in(renames: Iterable[WorkspaceRename], path: str) -> list[TextEdit]:
+    """The edits of ``renames`` in the file ``path``, combined as :func:`combined` combines
+    renames (an edit that only writes out a key gives way to a rename of that key)."""
+    return list(
+        combined(
+            RenamePlan(
+                r.edits.get(path, ()),
+                written_out=frozenset((None, s, e) for p, s, e in r.written_out if p == path),
+            )
+            for r in renames
+        ).edits
+    )

@@ -21,6 +21,7 @@ from bt_lsp.ide.name_edits import (
     taken_names,
 )
 from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.context import ModelDecl
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, escape_value
@@ -378,8 +379,14 @@ class Renamer:
     workspace documents (by path).  One renamer serves many renames of the same documents
     (the name fixes use it so): what it reads of their trees is read once."""
 
-    def __init__(self, doc: Document, others: Mapping[str, Document] | None = None) -> None:
+    def __init__(
+        self,
+        doc: Document,
+        others: Mapping[str, Document] | None = None,
+        registered: Mapping[str, ModelDecl] | None = None,
+    ) -> None:
         self._graph = KeyGraph(doc, others or {})
+        self._registered = registered  # the context's models: where node types come from
         self._elsewhere: dict[Symbol, Elsewhere | None] = {}
 
     def elsewhere(self, sym: Symbol | None) -> Elsewhere | None:
@@ -392,7 +399,7 @@ class Renamer:
         if sym not in self._elsewhere:
             graph = self._graph
             self._elsewhere[sym] = elsewhere(
-                sym, [graph.doc.model, *(d.model for d in graph.others.values())]
+                sym, [graph.doc.model, *(d.model for d in graph.others.values())], self._registered
             )
         return self._elsewhere[sym]
 
@@ -443,7 +450,11 @@ class Renamer:
 
 
 def rename(
-    doc: Document, offset: int, new_name: str, others: Mapping[str, Document] | None = None
+    doc: Document,
+    offset: int,
+    new_name: str,
+    others: Mapping[str, Document] | None = None,
+    registered: Mapping[str, ModelDecl] | None = None,
 ) -> RenamePlan | None:
     """Rename the name under ``offset`` and every reference to it in the workspace.
 
@@ -489,7 +500,7 @@ def rename(
     target = prepare_rename(doc, offset)
     if target is None:
         return None
-    renamer = Renamer(doc, others)
+    renamer = Renamer(doc, others, registered)
     if target.key is not None:
         return renamer.key_plan(target.key, new_name)
     ref = target.ref

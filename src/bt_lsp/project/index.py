@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.ide.places import IncludeLink
 from bt_lsp.project.config import CONFIG_FILE, ConfigError, Configs, Layer, excluded
 from bt_lsp.project.cpp_models import CppModels, cpp_diagnostics
@@ -612,10 +613,14 @@ class ProjectIndex:
         """Every diagnostic of ``doc`` in this workspace."""
         if path.suffix in CPP_SUFFIXES:  # a C++ source: the name rules at its literals
             return limited(cpp_diagnostics(doc.text, self.cpp.scanner if self.cpp else None))
-        out = analysis.analyze(doc, self.context_for(path, doc))
+        ctx = self.context_for(path, doc)
+        out = analysis.analyze(doc, ctx)
         out.extend(self.include_diagnostics(path, doc))
         out.sort(key=lambda d: (d.start, d.end, d.code))
-        return limited(out)
+        out = limited(out)
+        if any(d.is_name_rule for d in out):  # where a name must change first, if not here
+            out = with_targets(doc, out, self.other_documents(path), ctx.models)
+        return out
 
     def other_documents(self, path: Path) -> dict[str, Document]:
         """The other BT documents of the workspace (open ones as edited), by path: what a

@@ -65,14 +65,16 @@ def _others(ls: BtServer, od: OpenDocument) -> dict[str, Document]:
     return ls.project.other_documents(normalize(od.path)) if od.path is not None else {}
 
 
+def _context(ls: BtServer, od: OpenDocument) -> Context:
+    if od.path is not None:
+        return ls.project.context_for(od.path, od.doc)
+    return Context.from_document(od.doc)
+
+
 def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
-    fixes = fixes_for_name(od.doc, diag, _others(ls, od))
+    ctx = _context(ls, od)
+    fixes = fixes_for_name(od.doc, diag, _others(ls, od), ctx.models)
     if not diag.is_name_rule:
-        ctx = (
-            ls.project.context_for(od.path, od.doc)
-            if od.path is not None
-            else Context.from_document(od.doc)
-        )
         fixes += semantic_fixes.fixes_for_rule(od.doc, ctx, diag)
     return fixes
 
@@ -80,7 +82,7 @@ def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
 def _fix_all_edit(ls: BtServer, od: OpenDocument) -> types.WorkspaceEdit:
     """Every preferred name fix of the document; a tree defined here is renamed in the
     other files that call it too (those edits need confirmation where the client can)."""
-    fixed = fix_all(od.doc, ls.diagnostics_of(od), _others(ls, od))
+    fixed = fix_all(od.doc, ls.diagnostics_of(od), _others(ls, od), _context(ls, od).models)
     return _workspace_edit(ls, od, fixed.edits, fixed.other_edits)
 
 

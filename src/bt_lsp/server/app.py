@@ -21,6 +21,7 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
+from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.project.config import CONFIG_NAMES
 from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.settings import Settings
@@ -143,7 +144,7 @@ class BtServer(LanguageServer):
                 result = self.project.diagnostics(od.path, od.doc)
                 log_version(self, od.path)
             else:
-                result = analyze(od.doc)
+                result = with_targets(od.doc, analyze(od.doc))
             settings = self.settings if od.path is None else self.project.settings_for(od.path)
             result = with_severities(result, settings.severity)
         od.cache_key, od.cached = key, result
