@@ -744,7 +744,7 @@ def _patch_fix_all(monkeypatch: pytest.MonkeyPatch, bad: TextEdit) -> None:
     """The real fixes, with ``bad`` instead of any edit at the same place."""
     real = fixes.fix_all
 
-    def fake(doc: Any, diags: Any, others: Any = None) -> fixes.FixAll:
+    def fake(doc: Any, diags: Any, others: Any = None, registered: Any = None) -> fixes.FixAll:
         edits = [e for e in real(doc, diags).edits if e.start != bad.start]
         return fixes.FixAll([*edits, bad])
 
