@@ -20,8 +20,8 @@ import pytest
 from lxml import etree
 
 from bt_lsp import __version__
+from bt_lsp.cli import fix_workspace
 from bt_lsp.cli.main import main
-from bt_lsp.ide import name_fixes as fixes
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
 from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
@@ -689,13 +689,13 @@ def test_fix_gives_a_port_one_name_across_a_folder(
     )
     before = (models.read_text(encoding="utf-8"), trees.read_text(encoding="utf-8"))
     assert main(["check", "--fix", "d"]) == 0
-    # Each file is fixed alone, and the port gets the same name in both, its key included.
+    # One rename for the whole folder: the port gets the same name in both, its key
+    # included, and each file counts its own problems that went away.
     assert models.read_text(encoding="utf-8") == before[0].replace("bad.port", "bad_port")
     assert trees.read_text(encoding="utf-8") == before[1].replace("bad.port", "bad_port")
-    # (Once the declaration is renamed, the call misses the required port until it is fixed.)
     assert capsys.readouterr().err.splitlines() == [
         "fixed 1 problem in d/models.xml",
-        "fixed 2 problems in d/trees.xml",
+        "fixed 1 problem in d/trees.xml",
         "0 errors, 0 warnings in 2 files",
     ]
 
@@ -742,13 +742,12 @@ def test_fix_respects_severity_off(work: Path, capsys: pytest.CaptureFixture[str
 
 def _patch_fix_all(monkeypatch: pytest.MonkeyPatch, bad: TextEdit) -> None:
     """The real fixes, with ``bad`` instead of any edit at the same place."""
-    real = fixes.fix_all
+    real = fix_workspace.edits_in
 
-    def fake(doc: Any, diags: Any, others: Any = None, registered: Any = None) -> fixes.FixAll:
-        edits = [e for e in real(doc, diags).edits if e.start != bad.start]
-        return fixes.FixAll([*edits, bad])
+    def fake(renames: Any, path: str) -> list[TextEdit]:
+        return [*(e for e in real(renames, path) if e.start != bad.start), bad]
 
-    monkeypatch.setattr(fixes, "fix_all", fake)
+    monkeypatch.setattr(fix_workspace, "edits_in", fake)
 
 
 _SUBTREE_CALL = FIXABLE.index('<SubTree ID="Sub Tree"/>') + len('<SubTree ID="')
@@ -921,7 +920,15 @@ def test_a_link_out_of_the_folder_is_not_rewritten(
     assert "not fixing d/link.xml: it is a symbolic link to" in err
     assert "--follow-symlinks" in err
     assert outside.read_text(encoding="utf-8") == FIXABLE
-    assert inside.read_text(encoding="utf-8") != FIXABLE  # fixed
+    # Both files define the same trees: a rename of one of them renames it in both or in
+    # neither, so the file inside (checked as d/near.xml, its link) keeps its names too,
+    # with a note saying why.
+    assert inside.read_text(encoding="utf-8") == FIXABLE
+    assert (
+        "bt-lsp: d/near.xml: left 'Main Tree' as it is (not renamed to 'Main_Tree' in any "
+        "file): its rename changes d/link.xml too, which is not fixed: it is a symbolic link"
+    ) in err
     assert main(["check", "--fix", "--follow-symlinks", "d"]) == 0
+    assert inside.read_text(encoding="utf-8") != FIXABLE  # fixed
     assert outside.read_text(encoding="utf-8") != FIXABLE  # fixed through the link
     assert (work / "d" / "link.xml").is_symlink()

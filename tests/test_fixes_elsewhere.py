@@ -195,10 +195,10 @@ def test_check_fix_keeps_calls_of_trees_defined_elsewhere(
     left = f"bt-lsp: objectives/pick.xml: left 'Open Right Gripper' as it is: {OUTSIDE_TREE}\n"
     assert left in err
     assert "fixed 1 problem in objectives/helper.xml\n" in err
-    # Counted as diagnostics that went away: helper.xml is fixed first, so the call's bad
-    # name and its missing tree were one problem; after the fix a hint says the tree is in
-    # a file pick.xml does not include.
-    assert "fixed 1 problem in objectives/pick.xml\n" in err
+    # Counted as diagnostics that went away, with both files fixed: the bad ID of the
+    # tree and that of the call (a hint still says the tree is in a file pick.xml does not
+    # include).
+    assert "fixed 2 problems in objectives/pick.xml\n" in err
     # A second run changes nothing more.
     assert main(["check", "--fix", "objectives"]) == 1
     assert (ws / "pick.xml").read_text(encoding="utf-8") == pick

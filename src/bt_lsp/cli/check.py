@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Final, TextIO
 
 from bt_lsp.cli.fix import fix_document
+from bt_lsp.cli.fix_workspace import Planned, fix_files
 from bt_lsp.cli.formats import Format
 from bt_lsp.cli.formats.json import to_json
 from bt_lsp.cli.formats.sarif import to_sarif
@@ -115,11 +116,16 @@ def check_file(
     project: ProjectIndex | None = None,
     before: Mapping[Path, Document] | None = None,
     keep: str | None = None,
+    planned: Planned | None = None,
 ) -> FileResult:
     """Read, analyze and (with ``options.fix``) fix one file, in ``project`` if given;
     ``before`` are the workspace's documents before any file was fixed; ``keep`` says why
-    the file must not be rewritten, if it must not."""
+    the file must not be rewritten, if it must not.  ``planned``: what the fix of the whole
+    workspace did to the file (:func:`bt_lsp.cli.fix_workspace.fix_files`), reported as
+    it is."""
     result = FileResult(path)
+    if planned is not None:
+        return _planned_result(result, planned)
     try:
         decoded = read_text(path, options.max_bytes)
     except FileError as e:
@@ -169,6 +175,22 @@ def check_file(
         result.error = FileError(
             path, f"internal error while checking {path}: {type(e).__name__}: {e}"
         )
+    return result
+
+
+def _planned_result(result: FileResult, planned: Planned) -> FileResult:
+    """The result of a file that the fix of the whole workspace handled."""
+    doc, diags = planned.doc, planned.diags
+    outcome = planned.outcome
+    result.notes = list(planned.notes)
+    if isinstance(outcome, str):
+        result.not_fixed = outcome
+        result.unwritten = planned.unwritten
+    elif outcome is not None:
+        fixed_diags = with_severities(outcome.raw, planned.severities)
+        result.fixed = max(len(diags) - len(fixed_diags), 0)
+        doc, diags = outcome.doc, fixed_diags
+    result.findings = findings_of(result.path, doc, diags)
     return result
 
 
@@ -324,10 +346,16 @@ def run(
     if options.fix:
         for tmp in _remove_stale_temporaries(files, options.started):
             say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
+
+    def keep_of(path: str) -> str | None:
+        return None if options.follow_symlinks else _linked_from_outside(path, roots)
+
+    # Every rename of --fix in all the files it touches, or in none (see fix_workspace).
+    planned = fix_files(files, project, options.max_bytes, keep_of) if options.fix else {}
     for i, path in enumerate(files, 1):
         progress.show(i, path)
-        keep = None if options.follow_symlinks else _linked_from_outside(path, roots)
-        r = check_file(path, options, project, before, keep)
+        keep = keep_of(path)
+        r = check_file(path, options, project, before, keep, planned.get(str(normalize(path))))
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")

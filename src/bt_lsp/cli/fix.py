@@ -78,15 +78,26 @@ def fix_document(
 ) -> Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
     fix).  ``others`` are the other files of the workspace as they were before any was
-    fixed: a name is renamed only with its target, and every file's fixes give a symbol
-    the same new name."""
+    fixed: a name is renamed only with its target."""
     registered = (
         project.context_for(normalize(doc.path), doc).models
         if project is not None and doc.path is not None
         else None
     )
     fix_all = fixes.fix_all(doc, diags, others, registered)
-    edits = fix_all.edits
+    return apply_fixes(decoded, doc, raw, fix_all.edits, fix_all.notes, project)
+
+
+def apply_fixes(
+    decoded: Decoded,
+    doc: Document,
+    raw: list[Diagnostic],
+    edits: list[TextEdit],
+    notes: list[str],
+    project: ProjectIndex | None = None,
+) -> Fixed | str | None:
+    """``doc`` with ``edits`` applied, or why they cannot be applied safely (``None``:
+    nothing to change); ``raw`` are its diagnostics before, ``notes`` what the fixes left."""
     if not edits:
         return None
     if not decoded.lossless:
@@ -124,4 +135,4 @@ def fix_document(
         return "the fixes would add name problems elsewhere"
     if _well_formed(decoded.encode(doc.text)) and not _well_formed(new_bytes):
         return "the fixed file would not be well-formed XML"
-    return Fixed(new_doc, new_raw, fix_all.notes)
+    return Fixed(new_doc, new_raw, notes)
