@@ -13,11 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli import fix_workspace
 from bt_lsp.cli.main import main
 from bt_lsp.ide.name_fixes import edits_in
 from bt_lsp.ide.name_fixes import fix_workspace as plan_workspace
-from bt_lsp.project.fileio import FileError
+from bt_lsp.project.fileio import FileError, write_text_atomic
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
@@ -113,7 +112,7 @@ def test_a_failed_write_puts_back_the_files_already_written(
 ) -> None:
     (work / "d" / "dock.xml").write_text(DEFINES, encoding="utf-8")
     (work / "d" / "main.xml").write_text(_calls(), encoding="utf-8")
-    real = fix_workspace.write_text_atomic
+    real = write_text_atomic
     wrote: list[str] = []
 
     def failing(path: str, text: str, encoding: str, bom: bool, **kw: object) -> None:
@@ -122,7 +121,7 @@ def test_a_failed_write_puts_back_the_files_already_written(
         wrote.append(text)
         real(path, text, encoding, bom)
 
-    monkeypatch.setattr(fix_workspace, "write_text_atomic", failing)
+    monkeypatch.setattr("bt_lsp.cli.fix_workspace.write_text_atomic", failing)
     assert main(["check", "--fix", "d"]) == 2
     # dock.xml was written first, then put back when main.xml could not be written.
     assert wrote == [DEFINES.replace("Dock Robot", "Dock_Robot"), DEFINES]
