@@ -323,10 +323,50 @@ def test_a_word_typed_between_tags_is_replaced() -> None:
     text = DOC.format(here="").replace("<Sequence>\n", "<Sequence>⟦⟧‸")
     found, _, _ = run(text)  # right after a start tag's '>'
     assert "Fallback" in labels(found)
-    # Not in the indentation before a tag, where no new element goes.
-    text = here("").replace("      <MoveBase goal", "  ‸    <MoveBase goal")
+
+
+@pytest.mark.parametrize("column", [0, 2, 6])
+def test_the_indentation_before_a_tag_offers_what_fits_before_it(column: int) -> None:
+    # Anywhere in the indentation of `      <MoveBase …/>` (a child of a Sequence): the
+    # edit runs from the cursor to the tag, never over it.
+    line = "      <MoveBase goal"
+    text = here("").replace(line, line[:column] + "‸⟦" + line[column:6] + "⟧" + line[6:])
+    found, plain, _ = run(text)
+    assert found.context == "text"
+    assert plain[found.end] == "<"  # the existing tag is not in the edit
+    move = item(found, "MoveBase")
+    assert move.insert == " " * (6 - column) + '<MoveBase result="{result}"/>'
+    assert move.snippet == " " * (6 - column) + '<MoveBase goal="${1}" result="{${2:result}}"/>'
+    assert found.trail == "\n      "  # the tag goes on to a line of its own, as indented
+    assert "Fallback" in labels(found)
+    # Applied: the new node before the old one, each on its own line.
+    new = plain[: found.start] + move.insert + found.trail + plain[found.end :]
+    assert '      <MoveBase result="{result}"/>\n      <MoveBase goal=' in new
+
+
+def test_the_indentation_before_a_closing_tag_offers_a_last_child() -> None:
+    found, _, _ = run(here("").replace("    </Sequence>", "‸⟦    ⟧</Sequence>"))
+    assert item(found, "Sleep").insert == "    <Sleep/>"
+    assert found.trail == "\n    "
+
+
+def test_the_indentation_before_a_tag_where_nothing_fits() -> None:
+    # The tree has its one child: no second one goes before it.
+    found, _, _ = run("<root><BehaviorTree ID='T'>\n  ‸⟦⟧<Sequence/>\n</BehaviorTree></root>")
+    assert found.items == []
+    # Text before the cursor on the line: not the indentation.
+    text = here("").replace("      <MoveBase goal", "    x ‸<MoveBase goal")
     at = text.index(CURSOR)
-    assert complete(Document(text.replace(CURSOR, "")), at) is None
+    after_text = complete(Document(text.replace(CURSOR, "")), at)
+    assert after_text is None or after_text.items == []
+
+
+def test_the_indentation_before_a_tag_keeps_the_line_ends() -> None:
+    for newline in ("\r\n", "\r"):
+        text = here("").replace("\n", newline)
+        at = text.index("      <MoveBase goal") + 2
+        found = complete(Document(text), at)
+        assert found is not None and found.trail == newline + "      "
 
 
 def test_between_tags_elsewhere_offers_what_fits_there() -> None:

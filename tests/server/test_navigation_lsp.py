@@ -751,6 +751,59 @@ async def test_completion_in_each_context(lsp: NavClient) -> None:
         close_doc(lsp, uri)
 
 
+INDENTED = """\
+<root BTCPP_format="4">
+  <BehaviorTree ID="T">
+    <Fallback>
+      <Sequence>
+        <AlwaysSuccess/>
+
+      </Sequence>
+    </Fallback>
+  </BehaviorTree>
+</root>
+"""
+
+
+async def test_completion_in_the_indentation_and_on_an_empty_line(lsp: NavClient) -> None:
+    uri = open_doc(lsp, "indented.xml", INDENTED)
+    try:
+        td = pytest_lsp.client_capabilities(lsp.spec).text_document
+        item_caps = td.completion.completion_item if td and td.completion else None
+        modes = item_caps.insert_text_mode_support if item_caps else None
+        as_is = bool(modes and types.InsertTextMode.AsIs in modes.value_set)
+        # Ctrl+Space at column 0, 2 and 6 of `      <Sequence>`: node types with their
+        # '<', the edit ending where the tag starts, so that the tag stays.
+        line_at = INDENTED.index("      <Sequence>")
+        tag_at = line_at + 6
+        for column in (0, 2, 6):
+            at = line_at + column
+            items = by_label(await complete_at(lsp, uri, INDENTED, at))
+            sleep = items["Sleep"]
+            assert isinstance(sleep.text_edit, types.TextEdit)
+            assert sleep.text_edit.range == rng(lsp, INDENTED, (at, tag_at))
+            lead = " " * (6 - column)
+            body = '<Sleep msec="${1}"/>' if lsp.snippets else "<Sleep/>"
+            if as_is:  # VS Code: the new node on its own line, the tag on the next
+                tail = ("$0" if lsp.snippets else "") + "\n      "
+                assert sleep.text_edit.new_text == lead + body + tail
+                assert sleep.insert_text_mode == types.InsertTextMode.AsIs
+            else:  # before the tag, on its line
+                assert sleep.text_edit.new_text == lead + body
+                assert sleep.insert_text_mode is None
+            assert {"Sequence", "Fallback", "AlwaysFailure"} <= set(items)
+        # An empty line between tags inside the Sequence: inserted at the cursor.
+        at = INDENTED.index("\n\n") + 1
+        items = by_label(await complete_at(lsp, uri, INDENTED, at))
+        sleep = items["Sleep"]
+        assert isinstance(sleep.text_edit, types.TextEdit)
+        assert sleep.text_edit.range == rng(lsp, INDENTED, (at, at))
+        assert sleep.text_edit.new_text == ('<Sleep msec="${1}"/>' if lsp.snippets else "<Sleep/>")
+        assert sleep.insert_text_mode is None
+    finally:
+        close_doc(lsp, uri)
+
+
 async def test_completion_capability(lsp: NavClient) -> None:
     opts = lsp.init_result.capabilities.completion_provider
     assert (

@@ -5,9 +5,10 @@ and returns plain items with the span they replace (code-point offsets).  Contex
 
 * a start tag's name after ``<``: the elements allowed there (in a tree, the built-in and
   declared node types, with their required ports, and a ``<SubTree>`` call of each tree);
-* an empty line or the space between tags (Ctrl+Space with no ``<`` typed): the same
-  elements, the ``<`` included, where one fits (not in a leaf, a full decorator or a tree
-  that has its child);
+* an empty line, the space between tags or the indentation before a tag (Ctrl+Space with
+  no ``<`` typed): the same elements, the ``<`` included, where one fits (not in a leaf, a
+  full decorator or a tree that has its child); before a tag the new element goes in front
+  of it, on a line of its own where the client inserts text as it is;
 * an end tag's name after ``</``: the element it closes;
 * an attribute name in a start tag: the ports of the node and the reserved attributes;
 * an attribute value: tree IDs in ``<SubTree ID>`` and ``main_tree_to_execute``, node types

@@ -50,6 +50,10 @@ class Completions:
     end: int
     context: str
     items: list[Item] = field(default_factory=list)
+    # Written after an item where the client inserts text as it is (no indentation added):
+    # in the indentation before a tag, the line break and indentation that keep the tag on
+    # a line of its own.
+    trail: str = ""
 
 
 # --- text helpers --------------------------------------------------------------------------

@@ -87,6 +87,7 @@ def _at_line_end(text: str, offset: int) -> bool:
 
 
 _REST_OF_LINE_RE = re.compile(r"[ \t]*")
+_TAG_AHEAD_RE = re.compile(r"[ \t]*<")
 
 
 def _fits(doc: Document, ctx: Context, parent: int) -> bool:
@@ -123,8 +124,20 @@ def between_tags(doc: Document, ctx: Context, offset: int, text_start: int) -> C
         start -= 1
     if text[text_start:start].strip(" \t\r\n"):
         return None  # after text content (BT elements have none), not between tags
+    end, lead, trail = offset, "", ""
     if start == offset and not _at_line_end(text, offset) and text[offset - 1] != ">":
-        return None  # in the indentation before a tag: the place of no new element
+        # In the indentation before a tag: a new element goes before it, at the tag's
+        # column, and the tag keeps its place (the edit ends where the tag starts).
+        found_tag = _TAG_AHEAD_RE.match(text, offset)
+        line_start = max(text.rfind("\n", 0, offset), text.rfind("\r", 0, offset)) + 1
+        if found_tag is None or text[line_start:offset].strip(" \t"):
+            return None
+        end = found_tag.end() - 1
+        # The document's own line end (CRLF, LF or a lone CR), that of the line above.
+        newline = (
+            "\r\n" if text.endswith("\r\n", 0, line_start) else text[line_start - 1 : line_start]
+        )
+        lead, trail = text[offset:end], (newline or "\n") + text[line_start:end]
     model = doc.model
     parent = innermost(model, offset)
     if parent < 0:
@@ -133,7 +146,7 @@ def between_tags(doc: Document, ctx: Context, offset: int, text_start: int) -> C
     if zone not in (Zone.ROOT, Zone.TREE, Zone.NODE, Zone.MODELS, Zone.MODEL_ENTRY):
         return None
     if not _fits(doc, ctx, parent):
-        return Completions(start, offset, "text", [])
+        return Completions(start, end, "text", [])
     found = tag_names(doc, ctx, start, offset, parent, bare=True)
     items = [
         Item(
@@ -141,14 +154,14 @@ def between_tags(doc: Document, ctx: Context, offset: int, text_start: int) -> C
             it.kind,
             it.detail,
             it.documentation,
-            insert="<" + it.insert,
-            snippet="<" + it.snippet if it.snippet is not None else None,
+            insert=lead + "<" + it.insert,
+            snippet=lead + "<" + it.snippet if it.snippet is not None else None,
             filter=it.filter or it.label,
             sort=it.sort,
         )
         for it in found.items
     ]
-    return Completions(start, offset, "text", items)
+    return Completions(start, end, "text", items, trail)
 
 
 def _structural(

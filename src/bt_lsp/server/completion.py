@@ -54,10 +54,16 @@ def register(server: BtServer) -> None:
         snippets = bool(item_caps and item_caps.snippet_support)
         formats = (item_caps.documentation_format if item_caps else None) or []
         markdown = types.MarkupKind.Markdown in formats
+        # The line break before an existing tag only where the client inserts it as it is
+        # (else it would indent the tag's line twice); without it, on the tag's line.
+        modes = item_caps.insert_text_mode_support if item_caps else None
+        as_is = bool(found.trail) and bool(modes and types.InsertTextMode.AsIs in modes.value_set)
         items: list[types.CompletionItem] = []
         for it in found.items:
             use_snippet = snippets and it.snippet is not None
             new_text = it.snippet if use_snippet and it.snippet is not None else it.insert
+            if as_is:
+                new_text += ("$0" if use_snippet and "$0" not in new_text else "") + found.trail
             items.append(
                 types.CompletionItem(
                     label=it.label,
@@ -76,6 +82,7 @@ def register(server: BtServer) -> None:
                     if use_snippet
                     else types.InsertTextFormat.PlainText,
                     text_edit=types.TextEdit(range=rng, new_text=new_text),
+                    insert_text_mode=types.InsertTextMode.AsIs if as_is else None,
                 )
             )
         return types.CompletionList(is_incomplete=False, items=items)
