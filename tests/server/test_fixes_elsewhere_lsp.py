@@ -152,6 +152,12 @@ async def test_edits_of_other_files_need_confirmation(lsp: NavClient) -> None:
         annotations = fix.edit.change_annotations or {}
         (annotation,) = annotations.values()
         assert annotation.needs_confirmation is True
+        # Which file, and why it changes.
+        assert annotation.label == "Other file: helper.xml"
+        assert annotation.description == (
+            f"{fix.title}: helper.xml uses the same name, so its references there are renamed "
+            f"too (1 edit in {lsp.ws / 'helper.xml'}, not the file you are in)"
+        )
         for dc in changes:
             assert isinstance(dc, types.TextDocumentEdit)
             for e in dc.edits:

@@ -43,6 +43,7 @@ def _workspace_edit(
     od: OpenDocument,
     edits: Sequence[TextEdit],
     other_edits: Mapping[str, Sequence[TextEdit]] | None = None,
+    what: str = "the fix",
 ) -> types.WorkspaceEdit:
     """One edit for the document and, by path, for other workspace files (converted with
     their own line index; versioned when they are open in the editor)."""
@@ -58,7 +59,7 @@ def _workspace_edit(
         open_doc = ls.get(uri)
         version = open_doc.version if open_doc is not None else None
         per_uri.append((uri, version, [to_text_edit(doc.lines, e, enc) for e in file_edits]))
-    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
+    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits, what)
 
 
 def _others(ls: BtServer, od: OpenDocument) -> dict[str, Document]:
@@ -83,7 +84,7 @@ def _fix_all_edit(ls: BtServer, od: OpenDocument) -> types.WorkspaceEdit:
     """Every preferred name fix of the document; a tree defined here is renamed in the
     other files that call it too (those edits need confirmation where the client can)."""
     fixed = fix_all(od.doc, ls.diagnostics_of(od), _others(ls, od), _context(ls, od).models)
-    return _workspace_edit(ls, od, fixed.edits, fixed.other_edits)
+    return _workspace_edit(ls, od, fixed.edits, fixed.other_edits, "Fix all bt-lsp name problems")
 
 
 def register(server: BtServer) -> None:
@@ -137,7 +138,7 @@ def register(server: BtServer) -> None:
                             "index": i,
                         }
                     else:
-                        action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits)
+                        action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits, fix.title)
                     actions.append(action)
         if _wants(only, FIX_ALL_KIND) and any(d.is_name_rule for d in diags):
             action = types.CodeAction(title="Fix all bt-lsp name problems", kind=FIX_ALL_KIND)
@@ -164,8 +165,7 @@ def register(server: BtServer) -> None:
                 fixes = _all_fixes(ls, od, d)
                 index = data.get("index")
                 if isinstance(index, int) and 0 <= index < len(fixes):
-                    action.edit = _workspace_edit(
-                        ls, od, fixes[index].edits, fixes[index].other_edits
-                    )
+                    fix = fixes[index]
+                    action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits, fix.title)
                 break
         return action

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+from urllib.parse import unquote
 
 from lsprotocol import types
+from pygls.uris import to_fs_path
 
 from bt_lsp.rules.codes import FixData, Severity
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -54,33 +56,48 @@ def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit
     return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)
 
 
-# The change annotation of the edits a fix or rename makes in files other than the one the
-# user is in: clients that support annotations (VS Code) show those edits in a preview to be
-# confirmed before they write the other files.
+# The change annotations of the edits a fix or rename makes in files other than the one the
+# user is in, one per file: clients that support annotations (VS Code) show those edits in
+# a preview, grouped under the file's annotation, to be confirmed before they are written.
 OTHER_FILES = "bt-lsp.other-files"
+
+
+def _file_name(uri: str) -> str:
+    return unquote(uri.rstrip("/").rsplit("/", 1)[-1]) or uri
 
 
 def workspace_edit(
     per_uri: list[tuple[str, int | None, list[types.TextEdit]]],
     versioned: bool,
     annotated: bool = False,
+    what: str = "the rename",
 ) -> types.WorkspaceEdit:
     """Edits to several documents as one WorkspaceEdit: versioned ``documentChanges`` when
     the client supports them (it then refuses edits to a document that has moved on),
     else plain ``changes``.  The first entry is the document the user is in; with
-    ``annotated`` (the client supports change annotations) the edits of the other
-    documents carry an annotation that needs confirmation."""
+    ``annotated`` (the client supports change annotations) the edits of each other
+    document carry an annotation of their own that needs confirmation, saying which file
+    it is and why it changes: ``what`` (``"Rename 'a b' to 'a_b' (3 places, 1 other
+    file)"``) renames the same name there."""
     if versioned:
         changes: list[types.TextDocumentEdit] = []
-        others = False
+        annotations: dict[str, types.ChangeAnnotation] = {}
         for i, (uri, version, lsp_edits) in enumerate(per_uri):
             edits: list[types.TextEdit | types.AnnotatedTextEdit | types.SnippetTextEdit]
             if annotated and i > 0 and lsp_edits:
-                others = True
+                key = f"{OTHER_FILES}.{i}"
+                name = _file_name(uri)
+                annotations[key] = types.ChangeAnnotation(
+                    label=f"Other file: {name}",
+                    needs_confirmation=True,
+                    description=(
+                        f"{what}: {name} uses the same name, so its references there are "
+                        f"renamed too ({len(lsp_edits)} edit{'s' if len(lsp_edits) != 1 else ''}"
+                        f" in {to_fs_path(uri) or unquote(uri)}, not the file you are in)"
+                    ),
+                )
                 edits = [
-                    types.AnnotatedTextEdit(
-                        range=e.range, new_text=e.new_text, annotation_id=OTHER_FILES
-                    )
+                    types.AnnotatedTextEdit(range=e.range, new_text=e.new_text, annotation_id=key)
                     for e in lsp_edits
                 ]
             else:
@@ -94,16 +111,7 @@ def workspace_edit(
                 )
             )
         return types.WorkspaceEdit(
-            document_changes=list(changes),
-            change_annotations={
-                OTHER_FILES: types.ChangeAnnotation(
-                    label="Other files",
-                    needs_confirmation=True,
-                    description="bt-lsp renames the same name in files other than this one",
-                )
-            }
-            if others
-            else None,
+            document_changes=list(changes), change_annotations=annotations or None
         )
     return types.WorkspaceEdit(changes={uri: list(e) for uri, _, e in per_uri})
 
