@@ -19,7 +19,7 @@ import subprocess
 import sys
 import time
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -136,9 +136,12 @@ class CodeServer:
 
 
 @contextmanager
-def _code_server(tmp_path: Path, files: dict[str, str] | None = None) -> Iterator[CodeServer]:
+def _code_server(
+    tmp_path: Path, files: dict[str, str] | None = None, settings: Mapping[str, object] = {}
+) -> Iterator[CodeServer]:
     """code-server on 127.0.0.1 with the extension, an isolated user-data dir and a workspace
-    holding ``files`` (name -> text; by default tree.xml)."""
+    holding ``files`` (name -> text; by default tree.xml); ``settings`` override the user
+    settings."""
     workspace = tmp_path / "ws"
     workspace.mkdir()
     for name, text in (files or {"tree.xml": TREE}).items():
@@ -149,7 +152,7 @@ def _code_server(tmp_path: Path, files: dict[str, str] | None = None) -> Iterato
     xdg = tmp_path / "xdg"
 
     server_command = [sys.executable, "-m", "bt_lsp", "serve"]
-    settings = {
+    user_settings: dict[str, object] = {
         "btLsp.server.command": server_command,
         "btLsp.trace.server": "messages",
         "security.workspace.trust.enabled": False,
@@ -165,7 +168,8 @@ def _code_server(tmp_path: Path, files: dict[str, str] | None = None) -> Iterato
         "chat.commandCenter.enabled": False,
         "files.autoSave": "off",
     }
-    (user_data / "User" / "settings.json").write_text(json.dumps(settings, indent=2))
+    user_settings.update(settings)
+    (user_data / "User" / "settings.json").write_text(json.dumps(user_settings, indent=2))
 
     env = dict(os.environ)
     env.update(

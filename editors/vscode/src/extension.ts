@@ -100,7 +100,11 @@ function serverSettings(): Record<string, unknown> {
 }
 
 async function startClient(): Promise<void> {
-  const resource = vscode.window.activeTextEditor?.document.uri ?? vscode.workspace.workspaceFolders?.[0]?.uri;
+  // The settings of the file in front (its folder's), unless that is not a file of the
+  // workspace (say, the settings.json just edited to fix the command).
+  const active = vscode.window.activeTextEditor?.document.uri;
+  const resource =
+    active && (active.scheme === 'file' || active.scheme === 'untitled') ? active : vscode.workspace.workspaceFolders?.[0]?.uri;
   const { server, tried } = await resolveServerCommand(resource, log);
   tried.forEach((line) => log.info(line));
   if (!server) {
@@ -159,9 +163,15 @@ async function startClient(): Promise<void> {
     }
     // When the process exits during startup (say, `No module named bt_lsp`), the client only
     // knows that its pending request was dropped; what the process said is in the log.
-    const why = /connection got disposed/.test(errorText(error))
+    // Node's own wording (`Error: spawn /x ENOENT`) says in code what one word says plainly.
+    const text = errorText(error);
+    const why = /connection got disposed/.test(text)
       ? 'the server process exited before it answered (its messages are in the bt-lsp output)'
-      : firstLine(errorText(error));
+      : /\bENOENT\b/.test(text)
+        ? `${server.command} does not exist`
+        : /\bEACCES\b/.test(text)
+          ? `${server.command} is not executable`
+          : firstLine(text);
     showInstallHelp(`could not start ${JSON.stringify(argv)} (${server.origin}): ${why}`, []);
   }
 }
