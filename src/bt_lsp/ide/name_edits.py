@@ -7,12 +7,12 @@ included) on top of these, and :mod:`bt_lsp.ide.name_fixes` uses those renames.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import NamedTuple
 
 from bt_lsp.rules.context import ModelDecl
 from bt_lsp.syntax.edits import TextEdit, escape_value
-from bt_lsp.syntax.elements import NameRef, Role, Symbol
+from bt_lsp.syntax.elements import NameRef, NameSymbol, Role, Symbol
 from bt_lsp.syntax.model import Model
 
 __all__ = [
@@ -125,6 +125,7 @@ def elsewhere(
     symbol: Symbol | None,
     models: Iterable[Model],
     registered: Mapping[str, ModelDecl] | None = None,
+    defined: Callable[[NameSymbol], bool] | None = None,
 ) -> Elsewhere | None:
     """Whether ``symbol``'s target is outside the documents of ``models`` (the workspace):
 
@@ -138,7 +139,9 @@ def elsewhere(
       workspace renamed with it would leave the registration with the old name.
 
     ``None`` when the target is here, or when there is none: an instance name, and an
-    empty name (nothing is registered or defined under it, so no reference works)."""
+    empty name (nothing is registered or defined under it, so no reference works).
+    ``defined`` says whether a tree or node type is defined in the workspace, when the
+    caller knows it more cheaply than from the models' name tokens."""
     if symbol is None or not symbol.name:
         return None
     if symbol.kind == "port":
@@ -147,9 +150,15 @@ def elsewhere(
     else:
         owner = symbol
         subject = ""
-    models = list(models)
+    if defined is None:
+        found_in = list(models)
+
+        def defined(owner: NameSymbol) -> bool:
+            role = Role.TREE_DEF if owner.kind == "tree" else Role.MODEL_DEF
+            return any(r.role == role for m in found_in for r in m.refs_to(owner))
+
     if owner.kind == "tree":
-        if any(r.role == Role.TREE_DEF for m in models for r in m.refs_to(owner)):
+        if defined(owner):
             return None
         tree = shown(owner.name)
         return Elsewhere(
@@ -170,7 +179,7 @@ def elsewhere(
         node = shown(owner.name)
         decl = registered.get(owner.name) if registered is not None else None
         in_cpp = decl is not None and decl.source == "cpp" and decl.path is not None
-        if not in_cpp and any(r.role == Role.MODEL_DEF for m in models for r in m.refs_to(owner)):
+        if not in_cpp and defined(owner):
             return None
         found = _registered_where(decl)
         short, full = (

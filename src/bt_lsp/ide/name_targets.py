@@ -18,11 +18,10 @@ from dataclasses import replace
 from typing import Final
 
 from bt_lsp.ide.name_edits import Elsewhere, elsewhere
-from bt_lsp.rules.context import ModelDecl
+from bt_lsp.rules.context import ModelDecl, facts_of
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.elements import Symbol
-from bt_lsp.syntax.model import Model
+from bt_lsp.syntax.elements import NameSymbol, Symbol
 
 __all__ = ["with_targets"]
 
@@ -55,7 +54,17 @@ def with_targets(
     where the name must change first.  The other diagnostics are the same objects."""
     out = list(diags)
     model = doc.model
-    models: list[Model] | None = None
+    # What the workspace defines, from the declarations the context is made of (kept per
+    # section), not from every name token of every document.
+    ids: tuple[set[str], set[str]] | None = None
+
+    def defined(owner: NameSymbol) -> bool:
+        nonlocal ids
+        if ids is None:
+            facts = [facts_of(doc), *(facts_of(o) for o in (others or {}).values())]
+            ids = ({t.id for f in facts for t in f.trees}, {m.id for f in facts for m in f.models})
+        return owner.name in ids[0 if owner.kind == "tree" else 1]
+
     found: dict[Symbol, Elsewhere | None] = {}
     for i, d in enumerate(out):
         if not d.is_name_rule:
@@ -65,9 +74,7 @@ def with_targets(
             continue
         sym = ref.symbol
         if sym not in found:
-            if models is None:
-                models = [model, *(o.model for o in (others or {}).values())]
-            found[sym] = elsewhere(sym, models, registered)
+            found[sym] = elsewhere(sym, (), registered, defined)
         away = found[sym]
         if away is not None and away.first:
             out[i] = _amended(d, away.first)
