@@ -9,6 +9,7 @@ from bt_lsp.ide.catalog import BUILTIN_CATALOG_V3, builtin_catalog
 from bt_lsp.ide.completion import complete
 from bt_lsp.ide.definition import definition
 from bt_lsp.ide.hover import hover_at
+from bt_lsp.ide.rename import RenameRefused, rename
 from bt_lsp.rules import semantics
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.builtins import BUILTINS
@@ -211,3 +212,33 @@ def test_definition_in_a_v3_document_leads_to_the_3_8_catalog() -> None:
     assert cat.text[place.start : place.end] == "success_threshold"
     # Version 4 has neither.
     assert definition(d, V3_DOC.index("SequenceStar") + 3, ctx=v3_context(d, "4")) == []
+
+
+def _rename(body: str, at: str, new: str, version: str | None) -> str:
+    """The refusal of renaming the name at ``at`` in a document of ``version``, or ``ok``."""
+    d = doc(body)
+    try:
+        plan = rename(d, d.text.index(at) + 1, new, version=version)
+    except RenameRefused as e:
+        return e.message
+    assert plan is not None
+    return "ok"
+
+
+def test_rename_keeps_the_built_ins_of_the_projects_version() -> None:
+    star = "<SequenceStar><AlwaysSuccess/></SequenceStar>"
+    # 3.8 registers SequenceStar; 4.x does not, so there it is the project's own node.
+    assert "built-in node type" in _rename(star, "SequenceStar", "Seq", "3")
+    assert _rename(star, "SequenceStar", "Seq", "4") == "ok"
+    # Sleep is 4.x's built-in only: a v3 project's Sleep is its own.
+    sleep = '<Sleep msec="5"/>'
+    assert "built-in node type" in _rename(sleep, "Sleep", "Nap", "4")
+    assert _rename(sleep, "Sleep", "Nap", "3") == "ok"
+    # A 3.8 built-in's port is 3.8's to name.
+    check = '<BlackboardCheckInt value_A="1" value_B="1"><AlwaysSuccess/></BlackboardCheckInt>'
+    assert "port of the built-in node" in _rename(check, "value_A", "a", "3")
+    # A new name may not be one of the version's built-ins.
+    mine = "<MyNode/>"
+    assert "built-in node type" in _rename(mine, "MyNode", "SequenceStar", "3")
+    assert _rename(mine, "MyNode", "SequenceStar", "4") == "ok"
+    assert _rename(mine, "MyNode", "Sleep", "3") == "ok"

@@ -19,6 +19,7 @@ from typing import Any
 import pytest
 import pytest_lsp
 from lsprotocol import types
+from pygls.exceptions import JsonRpcException
 from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig
 
@@ -276,6 +277,15 @@ async def test_a_v3_package_gets_3_8s_nodes_in_diagnostics_completion_and_hover(
     assert isinstance(defined, list) and len(defined) == 1
     assert isinstance(defined[0], types.Location)
     assert defined[0].uri.endswith("/builtins-v3.xml")
+    # 3.8's SequenceStar keeps its name: a rename is refused.
+    with pytest.raises(JsonRpcException) as info:
+        await client.text_document_prepare_rename_async(
+            types.PrepareRenameParams(
+                text_document=types.TextDocumentIdentifier(uri=uri),
+                position=client.pos(HUMBLE, HUMBLE.index("SequenceStar") + 2),
+            )
+        )
+    assert "'SequenceStar' is a built-in node type" in str(info.value)
 
 
 async def test_the_version_is_logged_once_per_change(client: BtClient) -> None:

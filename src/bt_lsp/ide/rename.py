@@ -20,7 +20,8 @@ from bt_lsp.ide.name_edits import (
     shown,
     taken_names,
 )
-from bt_lsp.rules.builtins import BUILTINS
+from bt_lsp.rules.builtins import NodeModel
+from bt_lsp.rules.builtins_v3 import builtins_for
 from bt_lsp.rules.context import ModelDecl
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
 from bt_lsp.syntax.document import Document
@@ -84,12 +85,13 @@ def _refuse_key_use(k: KeyRef) -> None:
         )
 
 
-def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
+def prepare_rename(doc: Document, offset: int, version: str | None = None) -> RenameTarget | None:
     """The name a rename at ``offset`` would change, ``None`` when there is none there.
 
     Raises :class:`RenameRefused` for names that cannot be renamed from XML (the built-in
-    nodes of BehaviorTree.CPP and their ports) and for blackboard keys that cannot be
-    renamed (see :func:`rename`)."""
+    nodes of the project's BehaviorTree.CPP ``version`` and their ports) and for
+    blackboard keys that cannot be renamed (see :func:`rename`)."""
+    builtins = builtins_for(version)
     ref = doc.model.ref_at(offset)
     if ref is None:
         key = key_at(doc, offset)
@@ -98,7 +100,7 @@ def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
         _refuse_key_use(key)
         return RenameTarget(key.start, key.end, key.key, key=key)
     sym = ref.symbol
-    if sym is not None and sym.kind == "model" and sym.name in BUILTINS:
+    if sym is not None and sym.kind == "model" and sym.name in builtins:
         raise RenameRefused(
             f"'{shown(sym.name)}' is a built-in node type of BehaviorTree.CPP; it cannot be renamed"
         )
@@ -106,8 +108,8 @@ def prepare_rename(doc: Document, offset: int) -> RenameTarget | None:
         sym is not None
         and sym.kind == "port"
         and sym.owner_kind == "model"
-        and sym.owner in BUILTINS
-        and BUILTINS[sym.owner].port(sym.name) is not None
+        and sym.owner in builtins
+        and builtins[sym.owner].port(sym.name) is not None
     ):
         raise RenameRefused(
             f"'{shown(sym.name)}' is a port of the built-in node '{sym.owner}'; "
@@ -132,6 +134,7 @@ def _check_new_name(
     model: Model,
     others: Mapping[str, Document],
     taken: Collection[str] | None = None,
+    builtins: Mapping[str, NodeModel] | None = None,
 ) -> None:
     """Refuse a new name that breaks a rule of the name, or that another name of its
     namespace has (``taken``: those names, when the caller knows them already)."""
@@ -164,7 +167,7 @@ def _check_new_name(
         )
     if new_name == sym.name:
         return
-    if sym.kind != "port" and new_name in BUILTINS:
+    if sym.kind != "port" and new_name in (builtins_for(None) if builtins is None else builtins):
         _refuse_new_name(
             new_name,
             "it is a built-in node type of BehaviorTree.CPP, and trees and node types share "
@@ -384,9 +387,11 @@ class Renamer:
         doc: Document,
         others: Mapping[str, Document] | None = None,
         registered: Mapping[str, ModelDecl] | None = None,
+        version: str | None = None,
     ) -> None:
         self._graph = KeyGraph(doc, others or {})
         self._registered = registered  # the context's models: where node types come from
+        self._builtins = builtins_for(version)
         self._elsewhere: dict[Symbol, Elsewhere | None] = {}
 
     def elsewhere(self, sym: Symbol | None) -> Elsewhere | None:
@@ -424,7 +429,7 @@ class Renamer:
         away = self.elsewhere(ref.symbol)
         if away is not None and away.refuse:
             raise RenameRefused(f"Cannot rename {away.what}: {away.why}")
-        _check_new_name(ref, new_name, graph.doc.model, graph.others, taken)
+        _check_new_name(ref, new_name, graph.doc.model, graph.others, taken, self._builtins)
         sym = ref.symbol
         if sym is None:
             return RenamePlan(tuple(rename_edits([ref], new_name)))
@@ -455,13 +460,16 @@ def rename(
     new_name: str,
     others: Mapping[str, Document] | None = None,
     registered: Mapping[str, ModelDecl] | None = None,
+    version: str | None = None,
 ) -> RenamePlan | None:
     """Rename the name under ``offset`` and every reference to it in the workspace.
 
     ``None`` when there is no name there; raises :class:`RenameRefused` when the name cannot
     be renamed or ``new_name`` breaks a rule (the message gives the rule's reason).  A port
     attribute renamed while its value is ``{=}`` or ``=`` (the key named like the port)
-    gets that key written out, so that the node keeps its key.
+    gets that key written out, so that the node keeps its key.  ``version`` is the
+    project's BehaviorTree.CPP major version: its built-in nodes keep their names, and a
+    node of the project named like another version's built-in is the project's own.
 
     A blackboard key (under the cursor in ``{key}``, at the ``=`` of ``{=}`` or as a script
     identifier) is renamed in the tree that uses it, because BehaviorTree.CPP gives each
@@ -497,10 +505,10 @@ def rename(
     namespace, two keys it would merge) carries :attr:`RenameRefused.new_name`: another
     name may do.
     """
-    target = prepare_rename(doc, offset)
+    target = prepare_rename(doc, offset, version)
     if target is None:
         return None
-    renamer = Renamer(doc, others, registered)
+    renamer = Renamer(doc, others, registered, version)
     if target.key is not None:
         return renamer.key_plan(target.key, new_name)
     ref = target.ref

@@ -374,7 +374,7 @@ def register(server: BtServer) -> None:
         if req is None:
             return None
         try:
-            target = rename_target(req.doc, req.offset)
+            target = rename_target(req.doc, req.offset, req.context().btcpp_version)
         except RenameRefused as e:
             raise RequestFailed(e.message) from None
         if target is None:
@@ -397,6 +397,7 @@ def register(server: BtServer) -> None:
                 req.offset,
                 params.new_name,
                 {k: s.doc for k, s in sources.items()},
+                version=req.context().btcpp_version,
             )
         except RenameRefused as e:
             raise RequestFailed(e.message) from None
