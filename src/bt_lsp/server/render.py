@@ -84,12 +84,13 @@ class _Places:
         self.ls = ls
         self.uri = uri
         self.doc = doc
-        self.cache: dict[str, tuple[str, Document] | None] = {}
+        # The URI and document of each source asked for (None: none found).
+        self._by_source: dict[str, tuple[str, Document] | None] = {}
 
     def get(self, source: str | None) -> tuple[str, Document] | None:
         if source is None:
             return self.uri, self.doc
-        if source not in self.cache:
+        if source not in self._by_source:
             path = Path(source)
             found: tuple[str, Document] | None = None
             for od in self.ls.docs.values():  # an open document's text wins over the file
@@ -98,8 +99,8 @@ class _Places:
             if found is None:
                 doc = self.ls.project.document(path)
                 found = (from_fs_path(source) or source, doc) if doc is not None else None
-            self.cache[source] = found
-        return self.cache[source]
+            self._by_source[source] = found
+        return self._by_source[source]
 
 
 def _nodes(
