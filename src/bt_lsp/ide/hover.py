@@ -11,7 +11,6 @@ import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
 from bt_lsp.ide.name_edits import elsewhere, occurrences
@@ -56,7 +55,20 @@ def file_link(shown: str, path: str | None) -> str:
     line = shown.rpartition(":")[2]
     anchor = f"#L{line}" if line.isdigit() else ""
     label = shown.replace("[", "\\[").replace("]", "\\]")
-    return f"[{label}]({Path(path).as_uri()}{anchor})"
+    return f"[{label}]({file_uri(path)}{anchor})"
+
+
+_URI_SAFE = frozenset(b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-._~/")
+
+
+def file_uri(path: str) -> str:
+    """The ``file://`` URI of an absolute path, percent-encoded as RFC 8089 writes it
+    (written out here because the core imports no file-system or URL module)."""
+    drive, rest = os.path.splitdrive(path)
+    if drive:  # Windows: file:///C:/...
+        rest, drive = rest.replace("\\", "/"), "/" + drive
+    raw = rest.encode("utf-8", "surrogateescape")
+    return "file://" + drive + "".join(chr(b) if b in _URI_SAFE else f"%{b:02X}" for b in raw)
 
 
 class _Writer:
