@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -67,3 +69,56 @@ def test_looks_like_bt() -> None:
     assert looks_like_bt("<x><BehaviorTree ID='a'/></x>")
     assert not looks_like_bt("<launch><node name='a.b'/></launch>")
     assert not looks_like_bt("<package><name>rootless</name></package>")
+
+
+def _fresh_model(text: str) -> list[tuple[str, int, int]]:
+    return [(e.name, e.token_start, e.end) for e in Document(text).model.elements]
+
+
+def test_a_snapshot_is_left_alone_by_later_edits() -> None:
+    doc = Document(BASE)
+    doc.model  # noqa: B018 - the edit below then builds from a base model
+    snap = doc.snapshot()
+    doc.edit(0, 0, "<!-- x -->")
+    assert snap.text == BASE and doc.text.startswith("<!-- x -->")
+    assert [(e.name, e.token_start, e.end) for e in snap.model.elements] == _fresh_model(BASE)
+    assert [(e.name, e.token_start, e.end) for e in doc.model.elements] == _fresh_model(doc.text)
+    assert own_diagnostics(snap) == own_diagnostics(Document(BASE))
+
+
+def test_adopt_keeps_what_a_snapshot_built_only_if_unedited() -> None:
+    doc = Document(BASE)
+    snap = doc.snapshot()
+    own = own_diagnostics(snap)
+    doc.adopt(snap)
+    assert doc.model is snap.model and doc.own_diagnostics is own
+    edited = Document(BASE)
+    later = edited.snapshot()
+    later.model  # noqa: B018
+    edited.edit(0, 0, " ")
+    edited.adopt(later)
+    assert edited.model is not later.model
+    assert edited.model.elements[0].token_start == 1
+
+
+def test_a_model_built_while_an_edit_came_in_is_not_kept(monkeypatch: Any) -> None:
+    """Another thread may edit the document while its model is built (outside the
+    lock): that model answers the caller who asked, and the next one is of the edit."""
+    import bt_lsp.syntax.document as document
+
+    doc = Document(BASE)
+    real = document.build  # type: ignore[attr-defined]
+    calls: list[int] = []
+
+    def build_with_an_edit(*args: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 1:
+            doc.edit(0, 0, "  ")  # what the other thread does meanwhile
+        return real(*args)
+
+    monkeypatch.setattr(document, "build", build_with_an_edit)
+    stale = doc.model
+    assert stale.elements[0].token_start == 0  # built from the state before the edit
+    fresh = doc.model
+    assert fresh is not stale and fresh.elements[0].token_start == 2
+    assert doc.model is fresh and len(calls) == 2

@@ -108,8 +108,15 @@ def _assert_names_of(
     assert any(_WORKSPACE_CLAUSE.search(d.message) for d in complete.diagnostics)
 
 
-async def _publications(client: BtClient, uri: str) -> list[types.PublishDiagnosticsParams]:
-    await client.barrier()  # the server answers only after handling the open
+async def _publications(
+    client: BtClient, uri: str, count: int = 2
+) -> list[types.PublishDiagnosticsParams]:
+    """The document's publications once ``count`` arrived (the complete set of a large
+    document comes from the worker thread), and whatever a request after brings."""
+    await client.wait_until(
+        lambda: len(client.published.get(uri, [])) >= count or None, f"{count} publications"
+    )
+    await client.barrier()  # the early names are published while the open is handled
     return client.published.get(uri, [])
 
 
@@ -155,7 +162,7 @@ async def test_small_or_malformed_documents_are_published_once(client: BtClient)
     for text in (small, malformed):
         uri = client.open(text)
         try:
-            (only,) = await _publications(client, uri)
+            (only,) = await _publications(client, uri, 1)
             assert "model-name-forbidden-char" in {d.code for d in only.diagnostics}
         finally:
             client.close(uri)
@@ -166,7 +173,7 @@ async def test_pull_clients_get_no_early_push(client: BtClient) -> None:
     doc, codes = big_document()
     uri = client.open(doc.text)
     try:
-        assert await _publications(client, uri) == []
+        assert await _publications(client, uri, 0) == []
         report = await client.pull_report(uri)
         assert isinstance(report, types.RelatedFullDocumentDiagnosticReport)
         assert sorted(str(d.code) for d in names_only(report.items)) == sorted(codes)

@@ -95,10 +95,13 @@ def register(server: BtServer) -> None:
             resolve_provider=True,
         ),
     )
-    def code_action(
+    async def code_action(
         ls: BtServer, params: types.CodeActionParams
     ) -> list[types.CodeAction | types.Command] | None:
         od = ls.get(params.text_document.uri)
+        if od is not None:
+            await ls.analysed(od)  # a large document on the worker thread
+            od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return []
         enc = ls.encoding
@@ -150,11 +153,14 @@ def register(server: BtServer) -> None:
         return actions
 
     @server.feature(types.CODE_ACTION_RESOLVE)
-    def resolve(ls: BtServer, action: types.CodeAction) -> types.CodeAction:
+    async def resolve(ls: BtServer, action: types.CodeAction) -> types.CodeAction:
         data: Any = action.data
         if not isinstance(data, dict):
             return action
         od = ls.get(str(data.get("uri")))
+        if od is not None:
+            await ls.analysed(od)  # a large document on the worker thread
+            od = ls.get(str(data.get("uri")))
         if od is None or od.version != data.get("version"):
             return action  # the document changed; the client asks again
         if data.get("fixAll"):

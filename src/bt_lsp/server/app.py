@@ -30,6 +30,7 @@ from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
 from bt_lsp.server import transport
+from bt_lsp.server.background import Background
 from bt_lsp.server.convert import diagnostic_at
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
@@ -42,7 +43,7 @@ from bt_lsp.server.project import (
 )
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.syntax.document import looks_like_bt
+from bt_lsp.syntax.document import Document, looks_like_bt
 from bt_lsp.syntax.text import Encoding, normalize_encoding, positions_of
 
 log = logging.getLogger(__name__)
@@ -92,6 +93,7 @@ class BtServer(LanguageServer):
         # Package folder (or document) -> the BehaviorTree.CPP version logged for it.
         self.versions_logged: dict[Path, tuple[str | None, str]] = {}
         self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
+        self.background = Background(self)  # large documents are analysed off the loop
 
     @property
     def bt_protocol(self) -> BtProtocol:
@@ -129,27 +131,55 @@ class BtServer(LanguageServer):
         if self.project.revalidate():
             self.refresh_all()
 
+    def diagnostics_key(self, od: OpenDocument) -> tuple[int | None, int, int]:
+        """What ``od``'s diagnostics depend on: its version, the settings and the rest of
+        the workspace (every open document's edits included)."""
+        return (od.version, self.generation, self.project.generation + self.edits)
+
     def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
         """The document's diagnostics after severity settings, cached per version."""
         self.check_disk()
-        key = (od.version, self.generation, self.project.generation + self.edits)
+        key = self.diagnostics_key(od)
         if od.cache_key == key:
             return od.cached
+        self.diagnostics_computed(od, key, self.compute_diagnostics(od, od.doc))
+        return od.cached
+
+    def compute_diagnostics(self, od: OpenDocument, doc: Document) -> list[Diagnostic]:
+        """The diagnostics of ``doc`` (``od``'s document or a snapshot of it) after
+        severity settings.  Sends nothing, so the worker thread may call it."""
         if not od.is_bt:
-            result: list[Diagnostic] = self.cpp.diagnostics(od)
+            return self.cpp.diagnostics(od)
+        if doc.utf8_size > self.settings.max_document_bytes:
+            result = size_limited(doc, self.settings.max_document_bytes)
+        elif od.path is not None:
+            result = self.project.diagnostics(od.path, doc)
         else:
-            if od.doc.utf8_size > self.settings.max_document_bytes:
-                result = size_limited(od.doc, self.settings.max_document_bytes)
-            elif od.path is not None:
-                result = self.project.diagnostics(od.path, od.doc)
-                log_version(self, od.path)
-            else:
-                result = with_targets(od.doc, analyze(od.doc))
-            settings = self.settings if od.path is None else self.project.settings_for(od.path)
-            result = with_severities(result, settings.severity)
+            result = with_targets(doc, analyze(doc))
+        settings = self.settings if od.path is None else self.project.settings_for(od.path)
+        return with_severities(result, settings.severity)
+
+    def diagnostics_computed(
+        self, od: OpenDocument, key: tuple[int | None, int, int], result: list[Diagnostic]
+    ) -> None:
+        """Keep ``od``'s diagnostics for ``key``, and say what computing them found."""
         od.cache_key, od.cached = key, result
+        if od.is_bt and od.path is not None:
+            log_version(self, od.path)
         sync_config_diagnostics(self)  # the files' settings were made: their errors known
-        return result
+
+    async def analysed(self, od: OpenDocument) -> None:
+        """Wait, without holding the loop, until ``od``'s diagnostics are current: a
+        large document is analysed on the worker thread (:mod:`bt_lsp.server.background`),
+        others when :meth:`diagnostics_of` is called."""
+        while self.get(od.uri) is od and self.background.wants(od):
+            self.check_disk()
+            key = self.diagnostics_key(od)
+            if od.cache_key == key:
+                return
+            found = await asyncio.shield(self.background.analyse(od))
+            if found is None and self.diagnostics_key(od) == key:
+                return  # it failed (and was logged): the caller finds out for itself
 
     def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
         diags = self.diagnostics_of(od)
@@ -225,6 +255,13 @@ class BtServer(LanguageServer):
         if not od.is_bt and od.path is not None and od.path.name in CONFIG_NAMES:
             sync_config_diagnostics(self)  # a configuration file's diagnostics are its error
             return
+        if self.background.wants(od):
+            self.check_disk()
+            if od.cache_key != self.diagnostics_key(od):
+                if not self.background.busy(od):  # else its end publishes
+                    done = self.background.analyse(od)
+                    done.add_done_callback(lambda f: self._analysed(uri, f))
+                return
         try:
             array = od.published.array(
                 od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
@@ -238,7 +275,12 @@ class BtServer(LanguageServer):
             f'{{"uri": {json.dumps(uri)}, "diagnostics": {array}{version}}}',
         )
 
+    def _analysed(self, uri: str, done: asyncio.Future[list[Diagnostic] | None]) -> None:
+        if done.result() is not None:  # else what changed the document publishes
+            self.publish(uri)
+
     def clear(self, uri: str) -> None:
+        self.background.forget(uri)
         timer = self._timers.pop(uri, None)
         if timer is not None:
             timer.cancel()

@@ -92,10 +92,13 @@ def register(server: BtServer) -> None:
             identifier="bt-lsp", inter_file_dependencies=True, workspace_diagnostics=False
         ),
     )
-    def diagnostic(
+    async def diagnostic(
         ls: BtServer, params: types.DocumentDiagnosticParams
     ) -> types.DocumentDiagnosticReport:
         od = ls.get(params.text_document.uri)
+        if od is not None:
+            await ls.analysed(od)  # a large document on the worker thread
+            od = ls.get(params.text_document.uri)
         if od is None:
             return types.RelatedFullDocumentDiagnosticReport(items=[], result_id=None)
         # Everything the diagnostics depend on (see BtServer.diagnostics_of), other

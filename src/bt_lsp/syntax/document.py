@@ -4,11 +4,17 @@ An edit re-scans only the tokens around it (:func:`bt_lsp.syntax.scanner.rescan`
 line index in place of rebuilding it; the model is derived lazily from
 the tokens when first asked for, the model from the previous one (only the sections around
 the tokens replaced since are built again, see :mod:`bt_lsp.syntax.builder`).
+
+An edit replaces the text, line index and tokens with new objects and never changes the
+old ones, so :meth:`Document.snapshot` is a cheap copy that another thread can analyse
+while the editor keeps editing; the model is built from one consistent state under a
+short lock, and kept only if no edit came in meanwhile.
 """
 
 from __future__ import annotations
 
 import re
+import threading
 from typing import Any
 
 from bt_lsp.syntax.builder import build
@@ -34,9 +40,39 @@ class Document:
         self._change: Rescan | None = None
         self._is_bt: bool | None = None
         self._utf8_size: int | None = None
+        # Guards the state read to build a model against an edit on another thread (held
+        # only to read or write attributes, never while building).
+        self._lock = threading.Lock()
+        self._edits = 0  # bumped by every edit: a model built before it is not kept
+
+    def snapshot(self) -> Document:
+        """A copy that later edits of this document leave alone, for analysing it on
+        another thread (the text, line index, tokens and model are shared, not copied)."""
+        snap = Document.__new__(Document)
+        with self._lock:
+            snap.__dict__.update(self.__dict__)
+        snap._lock = threading.Lock()
+        return snap
+
+    def adopt(self, snap: Document) -> None:
+        """Keep what the analysis of ``snap`` (a :meth:`snapshot` of this document) built,
+        the model and own diagnostics, if this document was not edited since."""
+        with self._lock:
+            if snap.scan is not self.scan or snap.text is not self.text:
+                return
+            if self._model is None and snap._model is not None:
+                self._model = snap._model
+                self._base = self._change = None
+            if self.own_diagnostics is None:
+                self.own_diagnostics = snap.own_diagnostics
 
     def edit(self, start: int, end: int, new_text: str) -> None:
         """Replace ``text[start:end]`` (code-point offsets, clamped) with ``new_text``."""
+        with self._lock:
+            self._edit(start, end, new_text)
+
+    def _edit(self, start: int, end: int, new_text: str) -> None:
+        self._edits += 1
         n = len(self.text)
         start = min(max(start, 0), n)
         end = min(max(end, start), n)
@@ -54,15 +90,30 @@ class Document:
         self._utf8_size = None
 
     def replace_all(self, text: str) -> None:
-        self.__init__(text, self.path)  # type: ignore[misc]
+        fresh = Document(text, self.path)
+        with self._lock:
+            edits = self._edits + 1
+            lock = self._lock
+            self.__dict__.update(fresh.__dict__)
+            self._lock, self._edits = lock, edits
 
     @property
     def model(self) -> Model:
-        if self._model is None:
-            with gc_paused():
-                self._model = build(self.scan, self.text, self._base, self._change)
-            self._base = self._change = None
-        return self._model
+        model = self._model
+        if model is not None:
+            return model
+        with self._lock:
+            if self._model is not None:
+                return self._model
+            state = self.scan, self.text, self._base, self._change
+            edits = self._edits
+        with gc_paused():
+            model = build(*state)
+        with self._lock:
+            if self._edits == edits and self._model is None:
+                self._model = model
+                self._base = self._change = None
+        return model
 
     @property
     def is_bt(self) -> bool:

@@ -1,0 +1,167 @@
+"""A document at ``maxDocumentBytes`` is analysed off the event loop: requests on other
+documents, and the diagnostics of a small document being typed in, are answered before
+its analysis ends, and its own diagnostics still arrive, of its latest version.
+
+Through a raw stdio client, which sees every message in the order the server wrote it:
+the test asserts that order, never a time."""
+
+from __future__ import annotations
+
+import queue
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+
+from tests.server.test_framing import TIMEOUT, RawServer, frame, msg
+
+SMALL_URI = "untitled:small.xml"
+BIG_URI = "untitled:big.xml"
+SMALL = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main"><Sequence><AlwaysSuccess/></Sequence></BehaviorTree>\n'
+    "</root>\n"
+)
+# A bad name only the edit of the small document brings.
+SMALL_EDITED = SMALL.replace("<AlwaysSuccess/>", '<AlwaysSuccess na.me="x"/>')
+TAGS = "<AlwaysSuccess/><Fallback><AlwaysFailure/></Fallback>"
+LINE = '    <Sequence name="s{i}">' + TAGS + "</Sequence>\n"
+SIZE = 2 * 1024 * 1024
+
+
+def big_document(marker: str) -> str:
+    """About :data:`SIZE` bytes of valid trees, with one node type nobody registers
+    (``unknown-node`` is a semantic diagnostic: only the complete analysis finds it)."""
+    head = '<root BTCPP_format="4" main_tree_to_execute="Main">\n  <BehaviorTree ID="Main">\n'
+    head += f"    <{marker}/>\n"
+    tail = "  </BehaviorTree>\n</root>\n"
+    body = []
+    size = len(head) + len(tail)
+    i = 0
+    while size < SIZE:
+        line = LINE.format(i=i)
+        body.append(line)
+        size += len(line)
+        i += 1
+    return head + "".join(body) + tail
+
+
+def open_params(uri: str, text: str, version: int = 1) -> dict[str, Any]:
+    return {"textDocument": {"uri": uri, "languageId": "xml", "version": version, "text": text}}
+
+
+def hover(uri: str, msg_id: int, line: int = 1) -> bytes:
+    params = {"textDocument": {"uri": uri}, "position": {"line": line, "character": 30}}
+    return frame(msg("textDocument/hover", params, msg_id))
+
+
+class Session:
+    """A server whose messages are read in order, as they were written."""
+
+    def __init__(self, limit: int) -> None:
+        self.raw = RawServer()
+        self.log: list[dict[str, Any]] = []
+        options = {"debounceMs": 0, "maxDocumentBytes": limit}
+        init: dict[str, Any] = {"capabilities": {}, "processId": None, "rootUri": None}
+        self.raw.write(frame(msg("initialize", {**init, "initializationOptions": options}, 0)))
+        self.until(lambda m: m.get("id") == 0 and "method" not in m)
+        self.raw.write(frame(msg("initialized", {})))
+
+    def until(self, found: Callable[[dict[str, Any]], bool]) -> int:
+        """Read messages until one is ``found``; its index in :attr:`log`."""
+        for i, m in enumerate(self.log):
+            if found(m):
+                return i
+        while True:
+            try:
+                m = self.raw.inbox.get(timeout=TIMEOUT)
+            except queue.Empty:
+                raise AssertionError(f"nothing found within {TIMEOUT}s") from None
+            self.log.append(m)
+            if found(m):
+                return len(self.log) - 1
+
+
+def answer(msg_id: int) -> Callable[[dict[str, Any]], bool]:
+    return lambda m: "method" not in m and m.get("id") == msg_id
+
+
+def published(
+    uri: str, version: int | None = None, code: str | None = None
+) -> Callable[[dict[str, Any]], bool]:
+    """A publication for ``uri`` (of ``version``, holding ``code``)."""
+
+    def found(m: dict[str, Any]) -> bool:
+        if m.get("method") != "textDocument/publishDiagnostics" or m["params"]["uri"] != uri:
+            return False
+        if version is not None and m["params"].get("version") != version:
+            return False
+        return code is None or any(d.get("code") == code for d in m["params"]["diagnostics"])
+
+    return found
+
+
+@pytest.fixture
+def session() -> Iterator[Session]:
+    s = Session(limit=len(big_document("Frobnicate").encode()))
+    try:
+        s.raw.write(frame(msg("textDocument/didOpen", open_params(SMALL_URI, SMALL))))
+        s.raw.write(hover(SMALL_URI, 1))  # everything is imported and ready
+        s.until(answer(1))
+        yield s
+    finally:
+        s.raw.close()
+
+
+def test_other_requests_are_answered_before_a_large_document_is_analysed(
+    session: Session,
+) -> None:
+    s = session
+    big = big_document("Frobnicate")
+    change = {
+        "textDocument": {"uri": SMALL_URI, "version": 2},
+        "contentChanges": [{"text": SMALL_EDITED}],
+    }
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + hover(SMALL_URI, 2)
+        + frame(msg("textDocument/didChange", change))
+    )
+    hovered = s.until(answer(2))
+    small_done = s.until(published(SMALL_URI, 2, "port-name-forbidden-char"))
+    big_done = s.until(published(BIG_URI, 1, "unknown-node"))
+    assert hovered < big_done
+    assert small_done < big_done  # the small document's edit did not wait behind it
+    assert "result" in s.log[hovered]
+    # A request on the large document itself is answered too, and a code action, which
+    # needs its diagnostics, waits for its analysis (not the loop).
+    s.raw.write(hover(BIG_URI, 3, line=3))
+    rng = {"start": {"line": 2, "character": 0}, "end": {"line": 2, "character": 20}}
+    params = {"textDocument": {"uri": BIG_URI}, "range": rng, "context": {"diagnostics": []}}
+    s.raw.write(frame(msg("textDocument/codeAction", params, 4)))
+    assert "result" in s.log[s.until(answer(3))]
+    assert s.log[s.until(answer(4))].get("result") is not None
+
+
+def test_an_edit_during_the_analysis_is_what_gets_published(session: Session) -> None:
+    """The analysis of version 1 is superseded by the edit: version 2's diagnostics are
+    published, and nothing of version 1 after them."""
+    s = session
+    big = big_document("Frobnicate")
+    edited = big.replace("<Frobnicate/>", "<Wobble/>")
+    change = {"textDocument": {"uri": BIG_URI, "version": 2}, "contentChanges": [{"text": edited}]}
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + frame(msg("textDocument/didChange", change))
+        + hover(SMALL_URI, 5)
+    )
+    done = s.until(published(BIG_URI, 2, "unknown-node"))
+    message = next(
+        d["message"] for d in s.log[done]["params"]["diagnostics"] if d["code"] == "unknown-node"
+    )
+    assert "Wobble" in message
+    s.raw.write(hover(SMALL_URI, 6))  # anything still queued was written before this answer
+    s.until(answer(6))
+    later = [m for m in s.log[done + 1 :] if published(BIG_URI)(m)]
+    assert later == []
+    assert s.until(answer(5)) < done
