@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from bt_lsp.syntax.scanner import rescan, scan
-from bt_lsp.syntax.tokens import Kind
+from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_DUPLICATES, MAX_TAG_PROBLEMS
+from bt_lsp.syntax.tokens import Kind, Token
 from bt_lsp.syntax.values import decode_value
 
 # Text built from the pieces that matter to a tag scanner, so hypothesis reaches the
@@ -170,3 +172,62 @@ def test_deep_nesting_is_linear_and_never_recurses() -> None:
 def test_stray_lt_and_nul() -> None:
     s = scan("a < b\x00<")
     assert [t.kind for t in s.tokens] == [Kind.TEXT, Kind.STRAY, Kind.TEXT, Kind.STRAY]
+
+
+# -- what a tag keeps of hostile attribute counts ---------------------------------------
+
+
+def _tag(text: str) -> Token:
+    (tok,) = scan(text).tokens
+    assert tok.kind == Kind.START and tok.length == len(text)
+    return tok
+
+
+@pytest.mark.parametrize("sep", [" ", "\t"])
+@pytest.mark.parametrize("malformed", [False, True], ids=["fast", "slow"])
+def test_duplicates_beyond_the_first_are_counted_not_kept(sep: str, malformed: bool) -> None:
+    """A million duplicates keep O(1) records: the first attribute, MAX_DUPLICATES
+    duplicates each with its problem, and one problem counting the rest."""
+    n = 5_000
+    bad = ' b="<"' if malformed else ""  # a raw '<' takes the slow path
+    text = "<A" + bad + f'{sep}a="1"' * n + "/>"
+    tok = _tag(text)
+    kept = [a for a in tok.attrs if a.name == "a"]
+    assert len(kept) == 1 + MAX_DUPLICATES
+    dups = [p for p in tok.problems if p.message == "Duplicate attribute 'a'"]
+    assert len(dups) == MAX_DUPLICATES
+    assert [(p.start, p.end) for p in dups] == [(a.name_start, a.name_end) for a in kept[1:]]
+    (rest,) = [p for p in tok.problems if "more duplicate" in p.message]
+    assert rest.code == "xml-syntax"
+    assert rest.message.startswith(f"{n - 1 - MAX_DUPLICATES} more duplicate attributes")
+    first_left_out = text.index(f'{sep}a="1"', kept[-1].value_end) + 1
+    assert (rest.start, rest.end) == (first_left_out, first_left_out + 1)
+
+
+@pytest.mark.parametrize("malformed", [False, True], ids=["fast", "slow"])
+def test_attributes_beyond_max_attrs_are_read_not_kept(malformed: bool) -> None:
+    names = [f"p{i}" for i in range(MAX_ATTRS + 250)]
+    text = "<A " + " ".join(f'{n}="1"' for n in names) + (" b" if malformed else "") + "/>"
+    tok = _tag(text)
+    assert [a.name for a in tok.attrs] == names[:MAX_ATTRS]
+    (many,) = [p for p in tok.problems if p.code == "too-many-attributes"]
+    at = text.index(f" {names[MAX_ATTRS]}=") + 1
+    assert (many.start, many.end) == (at, at + len(names[MAX_ATTRS]))
+    total = len(names) + (1 if malformed else 0)
+    assert f"has {total} attributes" in many.message
+    # A duplicate among the left-out attributes is still an error.
+    dup = _tag(text[:-2] + ' p3="2"/>')
+    assert any(p.message == "Duplicate attribute 'p3'" for p in dup.problems)
+
+
+def test_a_malformed_tag_reports_a_bounded_number_of_problems() -> None:
+    tok = _tag("<A" + " a" * 5_000 + " b" * 5_000 + ">")  # attributes without a value
+    # 10,000 without a value and MAX_DUPLICATES duplicates, then what counts the rest.
+    more = 10_000 + MAX_DUPLICATES - MAX_TAG_PROBLEMS
+    messages = [p.message for p in tok.problems[MAX_TAG_PROBLEMS:]]
+    assert messages == [
+        f"{more} more problems in tag '<A' from here",
+        f"{2 * 4_999 - MAX_DUPLICATES} more duplicate attributes in tag '<A' from here "
+        f"(only the first {MAX_DUPLICATES} are listed)",
+    ]
+    assert not any(p.message.startswith("Missing whitespace") for p in tok.problems)

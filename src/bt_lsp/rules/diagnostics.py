@@ -42,6 +42,12 @@ DOCUMENT_TOO_LARGE: Final = define(
     "analysis limited because the document is larger than the configured maximum",
     XML,
 )
+TOO_MANY_ATTRIBUTES: Final = define(
+    "too-many-attributes",
+    Severity.INFORMATION,
+    "a tag with more attributes than any node has ports; only the first 1000 are checked",
+    XML,
+)
 TOO_MANY_PROBLEMS: Final = define(
     "too-many-problems",
     Severity.INFORMATION,

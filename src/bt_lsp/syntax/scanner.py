@@ -22,6 +22,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
 from bt_lsp.syntax.text import Offsets
 from bt_lsp.syntax.tokens import DOCTYPE_CODE, XML_SYNTAX, Attr, Kind, Problem, Token
 from bt_lsp.syntax.values import decode_value
@@ -36,13 +37,12 @@ _START = Kind.START
 _NAME_STOP = " \t\r\n/>=<\"'"
 _NAME_RE = re.compile(r"[^ \t\r\n/>=<\"']+")
 _WS_RE = re.compile(r"[ \t\r\n]*")
-# Well-formed start tag, the common case, matched in one go.  Values may not hold '<'
-# (the slow path handles and reports those).
-_FAST_TAG_RE = re.compile(
-    r"<([^ \t\r\n/>=<\"']+)"
-    r"((?:[ \t\r\n]+[^ \t\r\n/>=<\"']+[ \t\r\n]*=[ \t\r\n]*(?:\"[^\"<]*\"|'[^'<]*'))*)"
-    r"[ \t\r\n]*(/?)>"
-)
+# Well-formed start tag, the common case, read by three anchored patterns: its name, each
+# attribute, its end.  (One pattern for the whole tag, with the attributes as a repeated
+# group, needs memory for every repetition: half a gigabyte for a million attributes.)
+# Values may not hold '<' (the slow path handles and reports those).
+_FAST_NAME_RE = re.compile(r"<([^ \t\r\n/>=<\"']+)")
+_FAST_CLOSE_RE = re.compile(r"[ \t\r\n]*(/?)>")
 _FAST_END_RE = re.compile(r"</([^ \t\r\n/>=<\"']+)[ \t\r\n]*>")
 _FAST_ATTR_RE = re.compile(
     r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
@@ -228,36 +228,52 @@ def _scan_end_tag(text: str, pos: int, n: int) -> Token:
 
 
 def _scan_start_fast(text: str, pos: int) -> Token | None:
-    m = _FAST_TAG_RE.match(text, pos)
+    m = _FAST_NAME_RE.match(text, pos)
     if m is None:
         return None
-    name = _name(m.group(1))
-    a_start, a_end = m.span(2)
-    length = m.end() - pos
-    self_closing = m.group(3) == "/"
-    if a_start == a_end:
+    am = _FAST_ATTR_RE.match(text, m.end())
+    if am is None:
+        m = _FAST_CLOSE_RE.match(text, m.end())
+        if m is None:
+            return None
+        length = m.end() - pos
+        name = _name(text[pos + 1 : m.start()])
+        self_closing = m.group(1) == "/"
         return _new(
             Token, (_START, length, length + 1, name, 1, 1 + len(name), (), self_closing, True, ())
         )
+    name = _name(m.group(1))
     attrs: list[Attr] = []
     problems: list[Problem] = []
     seen: set[str] = set()
-    for am in _FAST_ATTR_RE.finditer(text, a_start, a_end):
-        aname, raw, raw2 = am.groups()
-        ns, ne = am.span(1)
-        if raw is None:
-            raw = raw2
-            vs, ve = am.span(3)
-            quote = "'"
-        else:
-            vs, ve = am.span(2)
-            quote = '"'
-        vs -= pos
+    limits = TagLimits()
+    attr_match = _FAST_ATTR_RE.match
+    a_end = 0
+    while am is not None:
+        cur = am
+        a_end = cur.end()
+        am = attr_match(text, a_end)
+        aname, raw, raw2 = cur.groups()
+        ns, ne = cur.span(1)
         if aname in seen:
+            if limits.duplicate(ns - pos, ne - pos):
+                continue
             problems.append(
                 Problem(ns - pos, ne - pos, XML_SYNTAX, f"Duplicate attribute '{aname}'")
             )
+        elif len(attrs) >= MAX_ATTRS:
+            seen.add(aname)
+            limits.beyond(ns - pos, ne - pos)
+            continue
         seen.add(aname)
+        if raw is None:
+            raw = raw2
+            vs, ve = cur.span(3)
+            quote = "'"
+        else:
+            vs, ve = cur.span(2)
+            quote = '"'
+        vs -= pos
         attrs.append(
             _new(
                 Attr,
@@ -272,6 +288,12 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
                 ),
             )
         )
+    close = _FAST_CLOSE_RE.match(text, a_end)
+    if close is None:
+        return None
+    length = close.end() - pos
+    self_closing = close.group(1) == "/"
+    problems.extend(Problem(*p) for p in limits.problems(name, len(attrs)))
     return _new(
         Token,
         (
@@ -296,6 +318,7 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
     problems: list[Problem] = []
     attrs: list[Attr] = []
     seen: set[str] = set()
+    limits = TagLimits()
     m = _NAME_RE.match(text, pos + 1)
     assert m is not None  # the caller checked that a name character follows '<'
     name = m.group(0)
@@ -303,9 +326,11 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
     reach = i
     self_closing = False
     closed = False
+    spaced = False  # whitespace was read after an attribute without a value
     while True:
         ws_end = _WS_RE.match(text, i).end()  # type: ignore[union-attr]
-        had_ws = ws_end > i
+        had_ws = ws_end > i or spaced
+        spaced = False
         i = ws_end
         reach = max(reach, i)
         if i >= n:
@@ -362,7 +387,9 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
             problems.append(
                 Problem(ns, ne, XML_SYNTAX, f"Missing whitespace before attribute '{aname}'")
             )
-        if aname in seen:
+        # An attribute beyond the limits is read (its value skipped) but not kept.
+        keep = attrs if limits.keeps(aname in seen, len(attrs), ns, ne) else []
+        if aname in seen and keep is attrs:
             problems.append(Problem(ns, ne, XML_SYNTAX, f"Duplicate attribute '{aname}'"))
         seen.add(aname)
         i = _WS_RE.match(text, am.end()).end()  # type: ignore[union-attr]
@@ -371,7 +398,8 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
             problems.append(
                 Problem(ns, ne, XML_SYNTAX, f"Attribute '{aname}' has no value: expected '=\"…\"'")
             )
-            attrs.append(Attr(aname, ns, ne, None, -1, -1, ""))
+            spaced = i > am.end()
+            keep.append(Attr(aname, ns, ne, None, -1, -1, ""))
             continue
         i = _WS_RE.match(text, i + 1).end()  # type: ignore[union-attr]
         reach = max(reach, i + 1)
@@ -390,7 +418,7 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
                     Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' has no closing {q}")
                 )
             raw = text[vstart:vend]
-            attrs.append(
+            keep.append(
                 Attr(
                     aname,
                     ns,
@@ -412,11 +440,19 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
                 Problem(ns, ne, XML_SYNTAX, f"Value of attribute '{aname}' must be quoted")
             )
             raw = text[i:vend]
-            attrs.append(
+            keep.append(
                 Attr(aname, ns, ne, decode_value(raw, i - pos, None), i - pos, vend - pos, "")
             )
             i = vend
     length = i - pos
+    if len(problems) > MAX_TAG_PROBLEMS:
+        more = len(problems) - MAX_TAG_PROBLEMS
+        at = problems[MAX_TAG_PROBLEMS]
+        del problems[MAX_TAG_PROBLEMS:]
+        problems.append(
+            Problem(at.start, at.end, at.code, f"{more} more problems in tag '<{name}' from here")
+        )
+    problems.extend(Problem(*p) for p in limits.problems(name, len(attrs)))
     return Token(
         Kind.START,
         length,
