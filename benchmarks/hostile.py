@@ -1,0 +1,109 @@
+"""Hostile sizes in the server: memory and waiting per input, up to ``maxDocumentBytes``.
+
+For each input a fresh ``bt-lsp serve`` opens a small document, then the input; right
+after the input's ``didOpen`` it asks for a hover on the small document. Printed per
+input: its size, the time from the open to its complete diagnostics (those holding
+``unknown-node``, which only the complete analysis reports), the hover's round trip
+while the input is analysed, and the server's peak RSS (VmHWM) above its RSS before the
+open, as a multiple of the input's size.
+
+    python benchmarks/hostile.py                 # every input
+    python benchmarks/hostile.py duplicates      # some of them
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from generate import generate
+from lsp_client import LspClient, rss_kib
+from run import SERVER
+
+MIB = 1024 * 1024
+TREE = '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n'
+END = "</BehaviorTree>\n</root>\n"
+SMALL = TREE + "<AlwaysSuccess/>\n" + END
+
+
+def _realistic() -> str:
+    text = generate(8 * MIB - 4096, seed=1).text
+    return text.replace("</BehaviorTree>", "<Frob/></BehaviorTree>", 1)
+
+
+INPUTS: dict[str, Callable[[], str]] = {
+    "duplicates": lambda: TREE + "<Frob" + ' a="1"' * 1_000_000 + "/>" + END,
+    "attributes": lambda: (
+        TREE + "<Frob" + "".join(f' a{i}="1"' for i in range(700_000)) + "/>" + END
+    ),
+    "realistic": _realistic,
+    "elements": lambda: TREE + "<Sequence>" + "<Frob/>" * 100_000 + "</Sequence>" + END,
+}
+
+
+async def measure(name: str, text: str) -> dict[str, float]:
+    client = await LspClient.start(SERVER)
+    try:
+        await client.initialize(None, {"debounceMs": 0})
+        small = "untitled:small.xml"
+        item = {"uri": small, "languageId": "xml", "version": 1, "text": SMALL}
+        fut = client.expect_diagnostics(small, 1)
+        client.notify("textDocument/didOpen", {"textDocument": item})
+        await asyncio.wait_for(fut, 60)
+        hover = {"textDocument": {"uri": small}, "position": {"line": 2, "character": 3}}
+        await client.request("textDocument/hover", hover)
+        before = rss_kib(client.pid)
+        uri = f"untitled:{name}.xml"
+        item = {"uri": uri, "languageId": "xml", "version": 1, "text": text}
+        opened = time.perf_counter()
+        client.notify("textDocument/didOpen", {"textDocument": item})
+        _, hover_seconds = await client.request_timed("textDocument/hover", hover, 600)
+        while True:  # the complete set, not the early names published first
+            fut = client.expect_diagnostics(uri, 1)
+            latest = client.latest(uri)
+            if latest is not None and any(
+                d.get("code") == "unknown-node" for d in latest.diagnostics
+            ):
+                published = latest
+                break
+            await asyncio.wait_for(fut, 600)
+        size = len(text.encode("utf-8"))
+        peak = rss_kib(client.pid, "VmHWM")
+        return {
+            "size": size,
+            "diagnostics_s": published.at - opened,
+            "hover_s": hover_seconds,
+            "rss_peak_mib": peak / 1024,
+            "ratio": (peak - before) * 1024 / size,
+        }
+    finally:
+        await client.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("inputs", nargs="*", help=f"some of: {', '.join(INPUTS)}")
+    args = parser.parse_args(argv)
+    unknown = set(args.inputs) - set(INPUTS)
+    if unknown:
+        parser.error(f"unknown inputs: {', '.join(sorted(unknown))}")
+    print("| input | size | open → diagnostics | hover meanwhile | peak RSS | peak / size |")
+    print("|---|---|---|---|---|---|")
+    for name in args.inputs or list(INPUTS):
+        r = asyncio.run(measure(name, INPUTS[name]()))
+        print(
+            f"| {name} | {r['size'] / MIB:.1f} MiB | {r['diagnostics_s']:.1f} s "
+            f"| {r['hover_s']:.2f} s | {r['rss_peak_mib']:.0f} MiB | {r['ratio']:.1f}× |",
+            flush=True,
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
