@@ -185,3 +185,53 @@ def test_a_registering_macro_not_read_leaves_the_registrations_unknown(tmp_path:
     found = _completeness(_ws(tmp_path / "2", composed + FACTORY))
     assert not found.complete
     assert found.why == "macro REG_NS of src/app/src/main.cpp registers nodes in a form not read"
+
+
+_SLEEP_CPP = """#include <behaviortree_cpp_v3/bt_factory.h>
+
+class Sleep : public BT::SyncActionNode
+{
+public:
+  Sleep(const std::string& name, const BT::NodeConfiguration& config)
+    : BT::SyncActionNode(name, config) {}
+  static BT::PortsList providedPorts() { return { BT::InputPort<int>("ms", "How long") }; }
+  BT::NodeStatus tick() override { return BT::NodeStatus::SUCCESS; }
+};
+
+int main()
+{
+  BT::BehaviorTreeFactory factory;
+  factory.registerNodeType<Sleep>("Sleep");
+  auto tree = factory.createTreeFromFile("trees/nap.xml");
+  return 0;
+}
+"""
+
+
+def test_a_v3_projects_own_sleep_is_its_c_plus_plus_node(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """BehaviorTree.CPP 3.8 has no built-in ``Sleep`` (4.x does), so a v3 project's C++
+    ``Sleep`` is the node its trees use, with the C++'s ports and authority."""
+    pkg = tmp_path / "ws" / "src" / "napper"
+    (pkg / "src").mkdir(parents=True)
+    (pkg / "trees").mkdir()
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?>\n<package format="3"><name>napper</name><version>0.1.0</version>'
+        "<description>d</description><maintainer email='a@b.c'>a</maintainer>"
+        "<license>MIT</license><depend>behaviortree_cpp_v3</depend></package>\n"
+    )
+    (pkg / "src" / "main.cpp").write_text(_SLEEP_CPP)
+    (pkg / "trees" / "nap.xml").write_text(
+        '<root main_tree_to_execute="T">\n'
+        '  <BehaviorTree ID="T">\n'
+        '    <Sleep ms="5" msec="5"/>\n'
+        "  </BehaviorTree>\n"
+        "</root>\n"
+    )
+    found = _check(capsys, tmp_path / "ws", "nap.xml")
+    # msec is 4.x's Sleep port, not the C++ node's: 3.8 refuses it at tree creation.
+    assert set(found) == {3}
+    severity, code, message = found[3]
+    assert (severity, code) == ("error", "undeclared-port")
+    assert "'Sleep' declares no port 'msec' (registered in src/napper/src/main.cpp:" in message

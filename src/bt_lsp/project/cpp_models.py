@@ -36,7 +36,8 @@ from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
 from bt_lsp.project.packages import BTCPP_PACKAGES, Manifest, Packages, is_file
 from bt_lsp.project.settings import Settings
-from bt_lsp.rules.builtins import BUILTINS, Category, Direction, PortModel
+from bt_lsp.rules.builtins import Category, Direction, PortModel
+from bt_lsp.rules.builtins_v3 import builtins_for
 from bt_lsp.rules.context import Context, ModelDecl, ModelSource
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -124,7 +125,7 @@ class CppModels:
         ] = {}
         self._known: set[Path] = set()
         self.tree_generation = 0  # bumps when a C++ file or manifest appears or goes
-        self._decls: dict[int, MappingProxyType[str, ModelDecl]] = {}
+        self._decls: dict[tuple[int, str | None], MappingProxyType[str, ModelDecl]] = {}
         self._line_starts: dict[Path, tuple[bytes, list[int]]] = {}
         self.generation = 0
         # "sync" reads the C++ when a context needs it (the command line); "background"
@@ -333,7 +334,8 @@ class CppModels:
         known = self.completeness(path, files, cat, resolve)
         if not cat.nodes and not known.complete:
             return ctx  # no C++ nodes: the messages need not say what was not read
-        decls = self.decls(cat)
+        builtins = builtins_for(ctx.btcpp_version)
+        decls = self.decls(cat, ctx.btcpp_version)
         merged = dict(ctx.models)
         for id_, d in decls.items():
             if id_ not in merged or cat.by_id[id_].authoritative:
@@ -342,7 +344,7 @@ class CppModels:
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
             # (those of the packages whose C++ is not visible among them).
-            registered = frozenset(n.id for n in cat.nodes if n.id not in BUILTINS) | {
+            registered = frozenset(n.id for n in cat.nodes if n.id not in builtins) | {
                 i for i, d in ctx.models.items() if d.authoritative or d.path in known.shipped
             }
         return replace(
@@ -446,17 +448,22 @@ class CppModels:
                 return path.relative_to(folder).as_posix()
         return str(path)
 
-    def decls(self, catalog: Catalog) -> MappingProxyType[str, ModelDecl]:
-        """The catalog's nodes as models by ID (built-ins and nodes of unknown kind left
-        out: a node's category cannot be guessed)."""
-        key = id(catalog)
+    def decls(
+        self, catalog: Catalog, version: str | None = None
+    ) -> MappingProxyType[str, ModelDecl]:
+        """The catalog's nodes as models by ID (the built-ins of the BehaviorTree.CPP
+        ``version``, which a factory refuses to register again, and nodes of unknown kind
+        left out: a node's category cannot be guessed).  A v3 project's own ``Sleep`` is
+        kept: 3.8 has no such built-in."""
+        builtins = builtins_for(version)
+        key = (id(catalog), version)
         with self._lock:
             hit = self._decls.get(key)
             if hit is not None:
                 return hit
         out: dict[str, ModelDecl] = {}
         for n in catalog.nodes:
-            if n.id in BUILTINS or n.kind is None or n.id in out:
+            if n.id in builtins or n.kind is None or n.id in out:
                 continue
             out[n.id] = self.decl(n)
         proxy = MappingProxyType(out)
