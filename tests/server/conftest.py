@@ -22,12 +22,14 @@ import re
 import sys
 from collections.abc import AsyncIterator, Awaitable, Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, TypeVar
 
 import pytest
 import pytest_lsp
 from lsprotocol import types
 from pygls.protocol import default_converter
+from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig, LanguageClient
 from pytest_lsp.client import DEFAULT_CLIENT_FEATURES, register_lsp_features
 
@@ -152,6 +154,47 @@ class BtClient(LanguageClient):
             )
         )
         self.encoding = str(self.init_result.capabilities.position_encoding or "utf-16")
+
+    async def start_in_workspace(self, folder: Path) -> None:
+        """A VS Code session with ``folder`` as its workspace folder and no debounce (the
+        project tests: C++, ROS packages)."""
+        self.profile_name = "vscode"
+        self.profile = PROFILES["vscode"]
+        self.init_result = await self.initialize_session(
+            types.InitializeParams(
+                capabilities=pytest_lsp.client_capabilities("visual-studio-code"),
+                initialization_options={"debounceMs": 0},
+                workspace_folders=[
+                    types.WorkspaceFolder(uri=from_fs_path(str(folder)) or "", name="ws")
+                ],
+            )
+        )
+        self.encoding = "utf-16"
+
+    def open_path(self, path: Path, language: str) -> str:
+        """Open the file at ``path`` with its text on disk; its URI."""
+        uri = from_fs_path(str(path)) or ""
+        self.text_document_did_open(
+            types.DidOpenTextDocumentParams(
+                text_document=types.TextDocumentItem(
+                    uri=uri, language_id=language, version=1, text=path.read_text()
+                )
+            )
+        )
+        return uri
+
+    async def diagnostics_until(
+        self, uri: str, check: Callable[[Sequence[types.Diagnostic]], bool]
+    ) -> list[types.Diagnostic]:
+        """The first diagnostics published for ``uri`` that pass ``check`` (waits)."""
+
+        def found() -> list[types.Diagnostic] | None:
+            last = self.latest(uri)
+            if last is not None and check(last.diagnostics):
+                return list(last.diagnostics)
+            return None
+
+        return await self.wait_until(found, f"diagnostics of {uri}")
 
     @property
     def pull(self) -> bool:

@@ -17,7 +17,6 @@ from pathlib import Path
 import pytest
 import pytest_lsp
 from lsprotocol import types
-from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig
 
 from tests.server.conftest import SERVER_COMMAND, BtClient, make_client
@@ -38,43 +37,9 @@ CONFIG = ClientServerConfig(
 
 @pytest_lsp.fixture(config=CONFIG, scope="module")
 async def app_client(lsp_client: BtClient) -> AsyncIterator[BtClient]:
-    caps = pytest_lsp.client_capabilities("visual-studio-code")
-    from tests.server.conftest import PROFILES
-
-    lsp_client.profile_name = "vscode"
-    lsp_client.profile = PROFILES["vscode"]
-    lsp_client.init_result = await lsp_client.initialize_session(
-        types.InitializeParams(
-            capabilities=caps,
-            initialization_options={"debounceMs": 0},
-            workspace_folders=[types.WorkspaceFolder(uri=from_fs_path(str(WS)) or "", name="ws")],
-        )
-    )
-    lsp_client.encoding = "utf-16"
+    await lsp_client.start_in_workspace(WS)
     yield lsp_client
     await lsp_client.shutdown_session()
-
-
-def _open(client: BtClient, path: Path, language: str) -> str:
-    uri = from_fs_path(str(path)) or ""
-    client.text_document_did_open(
-        types.DidOpenTextDocumentParams(
-            text_document=types.TextDocumentItem(
-                uri=uri, language_id=language, version=1, text=path.read_text()
-            )
-        )
-    )
-    return uri
-
-
-async def _until(client: BtClient, uri: str, check) -> list[types.Diagnostic]:  # type: ignore[no-untyped-def]
-    def found() -> list[types.Diagnostic] | None:
-        last = client.latest(uri)
-        if last is not None and check(last.diagnostics):
-            return list(last.diagnostics)
-        return None
-
-    return await client.wait_until(found, f"diagnostics of {uri}")
 
 
 def _at(diags: list[types.Diagnostic], line: int, code: str) -> types.Diagnostic | None:
@@ -91,8 +56,8 @@ def _teleport_is(severity: types.DiagnosticSeverity):  # type: ignore[no-untyped
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_complete_registrations_make_errors(app_client: BtClient) -> None:
-    uri = _open(app_client, APP, "xml")
-    diags = await _until(app_client, uri, _teleport_is(types.DiagnosticSeverity.Error))
+    uri = app_client.open_path(APP, "xml")
+    diags = await app_client.diagnostics_until(uri, _teleport_is(types.DiagnosticSeverity.Error))
     port = _at(diags, 3, "undeclared-port")
     assert port is not None and port.severity == types.DiagnosticSeverity.Error
     assert "(registered in src/robot_app/src/main.cpp:21;" in port.message
@@ -105,14 +70,14 @@ async def test_complete_registrations_make_errors(app_client: BtClient) -> None:
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_a_dependency_not_found_keeps_them_advisory(app_client: BtClient) -> None:
-    uri = _open(app_client, EXT, "xml")
+    uri = app_client.open_path(EXT, "xml")
 
     def read(ds) -> bool:  # type: ignore[no-untyped-def]
         d = _at(list(ds), 9, "unknown-node")
         return d is not None and "dependency vendor_nodes of robot_ext" in d.message
 
     # Once the C++ is read (before, nothing is known of it), the hint says why.
-    diags = await _until(app_client, uri, read)
+    diags = await app_client.diagnostics_until(uri, read)
     teleport = _at(diags, 9, "unknown-node")
     assert teleport is not None and teleport.severity == types.DiagnosticSeverity.Hint
     typo = _at(diags, 5, "unknown-node")
@@ -121,9 +86,9 @@ async def test_a_dependency_not_found_keeps_them_advisory(app_client: BtClient) 
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_registering_the_node_in_cpp_clears_its_error(app_client: BtClient) -> None:
-    uri = _open(app_client, APP, "xml")
-    await _until(app_client, uri, _teleport_is(types.DiagnosticSeverity.Error))
-    cpp_uri = _open(app_client, MAIN_CPP, "cpp")
+    uri = app_client.open_path(APP, "xml")
+    await app_client.diagnostics_until(uri, _teleport_is(types.DiagnosticSeverity.Error))
+    cpp_uri = app_client.open_path(MAIN_CPP, "cpp")
     text = MAIN_CPP.read_text().replace(
         '  factory.registerNodeType<Dock>("Dock");',
         '  factory.registerNodeType<Dock>("Dock");\n  factory.registerNodeType<Dock>("Teleport");',
@@ -134,5 +99,7 @@ async def test_registering_the_node_in_cpp_clears_its_error(app_client: BtClient
             content_changes=[types.TextDocumentContentChangeWholeDocument(text=text)],
         )
     )
-    diags = await _until(app_client, uri, lambda ds: _at(list(ds), 9, "unknown-node") is None)
+    diags = await app_client.diagnostics_until(
+        uri, lambda ds: _at(list(ds), 9, "unknown-node") is None
+    )
     assert _at(diags, 5, "unknown-node") is not None  # the typo is still one

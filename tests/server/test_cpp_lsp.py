@@ -18,7 +18,6 @@ from pathlib import Path
 import pytest
 import pytest_lsp
 from lsprotocol import types
-from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig
 
 from tests.server.conftest import SERVER_COMMAND, TIMEOUT, BtClient, make_client
@@ -41,42 +40,9 @@ CONFIG = ClientServerConfig(
 async def cpp_client(lsp_client: BtClient) -> AsyncIterator[BtClient]:
     caps = pytest_lsp.client_capabilities("visual-studio-code")
     assert caps.window is not None and caps.window.work_done_progress
-    lsp_client.profile_name = "vscode"
-    from tests.server.conftest import PROFILES
-
-    lsp_client.profile = PROFILES["vscode"]
-    lsp_client.init_result = await lsp_client.initialize_session(
-        types.InitializeParams(
-            capabilities=caps,
-            initialization_options={"debounceMs": 0},
-            workspace_folders=[types.WorkspaceFolder(uri=from_fs_path(str(WS)) or "", name="ws")],
-        )
-    )
-    lsp_client.encoding = "utf-16"
+    await lsp_client.start_in_workspace(WS)
     yield lsp_client
     await lsp_client.shutdown_session()
-
-
-def _open(client: BtClient, path: Path, language: str) -> str:
-    uri = from_fs_path(str(path)) or ""
-    client.text_document_did_open(
-        types.DidOpenTextDocumentParams(
-            text_document=types.TextDocumentItem(
-                uri=uri, language_id=language, version=1, text=path.read_text()
-            )
-        )
-    )
-    return uri
-
-
-async def _until(client: BtClient, uri: str, check) -> list[types.Diagnostic]:  # type: ignore[no-untyped-def]
-    def found() -> list[types.Diagnostic] | None:
-        last = client.latest(uri)
-        if last is not None and check(last.diagnostics):
-            return list(last.diagnostics)
-        return None
-
-    return await client.wait_until(found, f"diagnostics of {uri}")
 
 
 def _pos(path: Path, needle: str, line_has: str | None = None) -> types.Position:
@@ -87,8 +53,10 @@ def _pos(path: Path, needle: str, line_has: str | None = None) -> types.Position
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_background_scan_reports_progress_and_refreshes(cpp_client: BtClient) -> None:
-    uri = _open(cpp_client, MAIN, "xml")
-    diags = await _until(cpp_client, uri, lambda ds: any(d.code == "undeclared-port" for d in ds))
+    uri = cpp_client.open_path(MAIN, "xml")
+    diags = await cpp_client.diagnostics_until(
+        uri, lambda ds: any(d.code == "undeclared-port" for d in ds)
+    )
     codes = {(d.code, d.range.start.line) for d in diags}
     assert ("undeclared-port", 4) in codes  # <DriveTo speed=…>
     assert ("invalid-port-value", 3) in codes  # <BatteryOk min_percent="lots">
@@ -100,8 +68,8 @@ async def test_background_scan_reports_progress_and_refreshes(cpp_client: BtClie
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_hover_shows_the_cpp_declaration(cpp_client: BtClient) -> None:
-    uri = _open(cpp_client, MAIN, "xml")
-    await _until(cpp_client, uri, lambda ds: any(d.code == "undeclared-port" for d in ds))
+    uri = cpp_client.open_path(MAIN, "xml")
+    await cpp_client.diagnostics_until(uri, lambda ds: any(d.code == "undeclared-port" for d in ds))
     hover = await cpp_client.hover(uri, _pos(MAIN, "DriveTo", 'DriveTo target="dock"'))
     assert hover is not None and isinstance(hover.contents, types.MarkupContent)
     text = hover.contents.value
@@ -120,8 +88,8 @@ async def test_hover_shows_the_cpp_declaration(cpp_client: BtClient) -> None:
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_definition_goes_into_the_cpp(cpp_client: BtClient) -> None:
-    uri = _open(cpp_client, MAIN, "xml")
-    await _until(cpp_client, uri, lambda ds: any(d.code == "undeclared-port" for d in ds))
+    uri = cpp_client.open_path(MAIN, "xml")
+    await cpp_client.diagnostics_until(uri, lambda ds: any(d.code == "undeclared-port" for d in ds))
     params = types.DefinitionParams(
         text_document=types.TextDocumentIdentifier(uri=uri),
         position=_pos(MAIN, "DriveTo", 'DriveTo target="dock"'),
@@ -148,8 +116,8 @@ async def test_completion_offers_the_cpp_nodes(cpp_client: BtClient) -> None:
     )
     path = MAIN.parent / "complete.xml"
     path.write_text(text)
-    uri = _open(cpp_client, path, "xml")
-    await _until(cpp_client, uri, lambda ds: True)
+    uri = cpp_client.open_path(path, "xml")
+    await cpp_client.diagnostics_until(uri, lambda ds: True)
     at = types.Position(0, text.index("<Dri") + 4)
     for _ in range(50):  # the catalog of this file's package may still be being read
         result = await cpp_client.text_document_completion_async(
@@ -165,22 +133,23 @@ async def test_completion_offers_the_cpp_nodes(cpp_client: BtClient) -> None:
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_a_cpp_edit_refreshes_the_xml_and_gets_name_rules(cpp_client: BtClient) -> None:
-    main = _open(cpp_client, MAIN, "xml")
-    await _until(cpp_client, main, lambda ds: any(d.code == "undeclared-port" for d in ds))
-    cpp = _open(cpp_client, REGISTER, "cpp")
+    main = cpp_client.open_path(MAIN, "xml")
+    await cpp_client.diagnostics_until(
+        main, lambda ds: any(d.code == "undeclared-port" for d in ds)
+    )
+    cpp = cpp_client.open_path(REGISTER, "cpp")
     text = REGISTER.read_text()
     edited = text.replace('("BatteryOk")', '("Battery Ok")')
     cpp_client.replace(cpp, 2, edited)
     # The C++ document: its bad ID is reported at its literal.
-    cpp_diags = await _until(
-        cpp_client, cpp, lambda ds: any(d.code == "cpp-model-name" for d in ds)
+    cpp_diags = await cpp_client.diagnostics_until(
+        cpp, lambda ds: any(d.code == "cpp-model-name" for d in ds)
     )
     (d,) = cpp_diags
     line = edited.splitlines()[d.range.start.line]
     assert line[d.range.start.character : d.range.end.character] == '"Battery Ok"'
     # The tree: BatteryOk is no longer registered, so its port is no longer checked.
-    diags = await _until(
-        cpp_client,
+    diags = await cpp_client.diagnostics_until(
         main,
         lambda ds: (
             not any(d.code == "invalid-port-value" for d in ds)
@@ -189,4 +158,6 @@ async def test_a_cpp_edit_refreshes_the_xml_and_gets_name_rules(cpp_client: BtCl
     )
     assert any(d.code == "undeclared-port" for d in diags)  # DriveTo is still known
     cpp_client.replace(cpp, 3, text)
-    await _until(cpp_client, main, lambda ds: any(d.code == "invalid-port-value" for d in ds))
+    await cpp_client.diagnostics_until(
+        main, lambda ds: any(d.code == "invalid-port-value" for d in ds)
+    )
