@@ -19,34 +19,13 @@
 
 const fs = require('node:fs');
 const path = require('node:path');
-const { chromium } = require('playwright-core');
+const { driver } = require('./workbench');
 
 const config = JSON.parse(process.argv[2] || '{}');
-const STEP_TIMEOUT = config.stepTimeoutMs || 20000;
-const SERVER_TIMEOUT = config.serverTimeoutMs || 60000;
-const CHROMIUM = config.chromium || '/usr/bin/chromium';
-
-const result = { steps: [] };
-let step = 'start';
-const started = Date.now();
-
-function mark(name) {
-  step = name;
-  result.steps.push({ step: name, atMs: Date.now() - started });
-  process.stderr.write(`[restart] ${name}\n`);
-}
-
-async function until(fn, timeoutMs, intervalMs = 250) {
-  const deadline = Date.now() + timeoutMs;
-  let value;
-  for (;;) {
-    value = await fn();
-    if (value || Date.now() > deadline) {
-      return value;
-    }
-    await new Promise((resolve) => setTimeout(resolve, intervalMs));
-  }
-}
+const { STEP_TIMEOUT, SERVER_TIMEOUT, result, mark, until, openFile, loadWorkbench, run } = driver(
+  'restart',
+  config,
+);
 
 /** The bt-lsp notifications shown as toasts: their message and their buttons. */
 async function toasts(page) {
@@ -62,35 +41,10 @@ async function toasts(page) {
 
 async function main(page) {
   mark('load workbench');
-  await page.goto(config.url);
-  await page.waitForSelector('.monaco-workbench', { timeout: SERVER_TIMEOUT });
-  await page.waitForSelector(`.explorer-folders-view .monaco-list-row[aria-label*="${config.file}"]`, {
-    timeout: SERVER_TIMEOUT,
-  });
+  await loadWorkbench(page, config.file);
 
   mark('open file');
-  const opened = await until(async () => {
-    await page.keyboard.press('Escape');
-    await page.keyboard.press('Control+P');
-    const input = await page.waitForSelector('.quick-input-widget input', { state: 'visible', timeout: 5000 }).catch(() => null);
-    if (!input) {
-      return false;
-    }
-    await page.keyboard.type(config.file);
-    const row = await page
-      .waitForSelector(`.quick-input-list .monaco-list-row[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .catch(() => null);
-    if (!row) {
-      return false;
-    }
-    await page.keyboard.press('Enter');
-    return page
-      .waitForSelector(`.tabs-container .tab[aria-label*="${config.file}"]`, { timeout: 5000 })
-      .then(() => true, () => false);
-  }, STEP_TIMEOUT, 500);
-  if (!opened) {
-    throw new Error(`could not open ${config.file} with Quick Open`);
-  }
+  await openFile(page, config.file);
 
   mark('failed start notification');
   result.failed = await until(async () => {
@@ -140,27 +94,4 @@ async function main(page) {
   mark('done');
 }
 
-(async () => {
-  let exitCode = 0;
-  const browser = await chromium.launch({
-    executablePath: CHROMIUM,
-    headless: true,
-    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-background-networking', '--no-first-run'],
-  });
-  const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
-  await context.grantPermissions(['clipboard-read', 'clipboard-write'], { origin: new URL(config.url).origin });
-  const page = await context.newPage();
-  try {
-    await main(page);
-  } catch (error) {
-    exitCode = 1;
-    result.failedStep = step;
-    result.error = String(error && error.stack ? error.stack : error);
-    await page.screenshot({ path: path.join(config.shotDir, 'failure.png') }).catch(() => {});
-  } finally {
-    result.elapsedMs = Date.now() - started;
-    await browser.close().catch(() => {});
-  }
-  process.stdout.write(JSON.stringify(result) + '\n');
-  process.exit(exitCode);
-})();
+run(main, { viewport: { width: 1280, height: 800 }, failureShot: 'failure.png' });
