@@ -4,6 +4,7 @@ errors, ``--fix``, ``--severity``, the progress bar, ``serve`` and ``--version``
 from __future__ import annotations
 
 import codecs
+import errno
 import json
 import os
 import re
@@ -25,6 +26,9 @@ from bt_lsp.cli.main import main
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
 from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
+
+# The system's own words for a missing file (the message quotes the OS error).
+NO_FILE = os.strerror(errno.ENOENT)
 
 # 😋 (outside the BMP) sits before the bad port name on line 4: its column counts the emoji
 # as one character (24); SARIF counts it as two UTF-16 code units (25).
@@ -269,7 +273,7 @@ def test_missing_file_exits_2_and_others_are_checked(
     out, err = capsys.readouterr()
     _assert_lines(out, CRLF_LINES)
     assert err.splitlines() == [
-        "bt-lsp: cannot read nope.xml: No such file or directory",
+        f"bt-lsp: cannot read nope.xml: {NO_FILE}",
         "1 error, 0 warnings in 1 file; 1 file could not be checked",
     ]
 
@@ -289,7 +293,7 @@ def test_unreadable_file_in_a_directory(work: Path, capsys: pytest.CaptureFixtur
     assert main(["check", "d"]) == 2
     out, err = capsys.readouterr()
     _assert_lines(out, [("d/" + p, n) for p, n in CRLF_LINES])
-    assert "bt-lsp: cannot read d/broken.xml: No such file or directory\n" in err
+    assert f"bt-lsp: cannot read d/broken.xml: {NO_FILE}\n" in err
 
 
 def test_directory_named_like_a_file_is_searched(
@@ -422,9 +426,9 @@ def test_json_output(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
         "endColumn": None,
         "severity": "error",
         "code": "file-error",
-        "message": "cannot read missing.xml: No such file or directory",
+        "message": f"cannot read missing.xml: {NO_FILE}",
     }
-    assert err == "bt-lsp: cannot read missing.xml: No such file or directory\n"
+    assert err == f"bt-lsp: cannot read missing.xml: {NO_FILE}\n"
 
 
 def test_json_empty(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -549,7 +553,7 @@ def test_sarif_file_errors_and_outside_files(
     assert inv["executionSuccessful"] is False
     (note,) = inv["toolExecutionNotifications"]
     assert note["descriptor"] == {"id": "file-error"}
-    assert note["message"]["text"] == "cannot read gone.xml: No such file or directory"
+    assert note["message"]["text"] == f"cannot read gone.xml: {NO_FILE}"
 
 
 def test_sarif_clean(work: Path, capsys: pytest.CaptureFixture[str]) -> None:

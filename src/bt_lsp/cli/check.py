@@ -49,7 +49,7 @@ from bt_lsp.cli.project import (
     skip_reason,
     version_lines,
 )
-from bt_lsp.cli.results import FileResult, analyze, exit_code, findings_of, plural, summary
+from bt_lsp.cli.results import FileResult, exit_code, file_diagnostics, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import (
@@ -138,7 +138,7 @@ def check_file(
             diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
             result.findings = findings_of(path, doc, diags)
             return result
-        raw = analyze(doc, project)
+        raw = file_diagnostics(doc, project)
         # The workspace's settings for the file hold the flags' severities over its
         # configuration file's.
         severities = (

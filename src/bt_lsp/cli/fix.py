@@ -11,7 +11,7 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from bt_lsp.cli.results import analyze
+from bt_lsp.cli.results import file_diagnostics
 from bt_lsp.ide import name_fixes as fixes
 from bt_lsp.project.fileio import Decoded
 from bt_lsp.project.index import ProjectIndex, normalize
@@ -114,7 +114,7 @@ def apply_fixes(
         char = e.object[e.start]
         return f"U+{ord(char):04X} cannot be written in {decoded.encoding.upper()}"
     new_doc = Document(new_text, doc.path)
-    new_raw = analyze(new_doc, project)
+    new_raw = file_diagnostics(new_doc, project)
     before, after = _xml_counts(raw), _xml_counts(new_raw)
     worse = sorted(code for code in after if after[code] > before[code])
     if worse:

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bt_lsp.cli.fix import Fixed, apply_fixes
-from bt_lsp.cli.results import analyze
+from bt_lsp.cli.results import file_diagnostics
 from bt_lsp.ide.name_edits import shown
 from bt_lsp.ide.name_fixes import WorkspaceRename, edits_in, fix_workspace
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
@@ -66,7 +66,7 @@ def _read(
         except FileError:
             continue  # reported when the file is checked
         doc = Document(decoded.text, path)
-        raw = analyze(doc, project)
+        raw = file_diagnostics(doc, project)
         severities = _severities(project, path)
         diags = with_severities(raw, severities)
         planned = Planned(decoded, doc, raw, diags, severities)
@@ -220,5 +220,5 @@ def _write(
         given, planned = checked[path]
         outcome = planned.outcome
         if isinstance(outcome, Fixed):
-            raw = analyze(outcome.doc, project)
+            raw = file_diagnostics(outcome.doc, project)
             planned.outcome = Fixed(outcome.doc, raw, [])

@@ -53,7 +53,7 @@ class FileResult:
     unwritten: bool = False  # --fix could not write the fixed file (exit status 2)
 
 
-def analyze(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
+def file_diagnostics(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
     """Every diagnostic of ``doc``, before severity settings; with a project index, its
     includes, models and trees count too."""
     if project is None or doc.path is None:
