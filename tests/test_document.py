@@ -122,3 +122,37 @@ def test_a_model_built_while_an_edit_came_in_is_not_kept(monkeypatch: Any) -> No
     fresh = doc.model
     assert fresh is not stale and fresh.elements[0].token_start == 2
     assert doc.model is fresh and len(calls) == 2
+
+
+@given(st.data())
+@settings(max_examples=100, deadline=None)
+def test_an_unscanned_document_is_the_same_once_used(data: st.DataObject) -> None:
+    """``scanned=False`` only delays the line index and tokens: edited before or after
+    :meth:`Document.prepare`, the document equals one scanned at once."""
+    lazy = Document(BASE, scanned=False)
+    eager = Document(BASE)
+    assert not lazy.scanned
+    if data.draw(st.booleans()):
+        lazy.prepare()
+        assert lazy.scanned
+    for _ in range(data.draw(st.integers(0, 3))):
+        n = len(lazy.text)
+        start = data.draw(st.integers(0, n))
+        end = data.draw(st.integers(start, min(n, start + 8)))
+        new = data.draw(st.sampled_from(INSERTS))
+        lazy.edit(start, end, new)
+        eager.edit(start, end, new)
+    assert lazy.text == eager.text
+    assert lazy.lines == eager.lines
+    assert lazy.scan.tokens == eager.scan.tokens
+    assert own_diagnostics(lazy) == own_diagnostics(eager)
+
+
+def test_prepare_makes_what_the_loop_would_otherwise_make() -> None:
+    doc = Document(BASE, scanned=False)
+    doc.prepare(model=False)
+    assert doc._lines is not None and not doc.scanned  # a text that is not BT: no tokens
+    doc.prepare()
+    assert doc.scanned and doc._model is not None
+    doc.replace_all(BASE + " ", scanned=False)
+    assert not doc.scanned and doc.lines == LineIndex(BASE + " ")

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.early_names import early_name_diagnostics
+from bt_lsp.rules.names import NameKind, all_valid_port_uses, check_name
 from bt_lsp.syntax.document import Document
 from tests.test_scanner import xmlish
 
@@ -237,3 +238,32 @@ def test_edited_corpus_files_match_or_give_up(path: Path, data: st.DataObject) -
 def test_never_raises(text: str) -> None:
     found = early_name_diagnostics(text)
     assert found is None or found == full_names(text)
+
+
+def test_a_tag_with_more_attributes_than_the_model_keeps() -> None:
+    """Only a tag's first MAX_ATTRS attributes are checked, as the model keeps them: a bad
+    name after them is not reported, one among them is, and the pass stays exact."""
+    many = "".join(f' a{i}="1"' for i in range(3000))
+    for bad_at in (10, 2500):
+        attrs = many.replace(f' a{bad_at}="1"', ' b.ad="1"')
+        text = f'<root BTCPP_format="4"><BehaviorTree ID="M"><Frob{attrs}/></BehaviorTree></root>'
+        found = early(text)
+        assert found == full_names(text)
+        assert [text[d.start : d.end] for d in found] == (["b.ad"] if bad_at < 1000 else [])
+
+
+@given(st.lists(st.text(alphabet="a0.:_- \x00\x7fé😀", max_size=4), max_size=6))
+def test_the_bulk_port_check_is_check_name_for_each(names: list[str]) -> None:
+    expected = all(not check_name(n, NameKind.PORT) for n in names)
+    assert all_valid_port_uses(names) == expected
+    assert all_valid_port_uses(set(names)) == expected
+
+
+def test_gives_up_on_a_tag_lxml_would_read_in_one_long_call() -> None:
+    """A start tag of more than 256 Ki characters (700,000 attributes: lxml read it in one
+    call of 0.8 s, holding the interpreter beside the event loop) is left to the full
+    analysis; one just under that length is still read."""
+    for count, gives_up in ((40_000, True), (20_000, False)):
+        attrs = "".join(f' a{i}="1"' for i in range(count))
+        text = f'<root BTCPP_format="4"><BehaviorTree ID="M"><Frob{attrs}/></BehaviorTree></root>'
+        assert (early_name_diagnostics(text) is None) is gives_up

@@ -50,8 +50,8 @@ def open_params(uri: str, text: str, version: int = 1) -> dict[str, Any]:
     return {"textDocument": {"uri": uri, "languageId": "xml", "version": version, "text": text}}
 
 
-def hover(uri: str, msg_id: int, line: int = 1) -> bytes:
-    params = {"textDocument": {"uri": uri}, "position": {"line": line, "character": 30}}
+def hover(uri: str, msg_id: int, line: int = 1, character: int = 30) -> bytes:
+    params = {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}}
     return frame(msg("textDocument/hover", params, msg_id))
 
 
@@ -165,3 +165,56 @@ def test_an_edit_during_the_analysis_is_what_gets_published(session: Session) ->
     later = [m for m in s.log[done + 1 :] if published(BIG_URI)(m)]
     assert later == []
     assert s.until(answer(5)) < done
+
+
+def symbols(uri: str, msg_id: int) -> bytes:
+    return frame(msg("textDocument/documentSymbol", {"textDocument": {"uri": uri}}, msg_id))
+
+
+def test_the_open_of_a_large_document_holds_only_its_own_requests(session: Session) -> None:
+    """Nothing of the open runs on the event loop: a hover on another document is answered
+    before the large one's first publication (its early names, found on the worker), and
+    the requests on the large document wait for it to be ready, then answer correctly."""
+    s = session
+    big = big_document("Frobnicate")
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + hover(SMALL_URI, 7)
+        + hover(BIG_URI, 8, line=3)
+        + symbols(BIG_URI, 9)
+    )
+    small = s.until(answer(7))
+    first = s.until(published(BIG_URI))
+    assert small < first
+    assert s.log[first]["params"]["diagnostics"] == []  # the early names: none is bad
+    assert "AlwaysSuccess" in s.log[s.until(answer(8))]["result"]["contents"]["value"]
+    (tree,) = s.log[s.until(answer(9))]["result"]
+    assert (tree["name"], tree["range"]["start"]["line"]) == ("Main", 1)
+    assert len(tree["children"]) == big.count("<Sequence") + 1  # Frobnicate and each Sequence
+    s.until(published(BIG_URI, 1, "unknown-node"))
+
+
+def test_an_edit_right_after_the_open_is_not_lost(session: Session) -> None:
+    """An incremental edit sent with the open waits for the document to be ready, then
+    applies at the position it names; the requests after it see the edited text."""
+    s = session
+    big = big_document("Frobnicate")
+    rng = {"start": {"line": 2, "character": 5}, "end": {"line": 2, "character": 15}}
+    change = {
+        "textDocument": {"uri": BIG_URI, "version": 2},
+        "contentChanges": [{"range": rng, "text": "Wobble"}],
+    }
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + frame(msg("textDocument/didChange", change))
+        + hover(BIG_URI, 10, line=2, character=7)
+        + hover(SMALL_URI, 11)
+    )
+    assert s.until(answer(11)) < s.until(published(BIG_URI))
+    assert "Wobble" in s.log[s.until(answer(10))]["result"]["contents"]["value"]
+    done = s.until(published(BIG_URI, 2, "unknown-node"))
+    (message,) = (
+        d["message"] for d in s.log[done]["params"]["diagnostics"] if d["code"] == "unknown-node"
+    )
+    assert "Wobble" in message
+    assert not [m for m in s.log if published(BIG_URI, 1, "unknown-node")(m)]

@@ -13,7 +13,8 @@ Every diagnostic found is therefore one the full analysis makes too, with the sa
 code and message; the server publishes them first and the complete set when it is ready.
 
 The pass gives up (``None``) on what it does not follow exactly: text lxml rejects, cannot
-take or warns about, a DOCTYPE, XML namespaces.  Such a document waits for the full analysis.
+take or warns about, a DOCTYPE, XML namespaces, a stretch of 256 Ki characters without a
+``>`` (a start tag that long).  Such a document waits for the full analysis.
 Parsing reads nothing but the text: no DTD, no entities, no network.
 """
 
@@ -21,14 +22,21 @@ from __future__ import annotations
 
 import re
 from bisect import bisect_right
+from itertools import islice
 from typing import cast
 
 from lxml import etree
 
 from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, ref_diagnostics, violations
-from bt_lsp.rules.names import RESERVED_PORT_NAMES, NameKind, may_hold_bad_instance_name
+from bt_lsp.rules.names import (
+    RESERVED_PORT_NAMES,
+    NameKind,
+    all_valid_port_uses,
+    may_hold_bad_instance_name,
+)
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Role, Zone, zone_in
 from bt_lsp.syntax.nametokens import start_tag_element, start_tag_refs
+from bt_lsp.syntax.tag_limits import MAX_ATTRS
 
 __all__ = ["early_name_diagnostics"]
 
@@ -84,11 +92,13 @@ class _Reader:
             if violations(tag, _MODEL, Role.NODE_TYPE):
                 return True
             good_models.add(tag)
-        for key in attrib:
-            if key not in good_keys:
-                if violations(key, _PORT, Role.PORT_USE):
-                    return True
-                good_keys.add(key)
+        # The model keeps a tag's first MAX_ATTRS attributes (the rest are only counted).
+        keys = attrib.keys() if len(attrib) <= MAX_ATTRS else islice(attrib, MAX_ATTRS)
+        new_keys = set(keys) - good_keys
+        if new_keys:
+            if not all_valid_port_uses(new_keys):
+                return True
+            good_keys |= new_keys
         value = attrib.get("ID")
         if value is not None and value not in good_models:
             if violations(value, _MODEL, Role.NODE_ID):
@@ -127,6 +137,10 @@ def _start_tags(text: str) -> list[int]:
 
 
 _PIECE = 1 << 16
+# lxml reads a tag (a comment, ...) in one call once it has all of it, holding the
+# interpreter meanwhile: 0.8 s for one start tag of 700,000 attributes, when the pass
+# runs beside the event loop.  It gives up on a text with no ">" in this many characters.
+_MAX_RUN = 1 << 18
 
 
 def early_name_diagnostics(text: str) -> list[Diagnostic] | None:
@@ -146,8 +160,19 @@ def early_name_diagnostics(text: str) -> list[Diagnostic] | None:
     )
     try:
         # Fed in pieces: a copy of the whole text would be memory the allocator keeps.
+        since_end = 0  # characters since the last ">"
         for i in range(0, len(text), _PIECE):
-            parser.feed(text[i : i + _PIECE].encode("utf-8"))
+            piece = text[i : i + _PIECE]
+            last = piece.rfind(">")
+            if last < 0:
+                since_end += len(piece)
+            elif since_end + piece.find(">") > _MAX_RUN:
+                return None
+            else:
+                since_end = len(piece) - last - 1
+            if since_end > _MAX_RUN:
+                return None
+            parser.feed(piece.encode("utf-8"))
         parser.close()
     except (etree.XMLSyntaxError, UnicodeEncodeError, ValueError):  # lone surrogates too
         return None

@@ -12,6 +12,7 @@ Offsets and columns are counted in code points within the name (0-based ``offset
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Final
 
@@ -355,6 +356,21 @@ def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple
             ),
         )
     raise ValueError(f"unknown name kind {kind!r}")  # pragma: no cover
+
+
+# A name of a "\x00"-joined list that is empty or starts with a digit.
+_EMPTY_OR_DIGIT_RE: Final = re.compile(r"(?:^|\x00)(?:[0-9]|\x00|$)")
+
+
+def all_valid_port_uses(names: Collection[str]) -> bool:
+    """Whether no name of ``names`` breaks a rule as a port where it is used (what
+    :func:`check_name` with ``NameKind.PORT`` says of each), in a few C-level passes:
+    a start tag may hold hundreds of thousands of attributes."""
+    if not names:
+        return True
+    if _FORBIDDEN_RE.search("".join(names)) is not None:  # "\x00" among them
+        return False
+    return _EMPTY_OR_DIGIT_RE.search("\x00".join(names)) is None
 
 
 def may_hold_bad_instance_name(text: str) -> bool:

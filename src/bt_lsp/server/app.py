@@ -27,7 +27,6 @@ from bt_lsp.project.index import ProjectIndex
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
-from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.rules.registry import CODES
 from bt_lsp.server import transport
 from bt_lsp.server.background import Background
@@ -43,7 +42,7 @@ from bt_lsp.server.project import (
 )
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.syntax.document import Document, looks_like_bt
+from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.text import Encoding, normalize_encoding, positions_of
 
 log = logging.getLogger(__name__)
@@ -195,23 +194,21 @@ class BtServer(LanguageServer):
 
     # -- publishing -------------------------------------------------------------------------
 
-    def publish_early_names(self, uri: str, text: str, version: int | None) -> None:
-        """Publish the name diagnostics of a large document being opened, found without
-        its full analysis (:mod:`bt_lsp.rules.early_names`), ahead of the complete set."""
-        if self.pull_diagnostics or len(text) < EARLY_NAMES_CHARS or not looks_like_bt(text):
-            return
-        try:
-            found = early_name_diagnostics(text)
-        except Exception:  # the complete set follows anyway
-            self.log_error(f"finding the early name diagnostics of {uri}")
-            return
-        if found is None:
-            return
-        found = with_severities(found, self.settings.severity)
+    def wants_early_names(self, od: OpenDocument) -> bool:
+        """Whether the name diagnostics of ``od``, a large BT document being opened, are
+        pushed first, found without its full analysis (:mod:`bt_lsp.rules.early_names`)."""
+        return not self.pull_diagnostics and len(od.doc.text) >= EARLY_NAMES_CHARS
+
+    def publish_early_names(self, od: OpenDocument, found: list[Diagnostic]) -> None:
+        """Publish ``found``, the early name diagnostics of ``od`` (found on the worker
+        thread while it is prepared), ahead of the complete set."""
+        settings = self.settings if od.path is None else self.project.settings_for(od.path)
+        found = with_severities(found, settings.severity)
+        text = od.doc.text
         at = positions_of(text, [o for d in found for o in (d.start, d.end)], self.encoding)
         self.text_document_publish_diagnostics(
             types.PublishDiagnosticsParams(
-                uri=uri,
+                uri=od.uri,
                 diagnostics=[
                     diagnostic_at(
                         types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
@@ -220,7 +217,7 @@ class BtServer(LanguageServer):
                     )
                     for d in found
                 ],
-                version=version,
+                version=od.version,
             )
         )
 

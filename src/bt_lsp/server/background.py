@@ -16,16 +16,25 @@ wait for it: they use the open document, whose model is built from the last comp
 (only the sections edited since); a completed analysis hands its model and own
 diagnostics to the open document when it was not edited meanwhile.  What needs the
 document's diagnostics (pulled diagnostics) waits for its analysis, never the loop.
+
+Even the open of such a document does nothing on the loop in proportion to its text: the
+worker finds its early name diagnostics (published while nothing newer is known) and then
+makes its line index, tokens and model (:meth:`Background.prepare`).  Meanwhile every
+message about the document (a request, an edit, its close) is held, and handled in the
+order it came once the document is ready; messages about other documents are handled at
+once.
 """
 
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 
@@ -46,6 +55,32 @@ class _Job:
     done: asyncio.Future[list[Diagnostic] | None]
 
 
+@dataclass(slots=True)
+class _Held:
+    """A document being prepared on the worker, and the messages about it since."""
+
+    od: OpenDocument
+    messages: list[Any] = field(default_factory=list)
+
+
+def target_uri(message: Any) -> str | None:
+    """The document a client message is about: its ``textDocument``, the ``uri`` of a
+    command's argument (``bt-lsp.renderTree``) or of a code action's data."""
+    params = getattr(message, "params", None)
+    if params is None:
+        return None
+    uri = getattr(getattr(params, "text_document", None), "uri", None)
+    if isinstance(uri, str):
+        return uri
+    data = getattr(params, "data", None)  # codeAction/resolve
+    if isinstance(data, Mapping) and isinstance(data.get("uri"), str):
+        return str(data["uri"])
+    args = getattr(params, "arguments", None)  # workspace/executeCommand
+    if args and isinstance(args[0], Mapping) and isinstance(args[0].get("uri"), str):
+        return str(args[0]["uri"])
+    return None
+
+
 class Background:
     """The worker thread and the analysis under way (or queued) for each document."""
 
@@ -53,13 +88,95 @@ class Background:
         self._server = server
         self._pool: ThreadPoolExecutor | None = None
         self._jobs: dict[str, _Job] = {}
+        self._held: dict[str, _Held] = {}  # documents being prepared, by URI
+
+    def _worker(self) -> ThreadPoolExecutor:
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bt-lsp-analysis")
+        return self._pool
+
+    # -- preparing a large document --------------------------------------------------------
+
+    def prepare(self, od: OpenDocument, ready: Callable[[], None]) -> bool:
+        """Whether ``od`` (just opened, or replaced by a new text, and not yet scanned) is
+        large enough to be prepared on the worker thread; if so, its early name
+        diagnostics are found there first (pushed to clients that do not pull), then its
+        line index, tokens and model are made, and on the loop ``ready`` runs, followed by
+        the messages about ``od`` that came meanwhile, in their order."""
+        if len(od.doc.text) < WORKER_CHARS or od.uri in self._held:
+            return False
+        loop = asyncio.get_running_loop()
+        self._held[od.uri] = held = _Held(od)
+        pool = self._worker()
+        if od.is_bt and self._server.wants_early_names(od):
+            early = loop.run_in_executor(pool, early_name_diagnostics, od.doc.text)
+            early.add_done_callback(lambda f: self._early(held, f))
+        work = loop.run_in_executor(pool, od.doc.prepare, od.is_bt)
+        work.add_done_callback(lambda f: self._prepared(held, f, ready))
+        return True
+
+    def holds(self, message: Any) -> bool:
+        """Hold ``message`` if it is about a document being prepared (handled, in order,
+        once it is ready)."""
+        if not self._held:
+            return False
+        uri = target_uri(message)
+        held = self._held.get(uri) if uri is not None else None
+        if held is None:
+            return False
+        held.messages.append(message)
+        return True
+
+    def preparing(self, uri: str) -> bool:
+        return uri in self._held
+
+    def _early(self, held: _Held, work: asyncio.Future[list[Diagnostic] | None]) -> None:
+        """On the loop: publish the early names while the document is still being
+        prepared (nothing newer about it is known until then)."""
+        if work.cancelled() or self._held.get(held.od.uri) is not held:
+            return
+        exc = work.exception()
+        if exc is not None:  # the complete set follows anyway
+            self._server.log_message(
+                f"bt-lsp: error finding the early name diagnostics of {held.od.uri}: {exc!r}"
+            )
+            return
+        found = work.result()
+        if found is not None:
+            self._server.publish_early_names(held.od, found)
+
+    def _prepared(self, held: _Held, work: asyncio.Future[None], ready: Callable[[], None]) -> None:
+        """On the loop: the document is ready; then the messages held for it."""
+        if work.cancelled():  # shut down
+            return
+        if self._held.get(held.od.uri) is held:
+            del self._held[held.od.uri]
+        exc = work.exception()
+        if exc is not None:  # what is missing is made when first used
+            self._server.log_message(f"bt-lsp: error preparing {held.od.uri}: {exc!r}")
+        server = self._server
+        try:
+            ready()
+        except Exception:
+            server.log_error(f"opening {held.od.uri}")
+        protocol = server.bt_protocol
+        for message in held.messages:
+            try:
+                protocol.handle_message(message)
+            except Exception as exc:  # as BtProtocol.receive does
+                protocol.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    # -- analysing ---------------------------------------------------------------------------
 
     def wants(self, od: OpenDocument) -> bool:
         """Whether ``od`` is analysed on the worker thread."""
         return od.is_bt and len(od.doc.text) >= WORKER_CHARS
 
     def busy(self, od: OpenDocument) -> bool:
-        """Whether an analysis of ``od``'s current state is under way."""
+        """Whether an analysis of ``od``'s current state is under way (or ``od`` is being
+        prepared: once it is ready its diagnostics are due)."""
+        if od.uri in self._held:
+            return True
         job = self._jobs.get(od.uri)
         return job is not None and job.key == self._server.diagnostics_key(od)
 
@@ -74,9 +191,7 @@ class Background:
         loop = asyncio.get_running_loop()
         job = _Job(key, od.doc.snapshot(), loop.create_future())
         self._jobs[od.uri] = job
-        if self._pool is None:
-            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bt-lsp-analysis")
-        work = loop.run_in_executor(self._pool, self._run, od, job)
+        work = loop.run_in_executor(self._worker(), self._run, od, job)
         work.add_done_callback(lambda f: self._finished(od, job, f))
         return job.done
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 from lsprotocol import types
 from pygls.uris import to_fs_path
 
+from bt_lsp.server.background import WORKER_CHARS
 from bt_lsp.server.convert import to_offsets
 from bt_lsp.server.project import document_edited, is_project_file, sync_config_diagnostics
 from bt_lsp.server.state import OpenDocument
@@ -17,27 +18,43 @@ if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
 
 
+def _opened(ls: BtServer, od: OpenDocument) -> None:
+    ls.docs[od.uri] = od
+    if od.path is not None:
+        ls.project.open(od.path, od.doc)
+    ls.cpp.document_changed(od)
+    ls.edits += 1
+    ls.schedule_all(od.uri)
+    document_edited(ls, od, opened=True)
+
+
+def _changed(ls: BtServer, od: OpenDocument, was_bt: bool) -> None:
+    ls.cpp.document_changed(od)
+    ls.edits += 1
+    if was_bt and not od.is_bt:
+        ls.clear(od.uri)
+    ls.schedule_all(od.uri)
+    document_edited(ls, od)
+
+
 def register(server: BtServer) -> None:
     @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
     def did_open(ls: BtServer, params: types.DidOpenTextDocumentParams) -> None:
+        """A large document is prepared on the worker thread (its early name diagnostics
+        pushed first): until it is ready the server knows it not, and holds the
+        messages about it (see :mod:`bt_lsp.server.background`)."""
         item = params.text_document
         path = to_fs_path(item.uri) if item.uri.startswith("file:") else None
-        ls.publish_early_names(item.uri, item.text, item.version)
         od = OpenDocument(
             item.uri,
-            Document(item.text, path or item.uri),
+            Document(item.text, path or item.uri, scanned=False),
             item.version,
             item.language_id,
             Path(path) if path else None,
         )
         od.refresh_kind()
-        ls.docs[item.uri] = od
-        if od.path is not None:
-            ls.project.open(od.path, od.doc)
-        ls.cpp.document_changed(od)
-        ls.edits += 1
-        ls.schedule_all(item.uri)
-        document_edited(ls, od, opened=True)
+        if not ls.background.prepare(od, lambda: _opened(ls, od)):
+            _opened(ls, od)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
     def did_change(ls: BtServer, params: types.DidChangeTextDocumentParams) -> None:
@@ -52,16 +69,13 @@ def register(server: BtServer) -> None:
             if isinstance(change, types.TextDocumentContentChangePartial):
                 start, end = to_offsets(od.doc.lines, change.range, enc)
                 od.doc.edit(start, end, change.text)
-            else:
-                od.doc.replace_all(change.text)
+            else:  # a large new text is scanned on the worker thread, not here
+                od.doc.replace_all(change.text, scanned=len(change.text) < WORKER_CHARS)
         od.version = params.text_document.version
         od.refresh_kind()
-        ls.cpp.document_changed(od)
-        ls.edits += 1
-        if was_bt and not od.is_bt:
-            ls.clear(uri)
-        ls.schedule_all(uri)
-        document_edited(ls, od)
+        if not od.doc.scanned and ls.background.prepare(od, lambda: _changed(ls, od, was_bt)):
+            return
+        _changed(ls, od, was_bt)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(ls: BtServer, params: types.DidCloseTextDocumentParams) -> None:

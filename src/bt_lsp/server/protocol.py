@@ -221,6 +221,9 @@ class BtProtocol(LanguageServerProtocol):
                 error=JsonRpcInvalidRequest("the server is shut down").to_response_error(),
             )
             return
+        background = getattr(self._server, "background", None)
+        if background is not None and background.holds(message):
+            return  # about a large document being prepared: handled once it is ready
         super().handle_message(message)
 
     def _forward(self, method: str, params: Any) -> Generator[Any, Any, None]:

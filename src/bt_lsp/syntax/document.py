@@ -3,7 +3,10 @@
 An edit re-scans only the tokens around it (:func:`bt_lsp.syntax.scanner.rescan`) and updates the
 line index in place of rebuilding it; the model is derived lazily from
 the tokens when first asked for, the model from the previous one (only the sections around
-the tokens replaced since are built again, see :mod:`bt_lsp.syntax.builder`).
+the tokens replaced since are built again, see :mod:`bt_lsp.syntax.builder`).  A document
+made with ``scanned=False`` makes its line index and tokens on first use, or when
+:meth:`Document.prepare` is called: the server prepares a large document on a worker
+thread, so that the event loop never scans megabytes.
 
 An edit replaces the text, line index and tokens with new objects and never changes the
 old ones, so :meth:`Document.snapshot` is a cheap copy that another thread can analyse
@@ -26,11 +29,11 @@ from bt_lsp.syntax.text import LineIndex
 
 class Document:
     @with_gc_paused
-    def __init__(self, text: str, path: str | None = None) -> None:
+    def __init__(self, text: str, path: str | None = None, *, scanned: bool = True) -> None:
         self.path = path
         self.text = text
-        self.lines = LineIndex(text)
-        self.scan: Scan = scan(text)
+        self._lines: LineIndex | None = LineIndex(text) if scanned else None
+        self._scan: Scan | None = scan(text) if scanned else None
         self._model: Model | None = None
         # The document's own diagnostics, kept here by bt_lsp.rules.diagnostics.own_diagnostics
         # (this layer knows no rules); an edit clears them.
@@ -44,6 +47,38 @@ class Document:
         # only to read or write attributes, never while building).
         self._lock = threading.Lock()
         self._edits = 0  # bumped by every edit: a model built before it is not kept
+
+    @property
+    def lines(self) -> LineIndex:
+        lines = self._lines
+        if lines is None:
+            text = self.text
+            lines = LineIndex(text)
+            if self.text is text:
+                self._lines = lines
+        return lines
+
+    @property
+    def scan(self) -> Scan:
+        """The tokens of the text (scanned on first use when made with ``scanned=False``)."""
+        tokens = self._scan
+        if tokens is None:
+            text = self.text
+            with gc_paused():
+                tokens = scan(text)
+            if self.text is text:
+                self._scan = tokens
+        return tokens
+
+    @property
+    def scanned(self) -> bool:
+        """Whether the tokens are made (see ``scanned=False``)."""
+        return self._scan is not None
+
+    def prepare(self, model: bool = True) -> None:
+        """Make the line index and tokens now, and the model with ``model`` (a worker
+        thread does it for a large document, before the event loop uses it)."""
+        _ = self.lines, (self.model if model else None)
 
     def snapshot(self) -> Document:
         """A copy that later edits of this document leave alone, for analysing it on
@@ -77,8 +112,8 @@ class Document:
         start = min(max(start, 0), n)
         end = min(max(end, start), n)
         new_full = self.text[:start] + new_text + self.text[end:]
-        self.lines = self.lines.edited(start, end, new_text, new_full)
-        self.scan, change = rescan(self.scan, new_full, start, end, len(new_text))
+        self._lines = self.lines.edited(start, end, new_text, new_full)
+        self._scan, change = rescan(self.scan, new_full, start, end, len(new_text))
         self.text = new_full
         if self._model is not None:
             self._base, self._change = self._model, change
@@ -89,8 +124,8 @@ class Document:
         self._is_bt = None
         self._utf8_size = None
 
-    def replace_all(self, text: str) -> None:
-        fresh = Document(text, self.path)
+    def replace_all(self, text: str, *, scanned: bool = True) -> None:
+        fresh = Document(text, self.path, scanned=scanned)
         with self._lock:
             edits = self._edits + 1
             lock = self._lock
@@ -102,10 +137,13 @@ class Document:
         model = self._model
         if model is not None:
             return model
+        tokens = self.scan  # made outside the lock, on first use
         with self._lock:
             if self._model is not None:
                 return self._model
-            state = self.scan, self.text, self._base, self._change
+            if self._scan is not tokens:
+                tokens = self.scan
+            state = tokens, self.text, self._base, self._change
             edits = self._edits
         with gc_paused():
             model = build(*state)
