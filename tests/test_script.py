@@ -4,13 +4,22 @@ from __future__ import annotations
 
 import re
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.rules.script import ScriptError, _Checker, check_script, identifiers
+from bt_lsp.rules.script import (
+    _EOF,
+    _ERROR,
+    _PLAIN_SCRIPT,
+    ScriptError,
+    _Checker,
+    check_script,
+    identifiers,
+)
 
 # Every distinct script found in the real corpus (tests/data/corpus_real): Script/ScriptCondition
 # `code`, Precondition `if` and the eight pre/post-condition attributes, XML-decoded.
@@ -588,6 +597,68 @@ def test_never_raises_on_script_like_text(code: str) -> None:
         if result is not None:
             assert 0 <= result.offset <= result.end <= len(code)
             assert "position" in result.message or result.message == "Empty Script"
+
+
+def _until_end(tokens: Iterator[tuple[object, ...]]) -> list[tuple[object, ...]]:
+    out = []
+    for token in tokens:
+        out.append(token)
+        if token[0] in (_EOF, _ERROR):
+            return out
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+_SCRIPT_TEXT = st.one_of(
+    st.lists(_ALPHABET, max_size=40).map("".join),
+    st.lists(
+        st.sampled_from(_SYNTHETIC_VALID + REAL_SCRIPTS[:40] + [";", " ", "("]), max_size=6
+    ).map(" ".join),
+    st.text(max_size=30),
+)
+
+
+@settings(max_examples=1500, deadline=None)
+@given(_SCRIPT_TEXT)
+def test_regex_tokens_are_the_character_loops(code: str) -> None:
+    """The fast tokenizer (one regular expression, the character loop for the rest) reads
+    exactly the tokens the character loop alone reads, in both modes."""
+    for legacy in (False, True):
+        checker = _Checker(code, legacy)
+        assert _until_end(checker.tokens()) == _until_end(checker.slow_tokens())
+
+
+@settings(max_examples=1500, deadline=None)
+@given(_SCRIPT_TEXT)
+def test_plain_script_pattern_accepts_only_what_parses(code: str) -> None:
+    """What the regular expression accepts without the checker parses, and
+    check_script's answer is always the checker's."""
+    if _PLAIN_SCRIPT.fullmatch(code):
+        assert _Checker(code, False).run() is None
+        assert _Checker(code, True).run() is None
+    for legacy in (False, True):
+        assert check_script(code, legacy=legacy) == _Checker(code, legacy).run()
+
+
+def test_plain_script_pattern_takes_the_common_scripts() -> None:
+    plain = [c for c in REAL_SCRIPTS if not any(ch in c for ch in "()?") and ": " not in c]
+    assert len(plain) > 30
+    for code in plain:
+        assert _PLAIN_SCRIPT.fullmatch(code), code
+    assert not _PLAIN_SCRIPT.fullmatch("a ? b : c")
+    assert not _PLAIN_SCRIPT.fullmatch("(a)")
+    assert not _PLAIN_SCRIPT.fullmatch("a and b")
+    assert not _PLAIN_SCRIPT.fullmatch(";a")
+    assert not _PLAIN_SCRIPT.fullmatch("")
+
+
+def test_a_large_script_with_an_error_at_its_end() -> None:
+    code = "".join(f"k{i} := k{i} + 1; " for i in range(20_000)) + "x := == 1"
+    error = check_script(code)
+    assert error is not None
+    assert (error.offset, error.end) == (len(code) - 4, len(code) - 2)
+    assert error.message == f"Expected operand at position {len(code) - 4} (got '==')"
+    spans, stop = identifiers(code)
+    assert len(spans) == 40_001 and stop == len(code)
 
 
 @settings(max_examples=200, deadline=None)

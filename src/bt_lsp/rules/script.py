@@ -38,6 +38,7 @@ everywhere".
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Final
@@ -125,13 +126,66 @@ _WORD_OPERATORS: Final = {"and": "&&", "or": "||"}
 _LITERAL_WORDS: Final = frozenset({"true", "false"})
 
 
-@dataclass(frozen=True, slots=True)
-class _Token:
-    kind: int
-    start: int
-    end: int
-    problem: str = ""  # for _ERROR: what is wrong (the position is added after it)
-    hint: str = ""  # for _ERROR: appended after the position
+_IDENT: Final = 11  # an identifier: an operand (_ATOM) the blackboard reads as a name
+_SLOW: Final = 12  # not a token of the fast pattern: read by _Checker.slow_token
+
+#: A token: (kind, start, end), and for _ERROR also what is wrong (the position is added
+#: after it) and a hint appended after the position.
+_Token = tuple[int, int, int] | tuple[int, int, int, str, str]
+
+# The common tokens, white space before them included, read by one C regular expression;
+# anything else (a lexical error, a backslash, a non-ASCII character, a double quote) is
+# one _SLOW character that _Checker.slow_token reads as the character loop always did.
+# Numbers are matched only when valid (possessive, so no shorter prefix matches), with the
+# same rules as _Checker.scan_number.
+_NUMBER: Final = (
+    r"0[xX][0-9a-fA-F]++(?![.A-Za-z0-9_])"
+    r"|[0-9]++(?:\.[0-9]++|(?=\.\.)|(?!\.))(?:[eE][+-]?+[0-9]++|(?![eE]))(?![A-Za-z_@])"
+)
+_FAST_GROUPS: Final = (
+    (_IDENT, r"[A-Za-z_@][A-Za-z0-9_]*+{ident_end}"),
+    (_ATOM, _NUMBER + r"|'[^']*+'{double_quoted}"),
+    (_BINARY, r"\.\.|&&|\|\||==|!=|<=|>=|:=|\+=|-=|\*=|/=|[+*/&|^<>=]"),
+    (_MINUS, r"-"),
+    (_PREFIX, r"[~!]"),
+    (_QUESTION, r"\?"),
+    (_COLON, r":"),
+    (_LPAREN, r"\("),
+    (_RPAREN, r"\)"),
+    (_SEMI, r";"),
+    (_SLOW, r"[^ \t\n\r]"),
+)
+
+
+def _fast_pattern(legacy: bool) -> re.Pattern[str]:
+    alternatives = "|".join(f"({body})" for _, body in _FAST_GROUPS)
+    return re.compile(
+        "[ \t\n\r]*+(?:"
+        + alternatives.format(
+            # legacy: an identifier may go on with a non-ASCII letter: the slow path reads it
+            ident_end=r"(?![^\x00-\x7f])" if legacy else "",
+            double_quoted='|"[^"]*+"' if legacy else "",
+        )
+        + ")"
+    )
+
+
+_FAST: Final = (_fast_pattern(False), _fast_pattern(True))
+#: The token kind of each group of the fast pattern, by group number.
+_GROUP_KINDS: Final = (_ERROR, *(kind for kind, _ in _FAST_GROUPS))
+
+# A script of operands and binary operators only (no parentheses and no ternary outside
+# strings): a regular language, so one C regular expression tells that it parses, without
+# a Python step per token.  It accepts nothing the checker rejects: the tokens are read
+# the same (an operator is the longest one, an identifier or number never a shorter
+# prefix); any script it does not match (errors, parentheses, ``?``) goes to the checker.
+_WS: Final = r"[ \t\n\r]*+"
+_OPERAND: Final = rf"(?:[-!~]{_WS})*+(?:[A-Za-z_@][A-Za-z0-9_]*+|{_NUMBER}|'[^']*+')"
+_OPERATOR: Final = r"(?>\.\.|&&|\|\||==|!=|<=|>=|:=|\+=|-=|\*=|/=|[-+*/&|^<>=])"
+_STATEMENT: Final = rf"{_OPERAND}(?:{_WS}{_OPERATOR}{_WS}{_OPERAND})*+"
+_PLAIN_SCRIPT: Final = re.compile(
+    rf"{_WS}{_STATEMENT}(?:{_WS};(?:{_WS};)*+{_WS}{_STATEMENT})*+(?:{_WS};)*+{_WS}"
+)
 
 
 def check_script(code: str, *, legacy: bool = False) -> ScriptError | None:
@@ -140,6 +194,8 @@ def check_script(code: str, *, legacy: bool = False) -> ScriptError | None:
     ``code`` is the decoded attribute value (XML entities already replaced). Never raises;
     time and memory are linear in ``len(code)``.
     """
+    if _PLAIN_SCRIPT.fullmatch(code):
+        return None  # the common case, read in C (the legacy parser accepts it too)
     try:
         return _Checker(code, legacy).run()
     except Exception as exc:  # pragma: no cover - defensive: a checker must never crash
@@ -161,17 +217,14 @@ def identifiers(code: str) -> tuple[list[tuple[int, int]], int]:
     checker = _Checker(code, True)
     found: list[tuple[int, int]] = []
     for token in checker.tokens():
-        kind = token.kind
-        if kind == _EOF:
+        kind = token[0]
+        if kind == _IDENT:
+            if code[token[1] : token[2]] not in _LITERAL_WORDS:
+                found.append((token[1], token[2]))
+        elif kind == _EOF:
             return found, len(code)
-        if kind == _ERROR:
-            return found, token.start
-        if (
-            kind == _ATOM
-            and checker.is_ident_start(code[token.start])
-            and code[token.start : token.end] not in _LITERAL_WORDS
-        ):
-            found.append((token.start, token.end))
+        elif kind == _ERROR:
+            return found, token[1]
     return found, len(code)  # pragma: no cover - tokens() always ends with _EOF
 
 
@@ -187,20 +240,21 @@ class _Checker:
         return len(self.code[:offset].encode("utf-8", "surrogatepass"))
 
     def shown(self, token: _Token) -> str:
-        if token.kind == _EOF:
+        if token[0] == _EOF:
             return "end of input"
-        text = self.code[token.start : token.end]
+        text = self.code[token[1] : token[2]]
         if len(text) > _MAX_SHOWN:
             text = text[: _MAX_SHOWN - 3] + "..."
         return "'" + text.replace("\n", "\\n").replace("\r", "\\r").replace("\t", "\\t") + "'"
 
     def error(self, token: _Token, what: str, extra: str = "") -> ScriptError:
-        message = f"{what} at position {self.position(token.start)} (got {self.shown(token)})"
-        return ScriptError(token.start, token.end, message + extra)
+        message = f"{what} at position {self.position(token[1])} (got {self.shown(token)})"
+        return ScriptError(token[1], token[2], message + extra)
 
     def lexical_error(self, token: _Token) -> ScriptError:
-        message = f"{token.problem} at position {self.position(token.start)}{token.hint}"
-        return ScriptError(token.start, token.end, message)
+        assert len(token) == 5
+        _, start, end, problem, hint = token
+        return ScriptError(start, end, f"{problem} at position {self.position(start)}{hint}")
 
     def unclosed(self, token: _Token, stack: list[tuple[int, int]]) -> ScriptError:
         kind, start = stack[-1]
@@ -221,24 +275,36 @@ class _Checker:
         first = True
         token = next(tokens)
         while True:
-            kind = token.kind
-            if kind == _ERROR:
-                return self.lexical_error(token)
+            kind = token[0]
             if expect_operand:
-                if kind == _ATOM:
+                if kind in (_IDENT, _ATOM):
                     expect_operand = False
                 elif kind == _LPAREN:
-                    stack.append((_LPAREN, token.start))
+                    stack.append((_LPAREN, token[1]))
                 elif kind in (_MINUS, _PREFIX):
                     pass
+                elif kind == _ERROR:
+                    return self.lexical_error(token)
                 elif kind == _EOF and first:
                     return ScriptError(0, len(self.code), "Empty Script")
                 else:
                     return self.error(token, "Expected operand")
             elif kind in (_BINARY, _MINUS):
                 expect_operand = True
+            elif kind in (_SEMI, _EOF):
+                if stack:
+                    return self.unclosed(token, stack)
+                while kind == _SEMI:
+                    token = next(tokens)
+                    kind = token[0]
+                if kind == _EOF:
+                    return None
+                expect_operand = True
+                continue  # the token after the ';' starts the next statement
+            elif kind == _ERROR:
+                return self.lexical_error(token)
             elif kind == _QUESTION:
-                stack.append((_QUESTION, token.start))
+                stack.append((_QUESTION, token[1]))
                 expect_operand = True
             elif kind == _COLON:
                 if not stack or stack[-1][0] != _QUESTION:
@@ -250,27 +316,17 @@ class _Checker:
             elif kind == _RPAREN:
                 if not stack:
                     return ScriptError(
-                        token.start,
-                        token.end,
-                        f"Unmatched ')' at position {self.position(token.start)}",
+                        token[1],
+                        token[2],
+                        f"Unmatched ')' at position {self.position(token[1])}",
                     )
                 if stack[-1][0] != _LPAREN:
                     return self.unclosed(token, stack)
                 stack.pop()
-            elif kind in (_SEMI, _EOF):
-                if stack:
-                    return self.unclosed(token, stack)
-                while kind == _SEMI:
-                    token = next(tokens)
-                    kind = token.kind
-                if kind == _EOF:
-                    return None
-                expect_operand = True
-                continue  # the token after the ';' starts the next statement
             elif stack:
                 return self.unclosed(token, stack)
             else:
-                word = self.code[token.start : token.end]
+                word = self.code[token[1] : token[2]]
                 hint = f"; use '{_WORD_OPERATORS[word]}' instead" if word in _WORD_OPERATORS else ""
                 return self.error(token, "Expected ';' or end of script", hint)
             first = False
@@ -279,10 +335,57 @@ class _Checker:
     # -- tokenizing --------------------------------------------------------------------
 
     def tokens(self) -> Iterator[_Token]:
-        """Tokens of ``code``, then ``_EOF`` forever."""
+        """Tokens of ``code``, then ``_EOF`` forever.
+
+        The common tokens come from one regular expression; at any other character the
+        character loop of :meth:`slow_token` reads one token, then the expression goes on.
+        """
         code = self.code
         n = len(code)
         i = 0
+        finditer = _FAST[self.legacy].finditer
+        kinds = _GROUP_KINDS
+        while True:
+            for m in finditer(code, i):
+                group = m.lastindex
+                assert group is not None
+                kind = kinds[group]
+                if kind == _SLOW:
+                    i = m.start(group)
+                    break
+                yield (kind, m.start(group), m.end())
+            else:
+                break  # only white space is left
+            token, i = self.slow_token(i)
+            if token is None:
+                break
+            yield token
+            if token[0] == _ERROR:
+                return
+        eof = (_EOF, n, n)
+        while True:
+            yield eof
+
+    def slow_tokens(self) -> Iterator[_Token]:
+        """The tokens of ``code`` read by the character loop alone (what :meth:`tokens`
+        must give), then ``_EOF`` forever."""
+        i = 0
+        while True:
+            token, i = self.slow_token(i)
+            if token is None:
+                break
+            yield token
+            if token[0] == _ERROR:
+                return
+        n = len(self.code)
+        while True:
+            yield (_EOF, n, n)
+
+    def slow_token(self, i: int) -> tuple[_Token | None, int]:
+        """The token at or after white space from ``code[i]``, and where it ends; ``None``
+        at the end of ``code``."""
+        code = self.code
+        n = len(code)
         while i < n:
             c = code[i]
             if c in _WHITESPACE:
@@ -295,34 +398,26 @@ class _Checker:
             if c == "'" or (c == '"' and self.legacy):
                 close = code.find(c, i + 1)
                 if close < 0:
-                    yield _Token(_ERROR, start, n, "Unterminated string")
-                    return
-                i = close + 1
-                yield _Token(_ATOM, start, i)
-            elif c in _DIGITS:
+                    return (_ERROR, start, n, "Unterminated string", ""), n
+                return (_ATOM, start, close + 1), close + 1
+            if c in _DIGITS:
                 i, bad = self.scan_number(i)
                 if bad:
-                    yield _Token(_ERROR, start, i, f"Invalid number '{code[start:i]}'")
-                    return
-                yield _Token(_ATOM, start, i)
-            elif self.is_ident_start(c):
+                    return (_ERROR, start, i, f"Invalid number '{code[start:i]}'", ""), i
+                return (_ATOM, start, i), i
+            if self.is_ident_start(c):
                 i += 1
                 while i < n and self.is_ident_char(code[i]):
                     i += 1
-                yield _Token(_ATOM, start, i)
-            elif code[i : i + 2] in _TWO_CHAR_OPS:
-                i += 2
-                yield _Token(_TWO_CHAR_OPS[code[start:i]], start, i)
-            elif c in _ONE_CHAR_OPS:
-                i += 1
-                yield _Token(_ONE_CHAR_OPS[c], start, i)
-            else:
-                shown = f"'{c}'" if c.isprintable() else f"U+{ord(c):04X}"
-                hint = self.invalid_character_hint(c, start)
-                yield _Token(_ERROR, start, start + 1, f"Invalid character {shown}", hint)
-                return
-        while True:
-            yield _Token(_EOF, n, n)
+                return (_IDENT, start, i), i
+            if code[i : i + 2] in _TWO_CHAR_OPS:
+                return (_TWO_CHAR_OPS[code[start : i + 2]], start, i + 2), i + 2
+            if c in _ONE_CHAR_OPS:
+                return (_ONE_CHAR_OPS[c], start, i + 1), i + 1
+            shown = f"'{c}'" if c.isprintable() else f"U+{ord(c):04X}"
+            hint = self.invalid_character_hint(c, start)
+            return (_ERROR, start, start + 1, f"Invalid character {shown}", hint), start + 1
+        return None, n
 
     def is_ident_start(self, c: str) -> bool:
         if c in _IDENT_START:
