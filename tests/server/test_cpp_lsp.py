@@ -161,3 +161,43 @@ async def test_a_cpp_edit_refreshes_the_xml_and_gets_name_rules(cpp_client: BtCl
     await cpp_client.diagnostics_until(
         main, lambda ds: any(d.code == "invalid-port-value" for d in ds)
     )
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_bad_id_registered_in_cpp_is_renamed_there_first(cpp_client: BtClient) -> None:
+    """The C++ registers 'Battery.Ok' and the tree calls it: renaming the XML alone would
+    break the node, so the fix is not preferred and its title and the diagnostic say where
+    the name must change first."""
+    cpp = cpp_client.open_path(REGISTER, "cpp")
+    text = REGISTER.read_text()
+    cpp_client.replace(cpp, 2, text.replace('("BatteryOk")', '("Battery.Ok")'))
+    main = cpp_client.open_path(MAIN, "xml")
+    tree = MAIN.read_text().replace("<BatteryOk ", "<Battery.Ok ")
+    cpp_client.replace(main, 2, tree)
+    where = f"registered in C++ in {REGISTER}: rename it there first"
+    diags = await cpp_client.diagnostics_until(
+        main,
+        lambda ds: any(d.code == "model-name-forbidden-char" and where in d.message for d in ds),
+    )
+    (diag,) = [d for d in diags if d.code == "model-name-forbidden-char"]
+    assert diag.message.endswith(f"; the node type is {where}; fix-all leaves this name until then")
+    actions = await cpp_client.text_document_code_action_async(
+        types.CodeActionParams(
+            text_document=types.TextDocumentIdentifier(uri=main),
+            range=diag.range,
+            context=types.CodeActionContext(diagnostics=[diag]),
+        )
+    )
+    fixes = [
+        a for a in actions or [] if isinstance(a, types.CodeAction) and "Battery.Ok" in a.title
+    ]
+    assert fixes and not any(a.is_preferred for a in fixes)
+    assert fixes[0].title == (
+        "Rename 'Battery.Ok' to 'Battery_Ok' (1 place); the node type 'Battery.Ok' is "
+        "registered in C++ in register.cpp: rename it there too"
+    )
+    cpp_client.replace(cpp, 3, text)
+    cpp_client.replace(main, 3, MAIN.read_text())
+    await cpp_client.diagnostics_until(
+        main, lambda ds: any(d.code == "invalid-port-value" for d in ds)
+    )

@@ -215,3 +215,29 @@ async def test_hover_says_why_a_call_of_a_tree_defined_elsewhere_has_no_fix(
 ) -> None:
     hover = await _hover(lsp, "Open Right Gripper")
     assert f"No quick fix renames it: {OUTSIDE_TREE}." in hover.value
+
+
+async def test_a_rename_says_in_each_other_file_what_renames_it(lsp: NavClient) -> None:
+    pick, helper = lsp.uri("pick.xml"), lsp.uri("helper.xml")
+    edit = await lsp.text_document_rename_async(
+        types.RenameParams(
+            text_document=ident(pick),
+            position=doc_pos(lsp, OBJECTIVE, "Pick Object Helper", into=3),
+            new_name="Pick_Helper",
+        )
+    )
+    assert edit is not None
+    assert apply(lsp, HELPER, edits_by_uri(edit)[helper]) == HELPER.replace(
+        "Pick Object Helper", "Pick_Helper"
+    )
+    if lsp.spec != "visual-studio-code":  # no change annotations
+        assert edit.change_annotations is None
+        return
+    (annotation,) = (edit.change_annotations or {}).values()
+    assert annotation.label == "Other file: helper.xml"
+    assert annotation.needs_confirmation is True
+    assert annotation.description == (
+        "Rename 'Pick Object Helper' to 'Pick_Helper': helper.xml uses the same name, so its "
+        f"references there are renamed too (1 edit in {lsp.ws / 'helper.xml'}, not the file "
+        "you are in)"
+    )

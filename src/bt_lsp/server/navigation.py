@@ -136,9 +136,11 @@ def rename_edit(
     edits: Sequence[TextEdit],
     other_edits: dict[str, tuple[TextEdit, ...]],
     sources: dict[str, Source],
+    what: str = "the rename",
 ) -> types.WorkspaceEdit:
     """A WorkspaceEdit over several documents, each converted with its own line index
-    (versioned for open documents when the client supports document changes)."""
+    (versioned for open documents when the client supports document changes); ``what``
+    says in the other files' change annotations what renames them."""
     enc = ls.encoding
     per_uri: list[tuple[str, int | None, list[types.TextEdit]]] = [
         (od.uri, od.version, [to_text_edit(od.doc.lines, e, enc) for e in edits])
@@ -150,7 +152,7 @@ def rename_edit(
         per_uri.append(
             (src.uri, src.version, [to_text_edit(src.doc.lines, e, enc) for e in file_edits])
         )
-    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits)
+    return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits, what)
 
 
 # The outline's nesting depth.  BehaviorTree.CPP allows trees 256 levels deep; a symbol
@@ -403,7 +405,9 @@ def register(server: BtServer) -> None:
             raise RequestFailed(e.message) from None
         if plan is None:
             return None
-        return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources)
+        target = rename_target(od.doc, req.offset, req.context().btcpp_version)
+        what = f"Rename '{target.placeholder}' to '{params.new_name}'" if target else "the rename"
+        return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources, what)
 
     @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
     def document_symbol(ls: BtServer, params: types.DocumentSymbolParams) -> RawJson | None:
