@@ -142,3 +142,25 @@ async def test_version_of_a_v3_package_in_hover_and_log(client: BtClient, tmp_pa
 
     [line] = await client.wait_until(logged, "the version in the log")
     assert str(tmp_path / "pkg") in line
+
+
+@clients("nvim-0.11")
+async def test_a_pull_client_pulls_the_error_of_an_open_config_file(
+    client: BtClient, tmp_path: Path
+) -> None:
+    config = tmp_path / "bt-lsp.toml"
+    config.write_text('[severity]\nmissing-format = "eror"\n', encoding="utf-8")
+    open_file(client, tmp_path / "tree.xml", TREE)
+    cfg_uri = open_file(client, config, config.read_text(encoding="utf-8"), language="toml")
+
+    async def items() -> list[types.Diagnostic]:
+        report = await client.pull_report(cfg_uri)
+        assert isinstance(report, types.RelatedFullDocumentDiagnosticReport)
+        return list(report.items)
+
+    [d] = await eventually(items, lambda found: len(found) == 1, "the config error")
+    assert d.code == "config-error" and '"eror"' in d.message
+    assert (d.range.start, d.range.end) == (
+        types.Position(1, 0),
+        types.Position(1, len('missing-format = "eror"')),
+    )

@@ -88,3 +88,28 @@ def test_without_code_descriptions_nothing_described_is_reused() -> None:
     assert all("codeDescription" in d for d in described)
     plain = json.loads(published.array(doc.lines, analyze(doc), "utf-16", described=False))
     assert plain and all("codeDescription" not in d for d in plain)
+
+
+def test_a_pulled_report_reuses_the_unchanged_diagnostics_json() -> None:
+    """textDocument/diagnostic writes its items with the document's DiagnosticJson, as a
+    publication does: after an edit that changes no diagnostic's content, nothing is
+    converted again, and the items are what a fresh conversion gives."""
+    from bt_lsp.server.app import create_server
+    from bt_lsp.server.state import OpenDocument
+
+    ls = create_server()
+    ls.code_descriptions = True
+    od = OpenDocument("untitled:pulled.xml", document(30), 1, "xml")
+    od.refresh_kind()
+    ls.docs[od.uri] = od
+    first = json.loads(ls.diagnostics_json(od))
+    assert first == fresh(od.doc)
+    converted = od.published.converted
+    assert converted > 0
+    at = od.doc.text.index('    <Sequence name="s12')
+    od.doc.edit(at, at, "\n")  # every later diagnostic moves a line down
+    od.version = 2
+    ls.edits += 1
+    again = json.loads(ls.diagnostics_json(od))
+    assert again == fresh(od.doc) != first  # moved, and written anew where they moved to
+    assert od.published.converted == converted

@@ -278,6 +278,38 @@ async def test_pull_client_gets_no_pushes_and_unchanged_reports(client: BtClient
     assert uri not in client.published  # never pushed, not even on close
 
 
+@clients(*PULL_CLIENTS)
+async def test_pulled_reports_after_edits_match_a_fresh_open(client: BtClient) -> None:
+    """Pulled reports are written as JSON reusing the unchanged diagnostics' parts (see
+    test_publication_reuse.py): after an edit that moves, adds or removes diagnostics,
+    every field of every item is what a fresh open of the same text reports."""
+    trees = "".join(
+        f'  <BehaviorTree ID="T{i}"><Sequence name="s&#7;{i}"><Do.It{i} a.b="1"/>'
+        f'<SubTree ID="Missing"/></Sequence></BehaviorTree>\n'
+        for i in range(12)
+    )
+    text = f'<root BTCPP_format="4" main_tree_to_execute="T0">\n{trees}</root>\n'
+    uri = client.open(text)
+
+    def order(items: list[types.Diagnostic]) -> list[types.Diagnostic]:
+        return sorted(items, key=lambda d: (key(d.range), str(d.code), d.message))
+
+    for old, new in (('name="s&#7;3"', 'name="😋 s3"'), ("<Do.It5 ", "<DoIt5 "), ("T7", "T.7")):
+        assert (await client.pull_report(uri)).kind == "full"  # what the edit may reuse
+        at = text.index(old)
+        client.change(uri, 2, partial(text, at, at + len(old), new, client.encoding))
+        text = text[:at] + new + text[at + len(old) :]
+        edited = await client.pull_report(uri)
+        client.close(uri)
+        uri = client.open(text)  # alone in the workspace, as the edited one was
+        opened = await client.pull_report(uri)
+        assert isinstance(edited, types.RelatedFullDocumentDiagnosticReport)
+        assert isinstance(opened, types.RelatedFullDocumentDiagnosticReport)
+        assert order(list(edited.items)) == order(list(opened.items)), old
+        assert len(edited.items) > 30
+    client.close(uri)
+
+
 async def test_half_typed_tags_match_a_fresh_open(client: BtClient) -> None:
     """Typing an element character by character: after each keystroke the diagnostics are
     those of the same text opened fresh."""

@@ -180,17 +180,18 @@ class BtServer(LanguageServer):
             if found is None and self.diagnostics_key(od) == key:
                 return  # it failed (and was logged): the caller finds out for itself
 
-    def lsp_diagnostics(self, od: OpenDocument) -> list[types.Diagnostic]:
-        diags = self.diagnostics_of(od)
-        at = od.doc.lines.positions([o for d in diags for o in (d.start, d.end)], self.encoding)
-        return [
-            diagnostic_at(
-                types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
-                d,
-                self.code_descriptions,
-            )
-            for d in diags
-        ] + (config_diagnostics(self, od.uri) if not od.is_bt else [])
+    def diagnostics_json(self, od: OpenDocument) -> str:
+        """The JSON array of ``od``'s diagnostics, for a pull client: written as a
+        publication is, reusing what its unchanged diagnostics wrote before
+        (:class:`~bt_lsp.server.convert.DiagnosticJson`)."""
+        array = od.published.array(
+            od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
+        )
+        config = config_diagnostics(self, od.uri) if not od.is_bt else []
+        if not config:
+            return array
+        extra = json.dumps(self.protocol._converter.unstructure(config))
+        return array[:-1] + (", " if array != "[]" else "") + extra[1:]
 
     # -- publishing -------------------------------------------------------------------------
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -9,7 +10,7 @@ from lsprotocol import types
 from pygls.uris import to_fs_path
 
 from bt_lsp.server.background import WORKER_CHARS
-from bt_lsp.server.convert import to_offsets
+from bt_lsp.server.convert import RawJson, to_offsets
 from bt_lsp.server.project import document_edited, is_project_file, sync_config_diagnostics
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
@@ -108,7 +109,7 @@ def register(server: BtServer) -> None:
     )
     async def diagnostic(
         ls: BtServer, params: types.DocumentDiagnosticParams
-    ) -> types.DocumentDiagnosticReport:
+    ) -> types.DocumentDiagnosticReport | RawJson:
         od = ls.get(params.text_document.uri)
         if od is not None:
             await ls.analysed(od)  # a large document on the worker thread
@@ -120,6 +121,6 @@ def register(server: BtServer) -> None:
         result_id = f"{od.version}:{ls.generation}:{ls.project.generation + ls.edits}"
         if params.previous_result_id == result_id and od.cache_key is not None:
             return types.RelatedUnchangedDocumentDiagnosticReport(result_id=result_id)
-        return types.RelatedFullDocumentDiagnosticReport(
-            items=ls.lsp_diagnostics(od), result_id=result_id
-        )
+        # A full report written as JSON, its items as a publication writes them.
+        items = ls.diagnostics_json(od)
+        return RawJson(f'{{"kind": "full", "resultId": {json.dumps(result_id)}, "items": {items}}}')
