@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.syntax.text import Encoding, LineIndex, normalize_encoding, positions_of
+from bt_lsp.syntax.text import Encoding, LineIndex, Offsets, normalize_encoding, positions_of
 
 ENCODINGS: tuple[Encoding, ...] = get_args(Encoding)
 CODECS = {"utf-8": ("utf-8", 1), "utf-16": ("utf-16-le", 2), "utf-32": ("utf-32-le", 4)}
@@ -466,3 +466,37 @@ def test_positions_of_ascii_text_are_position_of_each(
     edited = lines.edited(cut, cut, "x\ny", edited_text)
     for idx in (lines, edited):
         assert idx.positions(offsets, encoding) == {o: idx.position(o, encoding) for o in offsets}
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.integers(0, 5_000), min_size=1, max_size=2_000).map(sorted),
+    st.lists(st.integers(0, 6_000), max_size=300),
+    st.integers(0, 2_100),
+    st.integers(0, 2_100),
+)
+def test_offsets_sweeps_are_their_searches(
+    starts: list[int], probes: list[int], first: int, stop: int
+) -> None:
+    """``floors`` (one sweep over sorted offsets) is ``floor`` of each, and ``between``
+    the slice, over several blocks."""
+    offsets = Offsets.of(starts)
+    assert len(offsets._blocks) == -(-len(starts) // Offsets.BLOCK)
+    probes = sorted(p for p in probes if p >= starts[0])
+    assert offsets.floors(probes) == [offsets.floor(p) for p in probes]
+    assert offsets.between(first, stop) == starts[first:stop]
+
+
+@given(texts, st.integers(0, 45), st.integers(0, 45), encodings)
+def test_starts_between_are_the_lines_of_a_span(
+    text: str, start: int, end: int, enc: Encoding
+) -> None:
+    lines = LineIndex(text)
+    start, end = min(start, len(text)), min(max(start, end), len(text))
+    first, starts = lines.starts_between(start, end)
+    assert first == lines.position(start, "utf-32")[0]
+    assert starts == [
+        lines.line_start(k) for k in range(first, lines.position(end, "utf-32")[0] + 1)
+    ]
+    plain = text.isascii() and "\r" not in text
+    assert lines.plain_columns(enc) == (plain or (enc == "utf-32" and "\r" not in text))

@@ -71,6 +71,36 @@ def test_kept_pieces_make_the_fresh_outline(
         assert outline_json(doc, Context.from_document(doc), enc) == fresh(doc, enc)
 
 
+def plain(text: str) -> str:
+    """``text`` in ASCII with LF line ends: columns are distances, the outline's fast path."""
+    return text.replace("\r\n", "\n").replace(" 😋", "").replace("é", "e")
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0, 1),
+            st.integers(0, 12),
+            st.sampled_from(["x", "\n", "  ", '"', "<", "/>", "</Sequence>", ""]),
+        ),
+        min_size=1,
+        max_size=8,
+    ),
+    st.sampled_from(ENCODINGS),
+)
+def test_kept_pieces_make_the_fresh_outline_in_plain_text(
+    edits: list[tuple[float, int, str]], enc: Encoding
+) -> None:
+    doc = Document(plain(document(5)), "a.xml")
+    assert doc.lines.plain_columns(enc)
+    assert outline_json(doc, Context.from_document(doc), enc) == fresh(doc, enc)
+    for where, length, new in edits:
+        start = int(where * len(doc.text))
+        doc.edit(start, min(start + length, len(doc.text)), new)
+        assert outline_json(doc, Context.from_document(doc), enc) == fresh(doc, enc)
+
+
 def test_deeper_than_the_limit_and_outside_the_root() -> None:
     for text in (
         deep(MAX_SYMBOL_DEPTH + 5),

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from enum import StrEnum
+from operator import attrgetter
 
 from bt_lsp.ide.places import element_end
 from bt_lsp.ide.ports import builtins_in
@@ -66,34 +67,51 @@ def _id_span(el: Element) -> tuple[str, int, int]:
     return "", el.name_start, el.name_end
 
 
-def _symbol_of(
-    el: Element, ctx: Context | None, used: dict[str, str] | None = None
-) -> DocSymbol | None:
+def _label(el: Element) -> str | None:
+    """The ``name`` attribute's value (``Element.value`` inlined: it is asked of every
+    node of the outline)."""
+    for a in el.attrs:
+        if a.name == "name":
+            return a.value
+    return None
+
+
+# Enum members as module constants: reading ``Zone.NODE`` costs a lookup through the
+# enum class (most of a symbol's time in Python 3.11), a module global does not.
+_Z_NODE, _Z_TREE, _Z_MODELS = Zone.NODE, Zone.TREE, Zone.MODELS
+_Z_MODEL_ENTRY, _Z_PORT_DECL, _Z_INCLUDE = Zone.MODEL_ENTRY, Zone.PORT_DECL, Zone.INCLUDE
+_K_TREE, _K_NODE, _K_SUBTREE = SymbolKind.TREE, SymbolKind.NODE, SymbolKind.SUBTREE
+_K_MODELS, _K_MODEL, _K_PORT = SymbolKind.MODELS, SymbolKind.MODEL, SymbolKind.PORT
+_K_INCLUDE = SymbolKind.INCLUDE
+
+
+def _symbol_of(el: Element, category: Callable[[str], str]) -> DocSymbol | None:
     zone = el.zone
-    if zone == Zone.TREE:
-        tid, s, e = _id_span(el)
-        return DocSymbol(tid or "(no ID)", "BehaviorTree", SymbolKind.TREE, 0, 0, s, e)
-    if zone == Zone.NODE:
-        label = el.value("name")
-        if el.name == "SubTree":
+    if zone == _Z_NODE:
+        label = _label(el)
+        name = el.name
+        if name == "SubTree":
             tid, s, e = _id_span(el)
             return DocSymbol(
-                label or tid or "SubTree", f"SubTree {tid}".strip(), SymbolKind.SUBTREE, 0, 0, s, e
+                label or tid or "SubTree", f"SubTree {tid}".strip(), _K_SUBTREE, 0, 0, s, e
             )
-        if el.name in EXPLICIT_TAGS:
+        if name in EXPLICIT_TAGS:
             nid, s, e = _id_span(el)
-            detail = f"{el.name} {nid}".strip()
+            detail = f"{name} {nid}".strip()
         else:
-            nid, s, e = el.name, el.name_start, el.name_end
-            detail = _category(nid, ctx, used)
+            nid, s, e = name, el.name_start, el.name_end
+            detail = category(nid)
             detail = f"{detail} {nid}".strip() if label else detail
-        return DocSymbol(label or nid or el.name, detail, SymbolKind.NODE, 0, 0, s, e)
-    if zone == Zone.MODELS:
-        return DocSymbol(el.name, "", SymbolKind.MODELS, 0, 0, el.name_start, el.name_end)
-    if zone == Zone.MODEL_ENTRY:
+        return DocSymbol(label or nid or name, detail, _K_NODE, 0, 0, s, e)
+    if zone == _Z_TREE:
+        tid, s, e = _id_span(el)
+        return DocSymbol(tid or "(no ID)", "BehaviorTree", _K_TREE, 0, 0, s, e)
+    if zone == _Z_MODELS:
+        return DocSymbol(el.name, "", _K_MODELS, 0, 0, el.name_start, el.name_end)
+    if zone == _Z_MODEL_ENTRY:
         mid, s, e = _id_span(el)
-        return DocSymbol(mid or el.name, el.name, SymbolKind.MODEL, 0, 0, s, e)
-    if zone == Zone.PORT_DECL:
+        return DocSymbol(mid or el.name, el.name, _K_MODEL, 0, 0, s, e)
+    if zone == _Z_PORT_DECL:
         a = el.attr("name")
         if a is not None and a.value is not None:
             s, e = el.span_of_value(a)
@@ -102,15 +120,13 @@ def _symbol_of(
             pname, s, e = "", el.name_start, el.name_end
         ptype = el.value("type")
         detail = el.name.replace("_", " ") + (f": {ptype}" if ptype else "")
-        return DocSymbol(pname or "(no name)", detail, SymbolKind.PORT, 0, 0, s, e)
-    if zone == Zone.INCLUDE:
+        return DocSymbol(pname or "(no name)", detail, _K_PORT, 0, 0, s, e)
+    if zone == _Z_INCLUDE:
         a = el.attr("path")
         if a is not None and a.value is not None:
             s, e = el.span_of_value(a)
-            return DocSymbol(a.value or "(no path)", "include", SymbolKind.INCLUDE, 0, 0, s, e)
-        return DocSymbol(
-            "(no path)", "include", SymbolKind.INCLUDE, 0, 0, el.name_start, el.name_end
-        )
+            return DocSymbol(a.value or "(no path)", "include", _K_INCLUDE, 0, 0, s, e)
+        return DocSymbol("(no path)", "include", _K_INCLUDE, 0, 0, el.name_start, el.name_end)
     return None
 
 
@@ -124,20 +140,36 @@ def _outline(
     is not among them (or is no symbol) is at the top."""
     made: dict[int, DocSymbol] = {}
     top: list[DocSymbol] = []
+    known: dict[str, str] = {}  # node type -> category, each looked up once
+
+    def category(node_id: str) -> str:
+        found = known.get(node_id)
+        if found is None:
+            found = known[node_id] = _category(node_id, ctx, used)
+        return found
+
+    parents: list[DocSymbol] = []  # the symbols with children, in document order
     for i, el in items:
-        sym = _symbol_of(el, ctx, used)
+        sym = _symbol_of(el, category)
         if sym is None:
             continue
         sym.start, sym.end = el.token_start, end_of(el)
         made[i] = sym
         parent = made.get(el.parent)
-        (parent.children if parent is not None else top).append(sym)
-    # A parent's range must hold its children's (an unclosed element ends at its tag).
-    for i in sorted(made, reverse=True):
-        sym = made[i]
-        for c in sym.children:
-            sym.end = max(sym.end, c.end)
+        if parent is None:
+            top.append(sym)
+        else:
+            if not parent.children:
+                parents.append(parent)
+            parent.children.append(sym)
+    # A parent's range must hold its children's (an unclosed element ends at its tag);
+    # the deepest first, so that a child's end is final when its parent's is taken.
+    for sym in reversed(parents):
+        sym.end = max(sym.end, *map(_END, sym.children))
     return top
+
+
+_END = attrgetter("end")
 
 
 def document_symbols(doc: Document, ctx: Context | None = None) -> list[DocSymbol]:

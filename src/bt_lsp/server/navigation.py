@@ -8,7 +8,9 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from bisect import bisect_right
 from collections.abc import Callable, Sequence
+from itertools import repeat
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -41,6 +43,7 @@ from bt_lsp.server.lookup import (
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit
+from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.text import Encoding, LineIndex
 
 if TYPE_CHECKING:
@@ -55,6 +58,7 @@ _SYMBOL_KINDS = {
     SymbolKind.PORT: types.SymbolKind.Property,
     SymbolKind.INCLUDE: types.SymbolKind.File,
 }
+_KIND_NUMBERS = {kind: str(int(number)) for kind, number in _SYMBOL_KINDS.items()}
 
 
 class RequestFailed(JsonRpcException):
@@ -165,41 +169,48 @@ MAX_SYMBOL_DEPTH = 64
 def _pre_order(top: Sequence[DocSymbol]) -> list[tuple[DocSymbol, int]]:
     """The symbols with their depth (from 1), in document order, without recursion."""
     order: list[tuple[DocSymbol, int]] = []
+    add = order.append
     stack = [(s, 1) for s in reversed(top)]
+    pop, push = stack.pop, stack.extend
     while stack:
-        s, depth = stack.pop()
-        order.append((s, depth))
-        below = min(depth + 1, MAX_SYMBOL_DEPTH)
-        stack.extend((c, below) for c in reversed(s.children))
+        s, depth = pop()
+        add((s, depth))
+        if s.children:  # most symbols are leaves
+            push(zip(reversed(s.children), repeat(min(depth + 1, MAX_SYMBOL_DEPTH))))
     return order
 
 
 def _write(
-    order: list[tuple[DocSymbol, int]], out: list[str], rng: Callable[[int, int], None]
+    order: list[tuple[DocSymbol, int]], out: list[str], rng: Callable[[int, int], str]
 ) -> None:
     """Append the symbols of ``order`` to ``out`` as the JSON of LSP DocumentSymbols,
-    separated by commas, without the enclosing brackets; ``rng`` appends a range."""
+    separated by commas, without the enclosing brackets; ``rng`` writes a range."""
     first = [True] * (MAX_SYMBOL_DEPTH + 2)  # no symbol yet in the open list at a depth
     open_depth = 0
+    add = out.append
+    quoted: dict[str, str] = {}  # names and details repeat: each is quoted once
     for s, depth in order:
         while open_depth >= depth:  # close the symbols this one is not inside
-            out.append("]}")
+            add("]}")
             open_depth -= 1
         if not first[depth]:
-            out.append(", ")
+            add(", ")
         first[depth] = False
-        detail = f'"detail": {json.dumps(s.detail)}, ' if s.detail else ""
-        out.append(
-            f'{{"name": {json.dumps(s.name)}, {detail}"kind": {int(_SYMBOL_KINDS[s.kind])}, '
-            '"range": '
+        name = quoted.get(s.name)
+        if name is None:
+            name = quoted[s.name] = json.dumps(s.name)
+        detail = ""
+        if s.detail:
+            detail = quoted.get(s.detail) or quoted.setdefault(s.detail, json.dumps(s.detail))
+            detail = f'"detail": {detail}, '
+        add(
+            f'{{"name": {name}, {detail}"kind": {_KIND_NUMBERS[s.kind]}, '
+            f'"range": {rng(s.start, s.end)}, "selectionRange": {rng(s.sel_start, s.sel_end)}, '
+            '"children": ['
         )
-        rng(s.start, s.end)
-        out.append(', "selectionRange": ')
-        rng(s.sel_start, s.sel_end)
-        out.append(', "children": [')
         first[depth + 1] = True
         open_depth = depth
-    out.append("]}" * open_depth)
+    add("]}" * open_depth)
 
 
 def _symbols_text(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> str:
@@ -210,9 +221,9 @@ def _symbols_text(lines: LineIndex, top: Sequence[DocSymbol], enc: Encoding) -> 
     )
     out: list[str] = []
 
-    def rng(start: int, end: int) -> None:
+    def rng(start: int, end: int) -> str:
         (sl, sc), (el, ec) = at[start], at[end]
-        out.append(
+        return (
             f'{{"start": {{"line": {sl}, "character": {sc}}}, '
             f'"end": {{"line": {el}, "character": {ec}}}}}'
         )
@@ -263,28 +274,49 @@ class _Template:
 
 def _template(lines: LineIndex, origin: int, top: Sequence[DocSymbol], enc: Encoding) -> _Template:
     order = _pre_order(top)
-    at = lines.positions(
-        [origin + o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)] + [origin],
-        enc,
-    )
-    line0, col0 = at[origin]
+    pos: Callable[[int], str]
+    if lines.plain_columns(enc):
+        # A column is a distance: the section's line starts are enough (one C search per
+        # position, no sorting of the positions).
+        reach = max(max(s.end, s.sel_end) for s, _ in order) if order else 0
+        _, starts = lines.starts_between(origin, origin + reach)
+        local = [start - origin for start in starts]  # local[0] <= 0: the first line's
+
+        def pos(offset: int) -> str:
+            k = bisect_right(local, offset) - 1
+            if k <= 0:  # on the first line: the column counts from the section's
+                return f'{{"line": {_MARK}0{_MARK}, "character": {_MARK}{offset << 1 | 1}{_MARK}}}'
+            return f'{{"line": {_MARK}{k << 1}{_MARK}, "character": {offset - local[k]}}}'
+
+    else:
+        at = lines.positions(
+            [origin + o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)]
+            + [origin],
+            enc,
+        )
+        line0, col0 = at[origin]
+        marked: dict[int, str] = {}  # each position's JSON, its numbers marked
+        for o, (line, col) in at.items():
+            if line == line0:
+                marked[o - origin] = (
+                    f'{{"line": {_MARK}0{_MARK}, '
+                    f'"character": {_MARK}{(col - col0) << 1 | 1}{_MARK}}}'
+                )
+            else:
+                marked[o - origin] = (
+                    f'{{"line": {_MARK}{(line - line0) << 1}{_MARK}, "character": {col}}}'
+                )
+        pos = marked.__getitem__
     out: list[str] = []
 
-    def pos(offset: int) -> str:
-        line, col = at[origin + offset]
-        if line == line0:
-            return (
-                f'{{"line": {_MARK}0{_MARK}, "character": {_MARK}{(col - col0) << 1 | 1}{_MARK}}}'
-            )
-        return f'{{"line": {_MARK}{(line - line0) << 1}{_MARK}, "character": {col}}}'
-
-    def rng(start: int, end: int) -> None:
-        out.append(f'{{"start": {pos(start)}, "end": {pos(end)}}}')
+    def rng(start: int, end: int) -> str:
+        return f'{{"start": {pos(start)}, "end": {pos(end)}}}'
 
     _write(order, out, rng)
     return _Template("".join(out))
 
 
+@with_gc_paused  # a large outline makes hundreds of thousands of objects at once
 def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
     """:func:`document_symbols_json` of the document's outline, made of its sections'
     pieces: a section's JSON is kept on it (with its outline, see

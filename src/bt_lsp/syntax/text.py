@@ -203,6 +203,38 @@ class Offsets(Sequence[int]):
         j = bisect_right(block, offset - base) - 1
         return self._firsts[b] + j, base + block[j]
 
+    def floors(self, offsets: Sequence[int]) -> list[tuple[int, int]]:
+        """:meth:`floor` of each of ``offsets`` (sorted, none before the first offset),
+        in one sweep: the block is searched for only when an offset passes its end."""
+        bases, firsts, blocks = self._bases, self._firsts, self._blocks
+        out: list[tuple[int, int]] = []
+        add = out.append
+        nxt = -1  # the base of the block after the current one (none yet)
+        base = first = 0
+        block = blocks[0] if blocks else array("q")
+        for o in offsets:
+            if o >= nxt:
+                b = bisect_right(bases, o) - 1
+                base, first, block = bases[b], firsts[b], blocks[b]
+                nxt = bases[b + 1] if b + 1 < len(bases) else o + (1 << 62)
+            j = bisect_right(block, o - base) - 1
+            add((first + j, base + block[j]))
+        return out
+
+    def between(self, first: int, stop: int) -> list[int]:
+        """The offsets of indexes ``first`` to ``stop`` (excluded), from their blocks only."""
+        firsts, n = self._firsts, self._n
+        out: list[int] = []
+        stop = min(stop, n)
+        if first >= stop:
+            return out
+        b = bisect_right(firsts, first) - 1
+        while b < len(firsts) and firsts[b] < stop:
+            lo, block = firsts[b], self._blocks[b]
+            out.extend(map(self._bases[b].__add__, block[max(first - lo, 0) : stop - lo]))
+            b += 1
+        return out
+
     def index_at(self, offset: int) -> int:
         """Index of the last offset at or before ``offset`` (-1 if none)."""
         return self.bisect_right(offset) - 1
@@ -338,6 +370,21 @@ class LineIndex:
             offset -= 1  # between "\r" and "\n": the end of the line
         return line, _column(text, start, offset, encoding)
 
+    def plain_columns(self, encoding: Encoding) -> bool:
+        """Whether every column is its distance from the line start in ``encoding`` (no
+        CR, and only ASCII or UTF-32), so that a caller may count columns itself."""
+        text = self._text
+        if self._plain is None:
+            self._plain = text.isascii() and "\r" not in text
+        return self._plain or (encoding == "utf-32" and "\r" not in text)
+
+    def starts_between(self, start: int, end: int) -> tuple[int, list[int]]:
+        """The line holding offset ``start``, and the starts of it and of the lines after
+        it that start at or before ``end``: what the positions of a span need."""
+        starts = self._starts
+        first = max(starts.bisect_right(start) - 1, 0)
+        return first, starts.between(first, starts.bisect_right(end))
+
     def positions(self, offsets: Iterable[int], encoding: Encoding) -> dict[int, tuple[int, int]]:
         """:meth:`position` of each of ``offsets``, in one pass over them sorted: the line
         starts are searched in C, and on one line each column is counted on from the
@@ -356,9 +403,8 @@ class LineIndex:
             self._plain = text.isascii() and "\r" not in text
         if self._plain or (encoding == "utf-32" and "\r" not in text):
             # A column is the distance from the line start.
-            for o in offs:
-                at = n if o > n else max(o, 0)
-                line, start = floor(at)
+            ats = [n if o > n else max(o, 0) for o in offs]
+            for o, at, (line, start) in zip(offs, ats, self._starts.floors(ats), strict=True):
                 out[o] = (line, at - start)
             return out
         at = column = line = 0
