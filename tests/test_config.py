@@ -198,3 +198,52 @@ def test_editor_settings_parse_btcpp_and_model_files() -> None:
     assert s.btcpp == "3" and s.models == (Path("a.xml"),) and problems == []
     s = Settings.parse({"btcpp": "2"}, problems)
     assert s.btcpp == "auto" and problems and "btcpp" in problems[0]
+
+
+def _touch_later(path: Path, text: str) -> None:
+    """Write ``text`` with a modification time surely different from the previous one."""
+    import os
+
+    before = path.stat().st_mtime_ns if path.exists() else 0
+    path.write_text(text, encoding="utf-8")
+    os.utime(path, ns=(before + 10**9, before + 10**9))
+
+
+def test_revalidate_finds_configuration_files_created_changed_or_deleted(tmp_path: Path) -> None:
+    """For clients that do not watch files: what was looked for or read is compared with
+    the disk, and only a change of the configuration that applies is reported."""
+    sub = tmp_path / "pkg" / "trees"
+    sub.mkdir(parents=True)
+    tree = sub / "a.xml"
+    tree.write_text("<root/>", encoding="utf-8")
+    configs = Configs()
+    assert configs.for_path(tree) is None
+    assert configs.revalidate() == []
+
+    (sub / "notes.txt").write_text("x", encoding="utf-8")  # the folder changes, no config
+    assert configs.revalidate() == []
+
+    config = tmp_path / "pkg" / "bt-lsp.toml"
+    config.write_text('btcpp = "3"\n', encoding="utf-8")  # in a folder above: found
+    assert configs.revalidate() == [config]
+    found = configs.for_path(tree)
+    assert isinstance(found, Layer) and found.btcpp == "3"
+
+    _touch_later(config, 'btcpp = "4"\n')
+    assert configs.revalidate() == [config]
+    found = configs.for_path(tree)
+    assert isinstance(found, Layer) and found.btcpp == "4"
+
+    # A pyproject.toml nearer the file counts once it has a [tool.bt-lsp] table.
+    pyproject = sub / "pyproject.toml"
+    pyproject.write_text("[project]\nname = 'x'\n", encoding="utf-8")
+    assert configs.revalidate() == []
+    assert configs.path_for(tree) == config
+    _touch_later(pyproject, "[tool.bt-lsp]\nbtcpp = '3'\n")
+    assert configs.revalidate() == [config, pyproject]
+    assert configs.path_for(tree) == pyproject
+
+    pyproject.unlink()
+    config.unlink()
+    assert configs.revalidate() == [pyproject]
+    assert configs.for_path(tree) is None

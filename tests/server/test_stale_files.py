@@ -218,3 +218,51 @@ async def test_a_file_created_or_deleted_on_disk_is_seen(client: Client) -> None
     await _subtree_message(client, caller, "defined in created.xml")
     _close(client, caller)
     made.unlink()
+
+
+UNFORMATTED = """<root main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <AlwaysSuccess/>
+  </BehaviorTree>
+</root>
+"""
+
+
+async def test_a_configuration_file_created_changed_or_deleted_on_disk_counts(
+    client: Client,
+) -> None:
+    """bt-lsp.toml written next to an open document after it was opened, by another
+    program: its settings apply at the next check of the disk, its error is published on
+    it, and deleting it brings the defaults back."""
+    folder = client.ws / "configured"
+    folder.mkdir()
+    (folder / "tree.xml").write_text(UNFORMATTED, encoding="utf-8")
+    uri = _uri(client, "configured/tree.xml")
+    _open(client, uri, UNFORMATTED)
+    await _codes(client, uri, 1, {"missing-format"})
+
+    config = folder / "bt-lsp.toml"
+    config_uri = _uri(client, "configured/bt-lsp.toml")
+    config.write_text('[severity]\nmissing-format = "off"\n', encoding="utf-8")
+    await asyncio.sleep(1.2)  # the server compares with the disk at most once a second
+    _change(client, uri, 2, UNFORMATTED + "\n")
+    await _codes(client, uri, 2, set())
+
+    # Changed: an error (then the file is ignored and the defaults apply).
+    config.write_text('[severity]\nmissing-format = "of"\n', encoding="utf-8")
+    await asyncio.sleep(1.2)
+    _change(client, uri, 3, UNFORMATTED)
+    await _codes(client, uri, 3, {"missing-format"})
+    await _codes(client, config_uri, 0, {"config-error"})
+
+    config.write_text('[severity]\nmissing-format = "off"\n', encoding="utf-8")
+    await asyncio.sleep(1.2)
+    _change(client, uri, 4, UNFORMATTED + "\n")
+    await _codes(client, uri, 4, set())
+    await _codes(client, config_uri, 0, set())
+
+    config.unlink()
+    await asyncio.sleep(1.2)
+    _change(client, uri, 5, UNFORMATTED)
+    await _codes(client, uri, 5, {"missing-format"})
+    _close(client, uri)

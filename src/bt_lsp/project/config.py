@@ -105,11 +105,30 @@ class Config(Layer):
     path: Path = field(default=Path())
 
 
-def find_config(start: Path) -> Path | None:
-    """The nearest configuration file at or above ``start`` (a file or a folder)."""
+Stamp = tuple[int, int]
+
+
+def _stamp(path: Path) -> Stamp:
+    """A file's or folder's (mtime_ns, size); (0, 0) when it is not there."""
+    try:
+        st = path.stat()
+    except (OSError, ValueError):
+        return (0, 0)
+    return (st.st_mtime_ns, st.st_size)
+
+
+def find_config(start: Path, searched: dict[Path, Stamp] | None = None) -> Path | None:
+    """The nearest configuration file at or above ``start`` (a file or a folder).  Each
+    folder looked in, and each ``pyproject.toml`` read, is recorded in ``searched`` with
+    its stamp, taken before (a file created or deleted in a folder changes the folder's
+    modification time)."""
     folder = start if os.path.isdir(start) else start.parent
     for _ in range(MAX_DEPTH):
+        if searched is not None:
+            searched[folder] = _stamp(folder)
         for name in CONFIG_NAMES:
+            if searched is not None and name == PYPROJECT:
+                searched[folder / name] = _stamp(folder / name)
             candidate = folder / name
             try:
                 if not candidate.is_file():
@@ -380,6 +399,9 @@ class Configs:
         self._found: dict[Path, Path | None] = {}
         self._loaded: dict[Path, Config | ConfigError | None] = {}
         self._texts: dict[Path, str] = {}  # configuration files open in an editor
+        # What the files found and read depend on, on disk (see revalidate).
+        self._searched: dict[Path, Stamp] = {}
+        self._read: dict[Path, Stamp] = {}
 
     def path_for(self, path: Path) -> Path | None:
         """The configuration file that applies to ``path`` (a file or folder)."""
@@ -387,12 +409,14 @@ class Configs:
             return self.explicit
         folder = path if os.path.isdir(path) else path.parent
         if folder not in self._found:
-            self._found[folder] = find_config(folder)
+            self._found[folder] = find_config(folder, self._searched)
         return self._found[folder]
 
     def load(self, config_path: Path) -> Config | ConfigError | None:
         if config_path not in self._loaded:
             text = self._texts.get(config_path)
+            if text is None:
+                self._read[config_path] = _stamp(config_path)
             try:
                 self._loaded[config_path] = load_config(
                     config_path, None if text is None else text.encode("utf-8")
@@ -428,9 +452,33 @@ class Configs:
         configuration file."""
         if path.name not in CONFIG_NAMES and path != self.explicit:
             return False
+        self._forget()
+        return True
+
+    def _forget(self) -> None:
         self._found.clear()
         self._loaded.clear()
-        return True
+        self._searched.clear()
+        self._read.clear()
+
+    def revalidate(self) -> list[Path]:
+        """For clients that do not report file changes: the configuration files created,
+        changed or deleted on disk since they were looked for or read (then everything is
+        forgotten).  A folder on the way that changed for another reason (a file of
+        another kind made in it) only costs looking again."""
+        changed = [p for p, st in self._read.items() if _stamp(p) != st]
+        if not changed and not any(_stamp(p) != st for p, st in self._searched.items()):
+            return []
+        before = dict(self._found)
+        self._found.clear()
+        self._searched.clear()
+        for folder, found in before.items():
+            now = self.path_for(folder)
+            if now != found:
+                changed.extend(p for p in (found, now) if p is not None)
+        if changed:
+            self._forget()
+        return changed
 
 
 # -- exclude globs -------------------------------------------------------------------------

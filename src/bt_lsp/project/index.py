@@ -223,6 +223,7 @@ class ProjectIndex:
         and find the workspace's files again when a file was created or deleted in one of
         its folders (for clients that do not report file changes); ``True`` if any was."""
         changed = [p for p, (stamp, _, _) in self._disk.items() if _stamp(p) != stamp]
+        changed += self.configs.revalidate()  # bt-lsp.toml created, edited or deleted
         for p in changed:
             self.file_changed(p)
         if self._files is not None and any(_folder_stamp(d) != t for d, t in self._folders.items()):
