@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from bt_lsp.rules import semantics
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import Diagnostic, limited, own_diagnostics
+from bt_lsp.rules.diagnostics import Diagnostic, limited, more_of, own_diagnostics
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.gcpause import with_gc_paused
 
@@ -17,7 +17,8 @@ def analyze(doc: Document, ctx: Context | None = None) -> list[Diagnostic]:
     Without ``ctx`` the document is checked as if it were alone
     (:meth:`Context.from_document`).
     """
-    out = list(own_diagnostics(doc))
-    out.extend(semantics.check(doc, ctx if ctx is not None else Context.from_document(doc)))
+    own = own_diagnostics(doc)
+    found = semantics.check(doc, ctx if ctx is not None else Context.from_document(doc))
+    out = [*own, *found]
     out.sort(key=lambda d: (d.start, d.end, d.code))
-    return limited(out)
+    return limited(out, more=more_of(own) + more_of(found))

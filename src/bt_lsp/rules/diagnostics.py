@@ -76,6 +76,37 @@ def make(start: int, end: int, code: str, message: str, data: FixData | None = N
     return Diagnostic(start, end, code, message, defined(code).severity, data)
 
 
+MAX_DIAGNOSTICS = 2000
+
+
+class Capped(list[Diagnostic]):
+    """Diagnostics sorted by position, at most :data:`MAX_DIAGNOSTICS` of them (the first),
+    and in ``more`` how many others were found and not kept.  What lies beyond the
+    publication cap is never published, so it is not kept either: a hostile document has
+    hundreds of thousands of findings, each costing more memory than its text."""
+
+    __slots__ = ("more",)
+
+    def __init__(self, kept: Iterable[Diagnostic] = (), more: int = 0) -> None:
+        super().__init__(kept)
+        self.more = more
+
+
+def more_of(diags: Iterable[Diagnostic]) -> int:
+    """How many diagnostics were found beyond those of ``diags`` (see :class:`Capped`)."""
+    return diags.more if isinstance(diags, Capped) else 0
+
+
+def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTICS) -> Capped:
+    """``diags`` sorted by position (stable), the first ``maximum`` kept; ``more``: how
+    many were already left out before."""
+    diags.sort(key=sort_key)
+    if len(diags) > maximum:
+        more += len(diags) - maximum
+        del diags[maximum:]
+    return Capped(diags, more)
+
+
 # The violations of each name text, per role (a role decides the kind and whether the
 # name is declared): model and port names repeat (every use of a node type or port), and
 # a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
@@ -141,7 +172,8 @@ def lexical_diagnostics(scan: Scan) -> list[Diagnostic]:
     return out
 
 
-def _sort_key(d: Diagnostic) -> tuple[int, int, str]:
+def sort_key(d: Diagnostic) -> tuple[int, int, str]:
+    """The order of diagnostics: by position, then code."""
     return d.start, d.end, d.code
 
 
@@ -151,19 +183,21 @@ _SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
 ] = weakref.WeakKeyDictionary()
 
 
-def _own(section: Section) -> list[Diagnostic]:
-    """The diagnostics of one section (in its coordinates), computed once."""
-    out: list[Diagnostic] | None = section.cache.get("diagnostics")
+def _own(section: Section) -> Capped:
+    """The diagnostics of one section (in its coordinates), computed once; the first
+    :data:`MAX_DIAGNOSTICS` are kept."""
+    out: Capped | None = section.cache.get("diagnostics")
     if out is None:
-        out = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
-        out.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
-        out.extend(ref_diagnostics(section.refs))
-        section.cache["diagnostics"] = out
+        found = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
+        found.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
+        found.extend(ref_diagnostics(section.iter_refs()))
+        out = section.cache["diagnostics"] = capped(found)
     return out
 
 
-def compute(doc: Document) -> list[Diagnostic]:
+def compute(doc: Document) -> Capped:
     model = doc.model
+    more = 0
     if model.head is None:
         out = lexical_diagnostics(doc.scan)
         out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
@@ -172,7 +206,9 @@ def compute(doc: Document) -> list[Diagnostic]:
         # Each section's own diagnostics are kept on it; they are only moved here, from
         # the sections that have some.  Which those are is remembered for the document:
         # an edit leaves all but a few sections as they were.
-        out = list(_own(model.head))
+        head = _own(model.head)
+        out = list(head)
+        more = head.more
         sections = model.sections
         now = set(sections)
         seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc, (set(), set()))
@@ -184,14 +220,17 @@ def compute(doc: Document) -> list[Diagnostic]:
             index = dict(zip(sections, range(len(sections)), strict=True))
             for k in sorted(index[sec] for sec in with_diagnostics):
                 o = origins[k]
+                own = _own(sections[k])
+                more += own.more
                 out.extend(
                     Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)
-                    for d in _own(sections[k])
+                    for d in own
                 )
         if model.tail is not None:
-            out.extend(_own(model.tail))
-    out.sort(key=_sort_key)
-    return out
+            tail = _own(model.tail)
+            out.extend(tail)
+            more += tail.more
+    return capped(out, more)
 
 
 def with_severities(
@@ -211,13 +250,14 @@ def with_severities(
     return out
 
 
-MAX_DIAGNOSTICS = 2000
-
-
-def limited(diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS) -> list[Diagnostic]:
+def limited(
+    diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS, more: int = 0
+) -> list[Diagnostic]:
     """At most ``maximum`` diagnostics (the first by position), plus one that says how many
-    were left out: hostile or binary input must not flood the client."""
-    if len(diags) <= maximum:
+    were left out (``more`` of them before ``diags`` was made): hostile or binary input
+    must not flood the client."""
+    left_out = len(diags) + more - maximum
+    if left_out <= 0:
         return diags
     kept = diags[:maximum]
     kept.append(
@@ -225,18 +265,17 @@ def limited(diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS) -> list[Dia
             0,
             0,
             TOO_MANY_PROBLEMS.code,
-            f"{len(diags) - maximum} more problems are not shown "
-            f"(only the first {maximum} are reported)",
+            f"{left_out} more problems are not shown (only the first {maximum} are reported)",
         )
     )
     return kept
 
 
-def own_diagnostics(doc: Document) -> list[Diagnostic]:
+def own_diagnostics(doc: Document) -> Capped:
     """The diagnostics of ``doc`` alone (lexical, XML structure, names), kept on it until
-    its next edit."""
-    found: list[Diagnostic] | None = doc.own_diagnostics
-    if found is None:
+    its next edit: the first :data:`MAX_DIAGNOSTICS`, with how many more there are."""
+    found = doc.own_diagnostics
+    if not isinstance(found, Capped):
         found = doc.own_diagnostics = compute(doc)
     return found
 
@@ -246,7 +285,8 @@ def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
     names, which stay cheap) and ``document-too-large`` saying the rest does not run.
     Capped like every other path, and found with the cyclic collector paused: hostile
     input has the most problems."""
-    out = list(limited(with_gc_paused(own_diagnostics)(doc)))
+    own = with_gc_paused(own_diagnostics)(doc)
+    out = list(limited(own, more=own.more))
     out.append(
         make(
             0,

@@ -160,14 +160,17 @@ class _Builder:
                     tok.attrs,
                     tok.self_closing,
                     tok.closed,
+                    length=tok.length,
                 )
                 els.append(el)
                 if parent is not None:
-                    parent.children.append(idx)
+                    children = parent.children
+                    if children:
+                        children.append(idx)  # type: ignore[attr-defined]  # a list
+                    else:
+                        parent.children = [idx]
                 _check_xml_names(tstart, tok, zone == node_zone, problems)
-                if tok.self_closing:
-                    el.end = tstart + tok.length
-                else:
+                if not tok.self_closing:
                     stack.append(idx)
             elif kind == end_kind:
                 closed = _close(tstart, tok, els, stack, problems)
@@ -189,7 +192,7 @@ class _Builder:
         root_end = None
         if end == CLOSED:
             root = self.els[0]
-            root_end = (root.end, root.end_name_start, root.end_name_end)
+            root_end = (root.end, root.end_name_start)
         return Section(
             ntokens,
             length,
@@ -296,11 +299,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
             re_ = sections[-1].root_end
             assert re_ is not None
             o = origins[-1]
-            root.end, root.end_name_start, root.end_name_end = (
-                re_[0] + o,
-                re_[1] + o if re_[1] >= 0 else -1,
-                re_[2] + o if re_[2] >= 0 else -1,
-            )
+            root.end, root.end_name_start = re_[0] + o, re_[1] + o if re_[1] >= 0 else -1
         tb = _Builder(text, 0, 0, [root], [0] if state != CLOSED else [], True)
         tb.run(tokens, starts, i, _TAIL)
         tb.finish(keep_root=False)
@@ -344,7 +343,7 @@ def _close(
     idx = stack.pop()
     el = elements[idx]
     el.end = tstart + tok.length
-    el.end_name_start, el.end_name_end = name_s, name_e  # its ref: see Section.refs
+    el.end_name_start = name_s  # its ref: see Section.refs
     return idx
 
 

@@ -9,7 +9,7 @@ one).  They are tuples, so equal symbols are equal keys however they were made.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from enum import IntEnum, StrEnum
 from typing import Literal, NamedTuple
 
@@ -120,8 +120,37 @@ class NameRef(NamedTuple):
         return self.role in DECLARING_ROLES
 
 
-@dataclass(slots=True)
+# ``Element._end`` of an empty-element tag: its end is its start tag's (not kept: an int
+# per element costs four times what ``<A/>`` does).
+_SELF_CLOSED = -2
+# The children of an element that has none (shared; the builder makes a list for the
+# first child).
+NO_CHILDREN: tuple[int, ...] = ()
+
+
 class Element:
+    """One element.  A document may be made of a hundred thousand ``<A/>``, so an element
+    is one slotted object that keeps only what it cannot derive: the end of an empty
+    element, the end of its end tag's name and an empty list of children are made when
+    read."""
+
+    __slots__ = (
+        "_end",
+        "attrs",
+        "children",
+        "closed",
+        "content",
+        "depth",
+        "end_name_start",
+        "length",
+        "name",
+        "parent",
+        "self_closing",
+        "token_index",
+        "token_start",
+        "zone",
+    )
+
     name: str
     zone: Zone
     token_start: int
@@ -130,14 +159,107 @@ class Element:
     depth: int
     attrs: tuple[Attr, ...]
     self_closing: bool
-    closed: bool  # its start tag ends with '>' or '/>'
-    end: int = -1  # offset after its end tag (or its start tag when empty); -1 if never closed
-    end_name_start: int = -1  # absolute span of the end tag's name, if any
-    end_name_end: int = -1
-    children: list[int] = field(default_factory=list)
-    # The text inside a port declaration (BehaviorTree.CPP writes a port's description
-    # there); ``None`` for every other element.
-    content: str | None = None
+    closed: bool
+    length: int
+    _end: int
+    end_name_start: int
+    children: Sequence[int]
+    content: str | None
+
+    def __init__(
+        self,
+        name: str,
+        zone: Zone,
+        token_start: int,
+        token_index: int,
+        parent: int,
+        depth: int,
+        attrs: tuple[Attr, ...],
+        self_closing: bool,
+        closed: bool,  # its start tag ends with '>' or '/>'
+        end: int = -1,  # offset after its end tag (or its start tag when empty); -1 if never closed
+        end_name_start: int = -1,  # absolute start of the end tag's name, if any
+        children: Sequence[int] = NO_CHILDREN,
+        # The text inside a port declaration (BehaviorTree.CPP writes a port's description
+        # there); ``None`` for every other element.
+        content: str | None = None,
+        length: int = 0,  # the length of its start tag
+    ) -> None:
+        self.name = name
+        self.zone = zone
+        self.token_start = token_start
+        self.token_index = token_index
+        self.parent = parent
+        self.depth = depth
+        self.attrs = attrs
+        self.self_closing = self_closing
+        self.closed = closed
+        self.length = length
+        self._end = _SELF_CLOSED if self_closing else end
+        self.end_name_start = end_name_start
+        self.children = children if children else NO_CHILDREN
+        self.content = content
+
+    def moved(
+        self, origin: int, token_origin: int, parent: int, children: Sequence[int]
+    ) -> Element:
+        """This element ``origin`` code points and ``token_origin`` tokens further on."""
+        el = Element.__new__(Element)
+        el.name, el.zone, el.attrs, el.depth = self.name, self.zone, self.attrs, self.depth
+        el.self_closing, el.closed, el.length = self.self_closing, self.closed, self.length
+        el.content = self.content
+        el.token_start = self.token_start + origin
+        el.token_index = self.token_index + token_origin
+        el.parent = parent
+        end = self._end
+        el._end = end + origin if end >= 0 else end
+        ens = self.end_name_start
+        el.end_name_start = ens + origin if ens >= 0 else -1
+        el.children = children if children else NO_CHILDREN
+        return el
+
+    @property
+    def end(self) -> int:
+        """The offset after its end tag (or its start tag when empty); -1 if never closed."""
+        end = self._end
+        return self.token_start + self.length if end == _SELF_CLOSED else end
+
+    @end.setter
+    def end(self, value: int) -> None:
+        self._end = value
+
+    @property
+    def end_name_end(self) -> int:
+        """The end of the end tag's name (which is the element's), -1 if none."""
+        ens = self.end_name_start
+        return ens + len(self.name) if ens >= 0 else -1
+
+    def _fields(self) -> tuple[object, ...]:
+        return (
+            self.name,
+            self.zone,
+            self.token_start,
+            self.token_index,
+            self.parent,
+            self.depth,
+            self.attrs,
+            self.self_closing,
+            self.closed,
+            self.end,
+            self.end_name_start,
+            self.children,
+            self.content,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Element):
+            return NotImplemented
+        return self._fields() == other._fields()
+
+    __hash__ = None  # type: ignore[assignment]  # mutable while the builder runs
+
+    def __repr__(self) -> str:
+        return f"Element({', '.join(map(repr, self._fields()))})"
 
     @property
     def name_start(self) -> int:

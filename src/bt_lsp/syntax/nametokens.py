@@ -234,4 +234,6 @@ def start_tag_refs(text: str, at: int, zone: Zone, parent: Element | None) -> li
 def start_tag_element(text: str, at: int, zone: Zone) -> Element:
     """The element whose start tag is at offset ``at``, alone (no parent or children)."""
     tok = scan_token(text, at)
-    return Element(tok.name, zone, at, 0, -1, 0, tok.attrs, tok.self_closing, tok.closed)
+    return Element(
+        tok.name, zone, at, 0, -1, 0, tok.attrs, tok.self_closing, tok.closed, length=tok.length
+    )

@@ -58,9 +58,11 @@ _UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
 # quicker, for the hot paths).
 _new = tuple.__new__
 
-# Shared tokens: text runs by length, end tags by their text (bounded).
+# Shared tokens: text runs by length, end tags and start tags without attributes by their
+# text (bounded).
 _TEXT_TOKENS: dict[int, Token] = {}
 _END_TOKENS: dict[str, Token] = {}
+_START_TOKENS: dict[str, Token] = {}
 # Tag and attribute names, shared (bounded).
 _NAMES: dict[str, str] = {}
 _SHARED_MAX = 8192
@@ -236,12 +238,19 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
         m = _FAST_CLOSE_RE.match(text, m.end())
         if m is None:
             return None
-        length = m.end() - pos
-        name = _name(text[pos + 1 : m.start()])
-        self_closing = m.group(1) == "/"
-        return _new(
-            Token, (_START, length, length + 1, name, 1, 1 + len(name), (), self_closing, True, ())
-        )
+        key = text[pos : m.end()]
+        tok = _START_TOKENS.get(key)
+        if tok is None:  # shared, like end tags: a document may be made of "<Frob/>"
+            if len(_START_TOKENS) >= _SHARED_MAX:
+                _START_TOKENS.clear()
+            length = m.end() - pos
+            name = _name(text[pos + 1 : m.start()])
+            self_closing = m.group(1) == "/"
+            tok = _START_TOKENS[key] = _new(
+                Token,
+                (_START, length, length + 1, name, 1, 1 + len(name), (), self_closing, True, ()),
+            )
+        return tok
     name = _name(m.group(1))
     attrs: list[Attr] = []
     problems: list[Problem] = []

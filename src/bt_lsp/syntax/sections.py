@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections import OrderedDict
+from collections.abc import Iterator
 from typing import Any
 
 from bt_lsp.syntax.elements import (
@@ -61,7 +62,7 @@ class Section:
         problems: list[StructureProblem],
         lexical: list[StructureProblem],
         end: int,
-        root_end: tuple[int, int, int] | None,
+        root_end: tuple[int, int] | None,
         root: Element | None = None,
     ) -> None:
         self.ntokens = ntokens
@@ -99,10 +100,36 @@ class Section:
         return refs
 
     def _make_refs(self) -> list[NameRef]:
+        refs = list(self._element_refs())
+        refs.sort(key=_start)
+        return refs
+
+    def iter_refs(self) -> Iterator[NameRef]:
+        """The section's name tokens, not in order, without keeping them (for a pass
+        over all of them, such as the name rules: a list of them all costs more memory
+        than the text they are in); notes the section's symbols on the way."""
+        refs = _RECENT_REFS.get(self)
+        if refs is not None:
+            yield from refs
+            return
+        if "symbols" in self.cache:
+            yield from self._element_refs()
+            return
+        symbols: dict[Symbol, None] = {}
+        for r in self._element_refs():
+            if r.symbol is not None:
+                symbols[r.symbol] = None
+            yield r
+        self.cache["symbols"] = tuple(symbols)
+
+    def _element_refs(self) -> Iterator[NameRef]:
+        """The name tokens of each element in turn."""
         refs: list[NameRef] = []
         root = self.root
         if root is not None:
             name_refs(root, 0, None, refs)
+            yield from refs
+            refs.clear()
         els = self.elements
         for i, el in enumerate(els, 1):
             p = el.parent
@@ -124,8 +151,9 @@ class Section:
                         i,
                     )
                 )
-        refs.sort(key=_start)
-        return refs
+            if refs:
+                yield from refs
+                refs.clear()
 
     def ref_at(self, offset: int) -> NameRef | None:
         """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
@@ -172,24 +200,13 @@ class Part:
 
     def element(self, el: Element) -> Element:
         """An element of the section in document coordinates."""
-        o = self.origin
-        g = self.element_index
-        return Element(
-            el.name,
-            el.zone,
-            el.token_start + o,
-            el.token_index + self.tok_origin,
-            g(el.parent),
-            el.depth,
-            el.attrs,
-            el.self_closing,
-            el.closed,
-            el.end + o if el.end >= 0 else -1,
-            el.end_name_start + o if el.end_name_start >= 0 else -1,
-            el.end_name_end + o if el.end_name_end >= 0 else -1,
-            # Children are never the root (local 0): a top element may have thousands.
-            list(map((self.elem_base - 1).__add__, el.children)),
-            el.content,
+        # Children are never the root (local 0): a top element may have thousands.
+        children = el.children
+        return el.moved(
+            self.origin,
+            self.tok_origin,
+            self.element_index(el.parent),
+            list(map((self.elem_base - 1).__add__, children)) if children else children,
         )
 
     def top(self) -> Element:

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.diagnostics import Capped, capped
 from bt_lsp.rules.semantics import document, models, nodes, ports, trees
 from bt_lsp.rules.semantics.base import State, TreeScope
 from bt_lsp.rules.semantics.sections import check_sections
@@ -33,8 +33,9 @@ if TYPE_CHECKING:
 __all__ = ["check"]
 
 
-def check(doc: Document, ctx: Context) -> list[Diagnostic]:
-    """Every semantic diagnostic of ``doc`` seen through ``ctx``, sorted by position."""
+def check(doc: Document, ctx: Context) -> Capped:
+    """Every semantic diagnostic of ``doc`` seen through ``ctx``, sorted by position: the
+    first :data:`~bt_lsp.rules.diagnostics.MAX_DIAGNOSTICS`, with how many more."""
     model = doc.model
     st = State(doc, ctx, model, doc.text)
     document.check_root(st)
@@ -45,8 +46,7 @@ def check(doc: Document, ctx: Context) -> list[Diagnostic]:
     trees.check_duplicate_ids(st)
     trees.check_main_tree(st)
     trees.check_recursion(st)
-    st.out.sort(key=lambda d: (d.start, d.end, d.code))
-    return st.out
+    return capped(st.out, st.more)
 
 
 def check_elements(st: State, elements: Sequence[Element]) -> None:

@@ -11,7 +11,7 @@ from bt_lsp.rules.builtins import BUILTINS, Category, NodeModel, PortModel
 from bt_lsp.rules.builtins_v3 import V3_BUILTINS, V3_OPTIONAL_PORTS
 from bt_lsp.rules.codes import BT, FixData, Severity, define, defined
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, sort_key
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 from bt_lsp.syntax.model import Model
 
@@ -117,6 +117,10 @@ _BUILTIN_RESOLVED_V3: Final[dict[str, Resolved]] = {
 }
 
 
+# When ``State.out`` holds this many diagnostics, it is cut to the first MAX_DIAGNOSTICS.
+_SHRINK_AT: Final = 2 * MAX_DIAGNOSTICS
+
+
 def is_compact(el: Element) -> bool:
     return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
 
@@ -142,6 +146,13 @@ class State:
     # text, in coordinates that start at document offset ``origin``.
     origin: int = 0
     uses_lines: bool = False  # whether a message names a line (see line_of)
+    # How many diagnostics were found and not kept in ``out``: only the first
+    # MAX_DIAGNOSTICS by position are ever published, so no more are kept (see add).
+    more: int = 0
+    # What a rule found for a name, by its own key, so that a document repeating the name
+    # a hundred thousand times costs one finding (the run over one section records
+    # what it read, so each run has its own).
+    memo: dict[object, object] = field(default_factory=dict)
 
     def line_of(self, offset: int) -> int:
         """The 0-based document line of ``offset`` (in this run's coordinates).  Messages
@@ -173,7 +184,12 @@ class State:
                 message += (
                     " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"
                 )
-        self.out.append(Diagnostic(start, end, code, message, sev, data))
+        out = self.out
+        out.append(Diagnostic(start, end, code, message, sev, data))
+        if len(out) >= _SHRINK_AT:  # keep the first by position (a stable sort)
+            out.sort(key=sort_key)
+            self.more += len(out) - MAX_DIAGNOSTICS
+            del out[MAX_DIAGNOSTICS:]
 
     def resolve(self, type_id: str) -> Resolved | None:
         """The model of node type ``type_id``: built-in first (of the project's

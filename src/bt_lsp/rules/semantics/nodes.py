@@ -40,7 +40,7 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, cast
 
 from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
 from bt_lsp.rules.codes import BT, FixData, Severity, define
@@ -187,9 +187,23 @@ def _count(n: int) -> str:
     return "1 child" if n == 1 else f"{n} children"
 
 
+# What ``unknown-node`` says of a type: its message, severity and data.
+_Finding = tuple[str, Severity | None, UnknownNodeData]
+
+
 def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explicit: bool) -> None:
+    key = ("unknown-node", type_id, explicit)
+    if key in st.memo:  # a name repeated all over a document is looked at once
+        found = cast(_Finding | None, st.memo[key])
+    else:
+        found = st.memo[key] = _unknown_finding(st, type_id, explicit)
+    if found is not None:
+        st.add(start, end, "unknown-node", *found)
+
+
+def _unknown_finding(st: State, type_id: str, explicit: bool) -> _Finding | None:
     if not explicit and check_name(type_id, NameKind.MODEL):
-        return  # the name rules report it (BehaviorTree.CPP checks the name first)
+        return None  # the name rules report it (BehaviorTree.CPP checks the name first)
     data = UnknownNodeData(type_id, explicit)
     ctx = st.ctx
     if type_id in V3_RENAMES:
@@ -200,71 +214,47 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
             if type_id in _MISSPELLINGS
             else "the BehaviorTree.CPP 3 name of a node"
         )
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}",
             Severity.ERROR if st.v4 else Severity.WARNING,
             data,
         )
-        return
     if st.v3 and type_id in BUILTINS:
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f"{quoted(type_id)} is a built-in node of BehaviorTree.CPP 4; this project builds "
             "against BehaviorTree.CPP 3, which does not register it (register it in C++)",
             Severity.WARNING,
             data,
         )
-        return
     if type_id in V3_ONLY:
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f"{quoted(type_id)} was a built-in node of BehaviorTree.CPP 3; version 4 does not "
             f"register it by default (register it in C++, or use {V3_ONLY[type_id]})",
             None if _complete(ctx) else Severity.HINT,
             data,
         )
-        return
     if type_id in ctx.trees or type_id in ctx.workspace_trees:
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f'{quoted(type_id)} is a tree, not a node type; call it with <SubTree ID="{type_id}"/>',
             Severity.ERROR if st.v4 else Severity.WARNING,
             data,
         )
-        return
     known = _BUILTIN_LOWER.get(type_id.lower())
     if known is not None:
         data = UnknownNodeData(type_id, explicit, known, preferred=True)
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f"Node type {quoted(type_id)} is not registered; did you mean {quoted(known)}? "
             "(names are case-sensitive)",
             Severity.ERROR,
             data,
         )
-        return
     if ctx.registered is not None and type_id in ctx.registered:
-        st.add(
-            start,
-            end,
-            "unknown-node",
+        return (
             f"Node type {quoted(type_id)} is registered in the project's C++, but its base "
             "class is not among the sources read: its kind and ports are unknown",
             Severity.HINT,
             data,
         )
-        return
     suggestion = _closest(st, type_id)
     if _complete(ctx):
         severity = None
@@ -297,7 +287,7 @@ def _unknown(st: State, el: Element, type_id: str, start: int, end: int, explici
         )
     if suggestion is not None:
         message += f"; did you mean {quoted(suggestion)}?"
-    st.add(start, end, "unknown-node", message, severity, data)
+    return message, severity, data
 
 
 def _unregistered(st: State, type_id: str, start: int, end: int, explicit: bool) -> None:

@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Final, TypeVar
 
 from bt_lsp.rules.context import Context, DocumentFacts, ModelDecl, TreeDecl
-from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.diagnostics import Diagnostic, capped
 from bt_lsp.rules.semantics.base import State
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.model import Model
@@ -96,7 +96,8 @@ class _Entry:
     settings: tuple[object, ...]
     line: int | None  # the line the section starts on, when a message names a line
     deps: dict[Dep, object]  # the signature of each context entry looked up
-    out: list[Diagnostic]
+    out: list[Diagnostic]  # the first MAX_DIAGNOSTICS by position
+    more: int = 0  # how many more were found
 
 
 @dataclasses.dataclass(slots=True)
@@ -228,9 +229,11 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         out = st.out
         for sec in with_diagnostics:
             origin = origins[index[sec]]
+            entry = sec.cache[_KEY]
+            st.more += entry.more
             out.extend(
                 Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
-                for d in sec.cache[_KEY].out
+                for d in entry.out
             )
     hist.settings = settings
     hist.sigs.update(memo)
@@ -316,4 +319,5 @@ def _run(
     elements = local.elements
     check(run, elements[1:] if isinstance(elements, list) else list(elements)[1:])
     line = lines.line_of(origin) if run.uses_lines else None
-    return _Entry(settings, line, {d: current(d) for d in deps}, run.out)
+    out = capped(run.out, run.more)
+    return _Entry(settings, line, {d: current(d) for d in deps}, out, out.more)

@@ -1,0 +1,85 @@
+"""What a document keeps stays in proportion to it: diagnostics beyond the publication cap
+are counted, not kept, and each element costs a bounded number of objects.
+
+(Memory in bytes depends on the machine; ``benchmarks/hostile.py`` measures it in the
+server.  These tests check the structure that keeps it bounded.)
+"""
+
+from __future__ import annotations
+
+import gc
+import tracemalloc
+
+from bt_lsp.rules.analysis import analyze
+from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, own_diagnostics
+from bt_lsp.syntax.document import Document
+
+TREE = '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<Sequence>'
+END = "</Sequence>\n</BehaviorTree>\n</root>\n"
+# An unknown node type (a semantic hint) and a bad model name (a name rule of the
+# document's own diagnostics), one after the other.
+PAIR = "<Frob/><Fr.ob/>"
+
+
+def test_the_first_diagnostics_by_position_are_kept_from_both_sources() -> None:
+    n = 3000  # 6,000 findings: more than twice the cap in each source
+    doc = Document(TREE + PAIR * n + END)
+    diags = analyze(doc)
+    assert len(diags) == MAX_DIAGNOSTICS + 1
+    first = len(TREE)
+    expected = []
+    for k in range(MAX_DIAGNOSTICS // 2):
+        at = first + k * len(PAIR)
+        expected.append((at + 1, at + 5, "unknown-node"))
+        expected.append((at + 8, at + 13, "model-name-forbidden-char"))
+    assert [(d.start, d.end, d.code) for d in diags[:-1]] == expected
+    assert diags[-1].code == "too-many-problems"
+    assert diags[-1].message.startswith(f"{2 * n - MAX_DIAGNOSTICS} more problems")
+
+
+def test_what_is_kept_beyond_the_cap_is_a_count() -> None:
+    n = 5000
+    doc = Document(TREE + PAIR * n + END)
+    analyze(doc)
+    own = own_diagnostics(doc)
+    assert len(own) == MAX_DIAGNOSTICS and own.more == n - MAX_DIAGNOSTICS
+    (section,) = doc.model.sections
+    assert len(section.cache["diagnostics"]) == MAX_DIAGNOSTICS
+    entry = section.cache["semantics"]
+    assert len(entry.out) == MAX_DIAGNOSTICS and entry.more == n - MAX_DIAGNOSTICS
+
+
+def test_an_edit_keeps_the_count_right() -> None:
+    n = 3000
+    doc = Document(TREE + PAIR * n + END)
+    analyze(doc)
+    at = len(TREE) + 10 * len(PAIR)
+    doc.edit(at, at + len(PAIR), "")  # one pair fewer, before the cap
+    diags = analyze(doc)
+    assert diags[-1].message.startswith(f"{2 * (n - 1) - MAX_DIAGNOSTICS} more problems")
+    assert [d.code for d in diags[:4]] == ["unknown-node", "model-name-forbidden-char"] * 2
+
+
+def _retained_blocks(elements: int) -> int:
+    """Memory blocks a document of ``elements`` empty elements holds once analysed."""
+    text = TREE + "<Frob/>" * elements + END
+    gc.collect()
+    tracemalloc.start()
+    try:
+        doc = Document(text)
+        analyze(doc)
+        gc.collect()
+        blocks = sum(s.count for s in tracemalloc.take_snapshot().statistics("filename"))
+    finally:
+        tracemalloc.stop()
+    assert doc.model.sections
+    return blocks
+
+
+def test_each_element_costs_a_bounded_number_of_objects() -> None:
+    small, large = _retained_blocks(2_000), _retained_blocks(20_000)
+    per_element = (large - small) / 18_000
+    # An element's record and three ints (its offset, token and index; empty children and
+    # the end of an empty element are not kept); a diagnostic kept per element (its record,
+    # message and offsets) or a name token would add three or more.
+    assert per_element < 4.5, per_element
