@@ -84,6 +84,8 @@ class LspClient:
         self._waiters: list[tuple[str, int | None, asyncio.Future[Published]]] = []
         self.log: list[str] = []  # window/logMessage and showMessage texts
         self.last_answer_at = 0.0  # when the latest answer to a request arrived
+        self.counts: dict[str, int] = {}  # publishDiagnostics received, by URI
+        self._closing = False
         self._reader = asyncio.get_running_loop().create_task(self._read_loop())
 
     @property
@@ -128,11 +130,18 @@ class LspClient:
         except (asyncio.IncompleteReadError, ConnectionError):
             pass
         finally:
-            for fut in self._pending.values():
+            for fut in self._pending.values():  # requests: their senders await them
                 if not fut.done():
                     fut.set_exception(ConnectionError("the server exited"))
+            # Waiters for diagnostics fail too, unless the client itself closed the
+            # connection: then nobody awaits them (diagnostics that never came), and a
+            # failed future that nobody retrieves is logged at exit.
             for _, _, w in self._waiters:
-                if not w.done():
+                if w.done():
+                    continue
+                if self._closing:
+                    w.cancel()
+                else:
                     w.set_exception(ConnectionError("the server exited"))
 
     def _dispatch(self, msg: dict[str, Any], at: float) -> None:
@@ -156,6 +165,7 @@ class LspClient:
             pub = Published(params.get("version"), params.get("diagnostics", []), at)
             uri = params["uri"]
             self._published[uri] = pub
+            self.counts[uri] = self.counts.get(uri, 0) + 1
             keep = []
             for w_uri, w_version, fut in self._waiters:
                 if w_uri == uri and (w_version is None or w_version == pub.version):
@@ -200,6 +210,20 @@ class LspClient:
     def latest(self, uri: str) -> Published | None:
         return self._published.get(uri)
 
+    async def published_count(self, uri: str, count: int, timeout: float = 600.0) -> Published:
+        """The latest diagnostics of ``uri`` once ``count`` publications of it arrived (a
+        large document's name diagnostics come first, then the complete set); their
+        ``at`` is when they were read, not when this noticed them."""
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout
+        while self.counts.get(uri, 0) < count:
+            if loop.time() > deadline:
+                raise TimeoutError(f"{count} publications of {uri}")
+            if self._reader.done():
+                raise ConnectionError("the server exited")
+            await asyncio.sleep(0.005)
+        return self._published[uri]
+
     async def initialize(
         self,
         root: str | None,
@@ -224,6 +248,7 @@ class LspClient:
 
     async def close(self, timeout: float = 10.0) -> None:
         """``shutdown`` and ``exit``; kills the server if it does not go."""
+        self._closing = True
         with contextlib.suppress(Exception):
             await self.request("shutdown", None, timeout=timeout)
             self.notify("exit", None)

@@ -128,14 +128,20 @@ async def test_a_large_open_publishes_names_first_then_the_complete_set(tmp_path
         first = client.expect_diagnostics(uri, 1)
         _open(client, uri, g.text)
         names = await first
-        complete = client.expect_diagnostics(uri, 1)
-        assert (await complete).diagnostics == names.diagnostics  # only names are planted
+        assert bench_run.open_publications(g.text) == 2  # what the runner waits for
+        complete = await client.published_count(uri, 2)
+        assert client.counts[uri] == 2 and complete.at >= names.at
+        assert complete.diagnostics == names.diagnostics  # only names are planted
         expected: Counter[str] = Counter()
         for p in g.planted:
             expected[p.code] += p.count
         assert Counter(d["code"] for d in names.diagnostics) == expected
+        never = client.expect_diagnostics("untitled:never-opened.xml", 1)
     finally:
         await client.close()
+    # Closing gives up on what nobody will see, without a failed future to be logged.
+    assert never.cancelled()
+    assert bench_run.open_publications(bench_generate.generate(4_000, seed=5).text) == 1
 
 
 def test_runner_table_and_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
