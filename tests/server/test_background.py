@@ -218,3 +218,25 @@ def test_an_edit_right_after_the_open_is_not_lost(session: Session) -> None:
     )
     assert "Wobble" in message
     assert not [m for m in s.log if published(BIG_URI, 1, "unknown-node")(m)]
+
+
+def test_a_close_right_after_the_open_waits_its_turn(session: Session) -> None:
+    """The close of a document still being prepared is handled once it is ready: its
+    diagnostics are cleared, it is never analysed, and opening it again works."""
+    s = session
+    big = big_document("Frobnicate")
+    close = {"textDocument": {"uri": BIG_URI}}
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + frame(msg("textDocument/didClose", close))
+        + hover(SMALL_URI, 12)
+    )
+    s.until(answer(12))
+    early = s.until(published(BIG_URI, 1))  # the names, found while it was prepared
+    cleared = s.until(lambda m: published(BIG_URI)(m) and "version" not in m["params"])
+    assert early < cleared and s.log[cleared]["params"]["diagnostics"] == []
+    s.raw.write(hover(SMALL_URI, 13))
+    s.until(answer(13))
+    assert not [m for m in s.log if published(BIG_URI, code="unknown-node")(m)]
+    s.raw.write(frame(msg("textDocument/didOpen", open_params(BIG_URI, big, version=3))))
+    s.until(published(BIG_URI, 3, "unknown-node"))
