@@ -147,19 +147,31 @@ def workspace_resolver(
     workspace files), looked up in ``others`` (path -> model)."""
     others = others or {}
     cache: dict[str, TreeSource | None] = {}
+    # Each model's trees by ID, made on first use: a picture that expands a chain of
+    # thousands of SubTree calls looks each one up, and a walk over the trees per call
+    # made that quadratic.
+    indexes: dict[int, dict[str, Element]] = {}
+
+    def tree_in(m: Model, tree_id: str) -> Element | None:
+        index = indexes.get(id(m))
+        if index is None:
+            index = indexes[id(m)] = {}
+            for t in document_trees(m):
+                index.setdefault(tree_id_of(t), t)  # the first, as find_tree
+        return index.get(tree_id)
 
     def resolve(tree_id: str) -> TreeSource | None:
         if tree_id in cache:
             return cache[tree_id]
         found: TreeSource | None = None
-        own = find_tree(model, tree_id)
+        own = tree_in(model, tree_id)
         if own is not None:
             found = TreeSource(model, own)
         elif ctx is not None:
             decls = ctx.trees.get(tree_id) or ctx.workspace_trees.get(tree_id) or ()
             for decl in reversed(decls):
                 other = others.get(decl.path) if decl.path is not None else None
-                el = find_tree(other, tree_id) if other is not None else None
+                el = tree_in(other, tree_id) if other is not None else None
                 if other is not None and el is not None:
                     found = TreeSource(other, el, decl.path)
                     break
@@ -245,18 +257,24 @@ def build_picture(
     nodes = [root]
     own_spans: list[tuple[int, int, int, int]] = [(tree.token_start, _element_end(tree), -1, 0)]
     truncated = False
-    # (model, element index, parent node, source, trees on the path)
-    stack: list[tuple[Model, int, int, str | None, frozenset[str]]] = []
+    # The trees on the path from the root to the element popped next: an expanded call
+    # adds its tree, and an entry pushed under the called tree's children takes it out
+    # again once they are done (a set per path made a chain of n calls cost n^2).
+    path = {tid}
+    # (model, element index, parent node, source); element index -1: leave tree ``src``
+    stack: list[tuple[Model, int, int, str | None]] = []
 
-    def push_children(
-        m: Model, el: Element, parent: int, src: str | None, path: frozenset[str]
-    ) -> None:
+    def push_children(m: Model, el: Element, parent: int, src: str | None) -> None:
         for ci in reversed(el.children):
-            stack.append((m, ci, parent, src, path))
+            stack.append((m, ci, parent, src))
 
-    push_children(model, tree, 0, None, frozenset({tid}))
+    push_children(model, tree, 0, None)
     while stack:
-        m, ei, parent, src, path = stack.pop()
+        m, ei, parent, src = stack.pop()
+        if ei < 0:
+            assert src is not None
+            path.discard(src)
+            continue
         el = m.elements[ei]
         if el.zone != Zone.NODE:
             continue
@@ -289,9 +307,11 @@ def build_picture(
                 if target is not None:
                     node.expanded = True
                     tsrc = target.source if target.model is not model else None
-                    push_children(target.model, target.element, node.index, tsrc, path | {type_})
+                    stack.append((m, -1, -1, type_))
+                    path.add(type_)
+                    push_children(target.model, target.element, node.index, tsrc)
             continue
-        push_children(m, el, node.index, src, path)
+        push_children(m, el, node.index, src)
 
     _give_problems(nodes, own_spans, diagnostics)
     if text_length is not None:
