@@ -44,6 +44,35 @@ INPUTS: dict[str, Callable[[], str]] = {
     ),
     "realistic": _realistic,
     "elements": lambda: TREE + "<Sequence>" + "<Frob/>" * 100_000 + "</Sequence>" + END,
+    # Shapes a per-statement, per-tree or recursive walk would make slow or break.
+    "script": lambda: (
+        TREE + '<Script code="' + "".join(f"a{i}:=1; " for i in range(200_000)) + '"/><Frob/>' + END
+    ),
+    "skip_if": lambda: (
+        TREE
+        + "<Sequence><Frob/>"
+        + "".join(f'<AlwaysSuccess _skipIf="k{i}==1"/>' for i in range(100_000))
+        + "</Sequence>"
+        + END
+    ),
+    "keys": lambda: (
+        TREE
+        + "<Sequence><Frob/>"
+        + "".join(f'<SetBlackboard value="1" output_key="{{k{i}}}"/>' for i in range(100_000))
+        + "</Sequence>"
+        + END
+    ),
+    "subtree_chain": lambda: (
+        '<root BTCPP_format="4" main_tree_to_execute="T0">'
+        + "".join(
+            f'<BehaviorTree ID="T{i}"><Sequence><SubTree ID="T{i + 1}"/><AlwaysSuccess/>'
+            "</Sequence></BehaviorTree>\n"
+            for i in range(20_000)
+        )
+        + '<BehaviorTree ID="T20000"><Frob/><SubTree ID="T0"/></BehaviorTree></root>\n'
+    ),
+    "deep": lambda: TREE + "<Sequence>" * 10_000 + "<Frob/>" + "</Sequence>" * 10_000 + END,
+    "single_line": lambda: _realistic().replace("\n", " "),
 }
 
 
