@@ -14,6 +14,8 @@ from hypothesis import strategies as st
 from bt_lsp.rules.script import (
     _EOF,
     _ERROR,
+    _IDENT,
+    _LEGACY_TOKENS,
     _PLAIN_SCRIPT,
     ScriptError,
     _Checker,
@@ -637,6 +639,36 @@ def test_plain_script_pattern_accepts_only_what_parses(code: str) -> None:
         assert _Checker(code, True).run() is None
     for legacy in (False, True):
         assert check_script(code, legacy=legacy) == _Checker(code, legacy).run()
+
+
+def _identifiers_by_tokens(code: str) -> tuple[list[tuple[int, int]], int]:
+    """identifiers() as the tokens read it, without the regular expressions' shortcut."""
+    found: list[tuple[int, int]] = []
+    for token in _Checker(code, True).tokens():
+        if token[0] == _IDENT and code[token[1] : token[2]] not in ("true", "false"):
+            found.append((token[1], token[2]))
+        elif token[0] == _EOF:
+            return found, len(code)
+        elif token[0] == _ERROR:
+            return found, token[1]
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+@settings(max_examples=1500, deadline=None)
+@given(_SCRIPT_TEXT)
+def test_identifiers_shortcut_is_the_tokens(code: str) -> None:
+    """Where the whole script is fast-pattern tokens, identifiers() reads the names with
+    one regular expression: the same spans the tokens give."""
+    assert identifiers(code) == _identifiers_by_tokens(code)
+
+
+def test_identifiers_of_a_large_script() -> None:
+    code = "".join(f"k{i} := k{i} + 0x1F * 2.5e3 .. 'x y' .. \"q\"; " for i in range(5_000))
+    assert _LEGACY_TOKENS.fullmatch(code)
+    spans, stop = identifiers(code)
+    assert stop == len(code)
+    assert [code[s:e] for s, e in spans][:4] == ["k0", "k0", "k1", "k1"]
+    assert len(spans) == 10_000 and (spans, stop) == _identifiers_by_tokens(code)
 
 
 def test_plain_script_pattern_takes_the_common_scripts() -> None:

@@ -171,13 +171,29 @@ def _port_key(
     return KeyRef(key, s, e, idx, tree, KeyForm.BRACES, a.name, a.quote, ent)
 
 
-def _script_keys(doc: Document, el: Element, a: Attr, idx: int, tree: int, out: TreeKeys) -> None:
+_SCRIPT = KeyForm.SCRIPT  # (an enum member read from the class costs a lookup per key)
+
+
+def _script_keys(
+    doc: Document, el: Element, a: Attr, idx: int, tree: int, out: TreeKeys, at: int = -1
+) -> None:
+    """The keys of a script attribute; with ``at``, only those whose span holds it."""
     v = _Value(doc, el, a)
     code = v.decoded
     spans, stop = identifiers(code)
-    for ds, de in spans:
-        s, e, ent = v.span(ds, de)
-        out.uses.append(KeyRef(code[ds:de], s, e, idx, tree, KeyForm.SCRIPT, a.name, a.quote, ent))
+    uses = out.uses
+    name, quote = a.name, a.quote
+    if v.offs is None:  # no references: decoded offsets are the text's, from the value's
+        base = v.base
+        if at >= 0:
+            spans = [(ds, de) for ds, de in spans if ds <= at - base <= de]
+        for ds, de in spans:
+            uses.append(KeyRef(code[ds:de], base + ds, base + de, idx, tree, _SCRIPT, name, quote))
+    else:
+        for ds, de in spans:
+            s, e, ent = v.span(ds, de)
+            if at < 0 or s <= at <= e:
+                uses.append(KeyRef(code[ds:de], s, e, idx, tree, _SCRIPT, name, quote, ent))
     if stop < len(code):
         out.unread.append(code[stop:])
 
@@ -190,7 +206,8 @@ def _is_port(name: str) -> bool:
     return not name.startswith("_") and bool(check_name(name, NameKind.PORT))
 
 
-def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
+def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys, at: int = -1) -> None:
+    """The key uses of node ``idx``; with ``at``, of its scripts only those holding it."""
     el = doc.model.elements[idx]
     if el.zone != Zone.NODE:
         return
@@ -199,7 +216,7 @@ def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
         if value is None:
             continue
         if a.name in CONDITION_ATTRS:
-            _script_keys(doc, el, a, idx, tree, out)
+            _script_keys(doc, el, a, idx, tree, out, at)
         elif not _is_port(a.name):
             continue  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
         elif is_blackboard_reference(value):
@@ -207,7 +224,7 @@ def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys) -> None:
             if k is not None:
                 out.uses.append(k)
         elif _is_script_port(el, a):
-            _script_keys(doc, el, a, idx, tree, out)
+            _script_keys(doc, el, a, idx, tree, out, at)
 
 
 def port_value_key(doc: Document, idx: int, a: Attr) -> KeyRef | None:
@@ -253,7 +270,7 @@ def key_at(doc: Document, offset: int) -> KeyRef | None:
     if el.zone != Zone.NODE or el.token_start + doc.scan.tokens[el.token_index].length < offset:
         return None
     out = TreeKeys()
-    _element_keys(doc, i, enclosing_tree(model, i), out)
+    _element_keys(doc, i, enclosing_tree(model, i), out, offset)
     for k in out.uses:
         if k.start <= offset <= k.end:
             return k

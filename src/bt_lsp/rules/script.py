@@ -188,6 +188,23 @@ _PLAIN_SCRIPT: Final = re.compile(
 )
 
 
+# A script the 4.0-4.9 tokenizer reads without a lexical error and without the character
+# loop (no backslash, no non-ASCII character outside strings): all of it is tokens of the
+# fast pattern.  Each match of _NAMES is then one identifier, after the strings, numbers,
+# operators and white space before it, all skipped in C; the last match (no identifier)
+# takes what follows the last one, so that no search starts inside a string.
+_LEGACY_TOKENS: Final = re.compile(
+    r"(?:[ \t\n\r]*+(?:[A-Za-z_@][A-Za-z0-9_]*+(?![^\x00-\x7f])|"
+    + _NUMBER
+    + r"""|'[^']*+'|"[^"]*+"|\.\.|&&|\|\||[=!<>:+*/-]=|[-+*/&|^<>=~!?:();]))*+[ \t\n\r]*+"""
+)
+_NAMES: Final = re.compile(
+    r"""(?:'[^']*+'|"[^"]*+"|"""
+    + _NUMBER
+    + r"""|[^A-Za-z_@'"0-9]++)*+(?:([A-Za-z_@][A-Za-z0-9_]*+)|\Z)"""
+)
+
+
 def check_script(code: str, *, legacy: bool = False) -> ScriptError | None:
     """The first syntax error in ``code``, or ``None`` if BehaviorTree.CPP parses it.
 
@@ -214,6 +231,11 @@ def identifiers(code: str) -> tuple[list[tuple[int, int]], int]:
     double-quoted string stays one string and a non-ASCII letter stays inside its
     identifier, so neither is split into identifiers that are not there.
     """
+    if _LEGACY_TOKENS.fullmatch(code):
+        names = _NAMES.finditer(code)
+        return [
+            m.span(1) for m in names if (word := m.group(1)) and word not in _LITERAL_WORDS
+        ], len(code)
     checker = _Checker(code, True)
     found: list[tuple[int, int]] = []
     for token in checker.tokens():
