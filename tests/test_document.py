@@ -156,3 +156,15 @@ def test_prepare_makes_what_the_loop_would_otherwise_make() -> None:
     assert doc.scanned and doc._model is not None
     doc.replace_all(BASE + " ", scanned=False)
     assert not doc.scanned and doc.lines == LineIndex(BASE + " ")
+
+
+def test_an_edit_of_a_document_never_scanned_does_not_scan_it() -> None:
+    """A text that is not BT (a large C++ or launch file) is never scanned as XML: its
+    edits update the text and line index only."""
+    doc = Document(BASE, scanned=False)
+    doc.edit(0, 0, " ")
+    doc.edit(5, 9, "")
+    assert not doc.scanned
+    text = (" " + BASE)[:5] + (" " + BASE)[9:]
+    assert doc.text == text and doc.lines == LineIndex(text)
+    assert doc.scan.tokens == Document(text).scan.tokens

@@ -113,7 +113,12 @@ class Document:
         end = min(max(end, start), n)
         new_full = self.text[:start] + new_text + self.text[end:]
         self._lines = self.lines.edited(start, end, new_text, new_full)
-        self._scan, change = rescan(self.scan, new_full, start, end, len(new_text))
+        if self._scan is None:  # never scanned (a text that is not BT): scanned when used
+            self.text = new_full
+            self._model = self._base = self._change = self.own_diagnostics = None
+            self._is_bt = self._utf8_size = None
+            return
+        self._scan, change = rescan(self._scan, new_full, start, end, len(new_text))
         self.text = new_full
         if self._model is not None:
             self._base, self._change = self._model, change
