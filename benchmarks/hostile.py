@@ -37,13 +37,25 @@ def _realistic() -> str:
     return text.replace("</BehaviorTree>", "<Frob/></BehaviorTree>", 1)
 
 
+def _sequence(body: str) -> str:
+    return TREE + "<Sequence>" + body + "</Sequence>" + END
+
+
 INPUTS: dict[str, Callable[[], str]] = {
     "duplicates": lambda: TREE + "<Frob" + ' a="1"' * 1_000_000 + "/>" + END,
     "attributes": lambda: (
         TREE + "<Frob" + "".join(f' a{i}="1"' for i in range(700_000)) + "/>" + END
     ),
     "realistic": _realistic,
-    "elements": lambda: TREE + "<Sequence>" + "<Frob/>" * 100_000 + "</Sequence>" + END,
+    "elements": lambda: _sequence("<Frob/>" * 100_000),
+    "attributed": lambda: _sequence(
+        "".join(f'<Frob a="1" b="x" c="{k}"/>' for k in range(100_000))
+    ),
+    "pairs": lambda: _sequence("<Sequence><Frob/></Sequence>" * 50_000),
+    "texts": lambda: _sequence("<Frob/>text<!-- note -->" * 100_000),
+    "lines": lambda: _sequence("\n" + "  <Frob/>\n" * 100_000),
+    "tiny-2mib": lambda: _sequence("<Frob/>" * 300_000),
+    "tiny-8mib": lambda: _sequence("<Frob/>" * 1_190_000),
     # Shapes a per-statement, per-tree or recursive walk would make slow or break.
     "script": lambda: (
         TREE + '<Script code="' + "".join(f"a{i}:=1; " for i in range(200_000)) + '"/><Frob/>' + END

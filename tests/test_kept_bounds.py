@@ -79,7 +79,19 @@ def _retained_blocks(elements: int) -> int:
 def test_each_element_costs_a_bounded_number_of_objects() -> None:
     small, large = _retained_blocks(2_000), _retained_blocks(20_000)
     per_element = (large - small) / 18_000
-    # An element's record and three ints (its offset, token and index; empty children and
-    # the end of an empty element are not kept); a diagnostic kept per element (its record,
-    # message and offsets) or a name token would add three or more.
-    assert per_element < 4.5, per_element
+    # An element's record and two ints (its offset and token index).  Its name and
+    # attributes are its start tag's (a token shared by equal tags), its children an array
+    # of machine ints, and an empty element's end is not kept.  A diagnostic kept per
+    # element (its record, message and offsets) or a name token would add three or more.
+    assert per_element < 3.5, per_element
+
+
+def test_equal_start_tags_are_one_token() -> None:
+    doc = Document(TREE + "<Frob/>" * 100 + '<Frob a="1"/>' * 2 + END)
+    tags = [el.tag for el in doc.model.elements if el.name == "Frob"]
+    assert len(tags) == 102
+    assert len({id(t) for t in tags[:100]}) == 1  # shared
+    assert tags[100] is not tags[101]  # a tag with attributes is its own
+    assert [el.end - el.token_start for el in doc.model.elements if el.name == "Frob"] == [
+        7
+    ] * 100 + [13] * 2

@@ -7,6 +7,7 @@ text outside the root, invalid XML names)."""
 from __future__ import annotations
 
 import re
+from array import array
 from bisect import bisect_left
 from collections.abc import Sequence
 
@@ -150,25 +151,16 @@ class _Builder:
                         )
                     self.has_root = True
                 idx = len(els)
-                el = Element(
-                    tok.name,
-                    zone,
-                    tstart,
-                    i - self.tok_origin,
-                    stack[-1] if stack else -1,
-                    len(stack),
-                    tok.attrs,
-                    tok.self_closing,
-                    tok.closed,
-                    length=tok.length,
+                el = Element.of_tag(
+                    tok, zone, tstart, i - self.tok_origin, stack[-1] if stack else -1, len(stack)
                 )
                 els.append(el)
                 if parent is not None:
                     children = parent.children
                     if children:
-                        children.append(idx)  # type: ignore[attr-defined]  # a list
-                    else:
-                        parent.children = [idx]
+                        children.append(idx)  # type: ignore[attr-defined]  # an array
+                    else:  # ints in an array: a Python int would cost four times <A/>
+                        parent.children = array("q", (idx,))
                 _check_xml_names(tstart, tok, zone == node_zone, problems)
                 if not tok.self_closing:
                     stack.append(idx)
@@ -227,8 +219,9 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     have changed are reused.
     """
     tokens = scan.tokens
-    # A full build reads every start: as a list; an update reads a few.
-    starts: Sequence[int] = scan.starts if change is not None else scan.starts.tolist()
+    # A full build reads every start: from one array of machine ints (a list would hold an
+    # int object per token while the elements are made); an update reads a few.
+    starts: Sequence[int] = scan.starts if change is not None else array("q", scan.starts)
     n = len(tokens)
     hb = _Builder(text, 0, 0, [], [], False)
     i, state = hb.run(tokens, starts, 0, _HEAD)

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from enum import IntEnum, StrEnum
 from typing import Literal, NamedTuple
 
-from bt_lsp.syntax.tokens import Attr
+from bt_lsp.syntax.tokens import Attr, Kind, Token
 from bt_lsp.syntax.vocabulary import NameKind
 
 
@@ -130,37 +130,30 @@ NO_CHILDREN: tuple[int, ...] = ()
 
 class Element:
     """One element.  A document may be made of a hundred thousand ``<A/>``, so an element
-    is one slotted object that keeps only what it cannot derive: the end of an empty
-    element, the end of its end tag's name and an empty list of children are made when
-    read."""
+    is one slotted object that keeps only what it cannot derive: its name, attributes and
+    flags are those of its start tag (a token, shared by equal tags), the end of an empty
+    element and the end of its end tag's name are computed when read, and its children
+    are an array of ints (or a shared empty tuple)."""
 
     __slots__ = (
         "_end",
-        "attrs",
         "children",
-        "closed",
         "content",
         "depth",
         "end_name_start",
-        "length",
-        "name",
         "parent",
-        "self_closing",
+        "tag",
         "token_index",
         "token_start",
         "zone",
     )
 
-    name: str
+    tag: Token
     zone: Zone
     token_start: int
     token_index: int
     parent: int
     depth: int
-    attrs: tuple[Attr, ...]
-    self_closing: bool
-    closed: bool
-    length: int
     _end: int
     end_name_start: int
     children: Sequence[int]
@@ -185,29 +178,46 @@ class Element:
         content: str | None = None,
         length: int = 0,  # the length of its start tag
     ) -> None:
-        self.name = name
+        tag = Token(
+            Kind.START, length, length + 1, name, 1, 1 + len(name), attrs, self_closing, closed
+        )
+        self._set(tag, zone, token_start, token_index, parent, depth)
+        if not self_closing:
+            self._end = end
+        self.end_name_start = end_name_start
+        self.children = children if children else NO_CHILDREN
+        self.content = content
+
+    @classmethod
+    def of_tag(
+        cls, tag: Token, zone: Zone, token_start: int, token_index: int, parent: int, depth: int
+    ) -> Element:
+        """The element that start tag ``tag`` (at ``token_start``, token ``token_index``)
+        opens: no end or children yet."""
+        el = cls.__new__(cls)
+        el._set(tag, zone, token_start, token_index, parent, depth)
+        el.end_name_start = -1
+        el.children = NO_CHILDREN
+        el.content = None
+        return el
+
+    def _set(
+        self, tag: Token, zone: Zone, token_start: int, token_index: int, parent: int, depth: int
+    ) -> None:
+        self.tag = tag
         self.zone = zone
         self.token_start = token_start
         self.token_index = token_index
         self.parent = parent
         self.depth = depth
-        self.attrs = attrs
-        self.self_closing = self_closing
-        self.closed = closed
-        self.length = length
-        self._end = _SELF_CLOSED if self_closing else end
-        self.end_name_start = end_name_start
-        self.children = children if children else NO_CHILDREN
-        self.content = content
+        self._end = _SELF_CLOSED if tag.self_closing else -1
 
     def moved(
         self, origin: int, token_origin: int, parent: int, children: Sequence[int]
     ) -> Element:
         """This element ``origin`` code points and ``token_origin`` tokens further on."""
         el = Element.__new__(Element)
-        el.name, el.zone, el.attrs, el.depth = self.name, self.zone, self.attrs, self.depth
-        el.self_closing, el.closed, el.length = self.self_closing, self.closed, self.length
-        el.content = self.content
+        el.tag, el.zone, el.depth, el.content = self.tag, self.zone, self.depth, self.content
         el.token_start = self.token_start + origin
         el.token_index = self.token_index + token_origin
         el.parent = parent
@@ -217,6 +227,28 @@ class Element:
         el.end_name_start = ens + origin if ens >= 0 else -1
         el.children = children if children else NO_CHILDREN
         return el
+
+    @property
+    def name(self) -> str:
+        return self.tag.name
+
+    @property
+    def attrs(self) -> tuple[Attr, ...]:
+        return self.tag.attrs
+
+    @property
+    def self_closing(self) -> bool:
+        return self.tag.self_closing
+
+    @property
+    def closed(self) -> bool:
+        """Whether its start tag ends with '>' or '/>'."""
+        return self.tag.closed
+
+    @property
+    def length(self) -> int:
+        """The length of its start tag."""
+        return self.tag.length
 
     @property
     def end(self) -> int:

@@ -20,6 +20,7 @@ five and character references are left as written, DOCTYPEs are skipped whole.
 from __future__ import annotations
 
 import re
+from array import array
 from dataclasses import dataclass
 
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
@@ -531,7 +532,7 @@ class Scan:
 
 def scan(text: str) -> Scan:
     tokens: list[Token] = []
-    starts: list[int] = []
+    starts = array("q")  # machine ints: a list would hold an int object per token
     pos, n = 0, len(text)
     while pos < n:
         tok = scan_token(text, pos)

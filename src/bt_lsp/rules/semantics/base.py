@@ -149,6 +149,9 @@ class State:
     # How many diagnostics were found and not kept in ``out``: only the first
     # MAX_DIAGNOSTICS by position are ever published, so no more are kept (see add).
     more: int = 0
+    # Once ``out`` holds MAX_DIAGNOSTICS: the key of its last diagnostic by position,
+    # which a later one must be below to be kept (an equal one sorts after it).
+    limit: tuple[int, int, str] | None = None
     # What a rule found for a name, by its own key, so that a document repeating the name
     # a hundred thousand times costs one finding (the run over one section records
     # what it read, so each run has its own).
@@ -170,6 +173,10 @@ class State:
         severity: Severity | None = None,
         data: FixData | None = None,
     ) -> None:
+        limit = self.limit
+        if limit is not None and (start, end, code) >= limit:
+            self.more += 1  # after the first MAX_DIAGNOSTICS found: never kept
+            return
         sev = defined(code).severity if severity is None else severity
         if (
             sev == Severity.ERROR
@@ -186,10 +193,13 @@ class State:
                 )
         out = self.out
         out.append(Diagnostic(start, end, code, message, sev, data))
-        if len(out) >= _SHRINK_AT:  # keep the first by position (a stable sort)
+        if len(out) == MAX_DIAGNOSTICS and limit is None:
+            self.limit = max(map(sort_key, out))  # one at or after it is the cap's + 1st
+        elif len(out) >= _SHRINK_AT:  # keep the first by position (a stable sort)
             out.sort(key=sort_key)
             self.more += len(out) - MAX_DIAGNOSTICS
             del out[MAX_DIAGNOSTICS:]
+            self.limit = sort_key(out[-1])
 
     def resolve(self, type_id: str) -> Resolved | None:
         """The model of node type ``type_id``: built-in first (of the project's
