@@ -91,6 +91,17 @@ def _keep(pool: dict[str, str], s: str) -> str:
     return s
 
 
+# Attributes (relative to their tag) shared by equal tags' attributes (bounded).
+_ATTRS: dict[Attr, Attr] = {}
+
+
+def _keep_attr(attr: Attr) -> Attr:
+    if len(_ATTRS) >= _SHARED_MAX:
+        _ATTRS.clear()
+    _ATTRS[attr] = attr
+    return attr
+
+
 def _name(name: str) -> str:
     return _NAMES.get(name) or _keep(_NAMES, name)
 
@@ -284,20 +295,20 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
             vs, ve = cur.span(2)
             quote = '"'
         vs -= pos
-        attrs.append(
-            _new(
-                Attr,
-                (
-                    _name(aname),
-                    ns - pos,
-                    ne - pos,
-                    _value(raw) if "&" not in raw else decode_value(raw, vs, problems),
-                    vs,
-                    ve - pos,
-                    quote,
-                ),
-            )
+        attr = _new(
+            Attr,
+            (
+                _name(aname),
+                ns - pos,
+                ne - pos,
+                _value(raw) if "&" not in raw else decode_value(raw, vs, problems),
+                vs,
+                ve - pos,
+                quote,
+            ),
         )
+        # Equal attributes at the same place in their tags are one tuple, like short values.
+        attrs.append(_ATTRS.get(attr) or _keep_attr(attr))
     close = _FAST_CLOSE_RE.match(text, a_end)
     if close is None:
         return None
