@@ -13,6 +13,9 @@ from typing import Any
 
 import pytest
 
+from bt_lsp.rules import facts
+from bt_lsp.server.background import _prepare
+from bt_lsp.syntax.document import Document
 from tests.server.test_framing import TIMEOUT, RawServer, frame, msg
 
 SMALL_URI = "untitled:small.xml"
@@ -240,3 +243,17 @@ def test_a_close_right_after_the_open_waits_its_turn(session: Session) -> None:
     assert not [m for m in s.log if published(BIG_URI, code="unknown-node")(m)]
     s.raw.write(frame(msg("textDocument/didOpen", open_params(BIG_URI, big, version=3))))
     s.until(published(BIG_URI, 3, "unknown-node"))
+
+
+def test_the_worker_prepares_what_the_first_requests_read() -> None:
+    """A large document's name index and declarations are made on the worker thread with
+    its tokens and model, so that its first hover or definition does not make them on
+    the event loop."""
+    doc = Document(big_document("Frobnicate"), "big.xml", scanned=False)
+    _prepare(doc, True)
+    assert doc._model is not None and doc._model._by_symbol is not None
+    cached = facts._CACHE.get(doc)
+    assert cached is not None and cached[0] is doc._model
+    other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
+    _prepare(other, False)  # not BT: the line index only
+    assert not other.scanned and facts._CACHE.get(other) is None

@@ -33,6 +33,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from bt_lsp.rules.context import facts_of
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.server.state import OpenDocument
@@ -46,6 +47,15 @@ if TYPE_CHECKING:
 WORKER_CHARS = 256 * 1024
 
 Key = tuple[int | None, int, int]
+
+
+def _prepare(doc: Document, is_bt: bool) -> None:
+    """On the worker thread: what the first requests on a large document need, so that
+    none of it is made on the loop (for a BT document, what it declares too: a hover
+    reads the context made of it)."""
+    doc.prepare(is_bt)
+    if is_bt:
+        facts_of(doc)
 
 
 @dataclass(slots=True)
@@ -111,7 +121,7 @@ class Background:
         if od.is_bt and self._server.wants_early_names(od):
             early = loop.run_in_executor(pool, early_name_diagnostics, od.doc.text)
             early.add_done_callback(lambda f: self._early(held, f))
-        work = loop.run_in_executor(pool, od.doc.prepare, od.is_bt)
+        work = loop.run_in_executor(pool, _prepare, od.doc, od.is_bt)
         work.add_done_callback(lambda f: self._prepared(held, f, ready))
         return True
 
