@@ -135,3 +135,21 @@ def test_a_changed_model_category_rebuilds_the_sections_that_show_it() -> None:
     again = outline_json(doc, Context.from_document(doc), "utf-16")
     assert again == fresh(doc, "utf-16")
     assert '"detail": "Condition Check"' not in again and '"detail": "Action Check"' in again
+
+
+def test_a_kept_outline_shares_its_repeated_json_pieces() -> None:
+    """A section's outline JSON is kept as pieces between its numbers; the pieces that
+    repeat (most of them) are one object each, not a copy per symbol."""
+    text = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
+        + ("<AlwaysSuccess/>\n" * 200)
+        + "</Sequence></BehaviorTree></root>\n"
+    )
+    doc = Document(text)
+    outline_json(doc, Context.from_document(doc), "utf-16")
+    templates = [
+        kept[2] for s in doc.model.sections if (kept := s.cache.get("outline-json")) is not None
+    ]
+    pieces = [p for t in templates for p in t.texts]
+    assert len(pieces) > 800
+    assert len({id(p) for p in pieces}) < len(pieces) // 50

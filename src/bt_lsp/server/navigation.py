@@ -12,6 +12,7 @@ from bisect import bisect_right
 from collections.abc import Callable, Sequence
 from itertools import repeat
 from pathlib import Path
+from sys import intern
 from typing import TYPE_CHECKING
 
 from lsprotocol import types
@@ -254,7 +255,9 @@ class _Template:
 
     def __init__(self, marked: str) -> None:
         pieces = marked.split(_MARK)
-        self.texts = pieces[0::2]
+        # Most pieces are the same few (`, "character": `): shared, they cost a pointer
+        # each, where a copy of each took most of a large outline's memory.
+        self.texts = list(map(intern, pieces[0::2]))
         self.numbers = list(map(int, pieces[1::2]))
         self.at: tuple[int, int] | None = None
         self.text = ""
