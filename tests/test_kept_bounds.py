@@ -95,3 +95,11 @@ def test_equal_start_tags_are_one_token() -> None:
     assert [el.end - el.token_start for el in doc.model.elements if el.name == "Frob"] == [
         7
     ] * 100 + [13] * 2
+
+
+def test_equal_attributes_at_one_place_are_one_tuple() -> None:
+    doc = Document(TREE + "".join(f'<Frob a="1" c="{k}"/>' for k in range(50)) + END)
+    frobs = [el for el in doc.model.elements if el.name == "Frob"]
+    assert len({id(el.attrs[0]) for el in frobs}) == 1  # a="1" everywhere: shared
+    assert len({id(el.attrs[1]) for el in frobs}) == 50  # c differs
+    assert [el.value("c") for el in frobs] == [str(k) for k in range(50)]
