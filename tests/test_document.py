@@ -154,7 +154,6 @@ def test_prepare_makes_what_the_loop_would_otherwise_make() -> None:
     assert doc._lines is not None and not doc.scanned  # a text that is not BT: no tokens
     doc.prepare()
     assert doc.scanned and doc._model is not None
-    assert doc._model._by_symbol is not None  # the first hover's or definition's index
     doc.replace_all(BASE + " ", scanned=False)
     assert not doc.scanned and doc.lines == LineIndex(BASE + " ")
 

@@ -246,14 +246,17 @@ def test_a_close_right_after_the_open_waits_its_turn(session: Session) -> None:
 
 
 def test_the_worker_prepares_what_the_first_requests_read() -> None:
-    """A large document's name index and declarations are made on the worker thread with
-    its tokens and model, so that its first hover or definition does not make them on
-    the event loop."""
+    """A large document's declarations are made on the worker thread with its tokens and
+    model, and its name index too when a request is waiting for it, so that the first
+    hover or definition does not make it on the event loop."""
     doc = Document(big_document("Frobnicate"), "big.xml", scanned=False)
     _prepare(doc, True)
-    assert doc._model is not None and doc._model._by_symbol is not None
+    assert doc._model is not None and doc._model._by_symbol is None  # nobody asked
     cached = facts._CACHE.get(doc)
     assert cached is not None and cached[0] is doc._model
+    asked = Document(big_document("Frobnicate"), "big.xml", scanned=False)
+    _prepare(asked, True, [hover(BIG_URI, 7)])
+    assert asked._model is not None and asked._model._by_symbol is not None
     other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
     _prepare(other, False)  # not BT: the line index only
     assert not other.scanned and facts._CACHE.get(other) is None

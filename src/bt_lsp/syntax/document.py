@@ -76,10 +76,9 @@ class Document:
         return self._scan is not None
 
     def prepare(self, model: bool = True) -> None:
-        """Make the line index and tokens now, and with ``model`` the model and its index
-        of name references (a worker thread does it for a large document, before the
-        event loop uses it: the first hover or definition needs the index)."""
-        _ = self.lines, (self.model.by_symbol if model else None)
+        """Make the line index and tokens now, and the model with ``model`` (a worker
+        thread does it for a large document, before the event loop uses it)."""
+        _ = self.lines, (self.model if model else None)
 
     def snapshot(self) -> Document:
         """A copy that later edits of this document leave alone, for analysing it on
