@@ -252,11 +252,43 @@ def test_the_worker_prepares_what_the_first_requests_read() -> None:
     doc = Document(big_document("Frobnicate"), "big.xml", scanned=False)
     _prepare(doc, True)
     assert doc._model is not None and doc._model._by_symbol is None  # nobody asked
-    cached = facts._CACHE.get(doc)
+    cached = facts._CACHE.get(doc.history)
     assert cached is not None and cached[0] is doc._model
     asked = Document(big_document("Frobnicate"), "big.xml", scanned=False)
     _prepare(asked, True, [hover(BIG_URI, 7)])
     assert asked._model is not None and asked._model._by_symbol is not None
     other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
     _prepare(other, False)  # not BT: the line index only
-    assert not other.scanned and facts._CACHE.get(other) is None
+    assert not other.scanned and facts._CACHE.get(other.history) is None
+
+
+def test_a_snapshot_continues_the_caches_of_its_document(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The analysis of a snapshot after an edit costs what the edit changed: it finds the
+    caches the document's earlier versions left (one tree's declarations read again, not
+    every tree's), and its diagnostics are those of a fresh document."""
+    from bt_lsp.rules.analysis import analyze
+
+    trees = "".join(
+        f'<BehaviorTree ID="T{i}"><Sequence><Frobnicate/><SubTree ID="T{i + 1}"/></Sequence>'
+        "</BehaviorTree>\n"
+        for i in range(200)
+    )
+    text = f'<root BTCPP_format="4">\n{trees}<BehaviorTree ID="T200"/>\n</root>\n'
+    doc = Document(text, "big.xml")
+    first = doc.snapshot()
+    analyze(first)
+    doc.adopt(first)  # as the server does with a current result
+    read: list[int] = []
+    extract_all = facts._extract_all
+
+    def counting(sections: Any, *args: Any) -> Any:
+        read.append(len(sections))
+        return extract_all(sections, *args)
+
+    monkeypatch.setattr(facts, "_extract_all", counting)
+    at = text.index("<Frobnicate") + 1
+    doc.edit(at, at, "X")
+    snap = doc.snapshot()
+    got = analyze(snap)
+    assert read == [1] and len(doc.model.sections) > 100
+    assert got == analyze(Document(snap.text, "big.xml"))

@@ -36,7 +36,7 @@ from bt_lsp.rules.facts import facts_of
 from bt_lsp.syntax.model import Model
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document
+    from bt_lsp.syntax.document import Document, History
 
 __all__ = [
     "AUTHORITATIVE",
@@ -243,7 +243,7 @@ def _tagged(facts: DocumentFacts, source: ModelSource) -> tuple[ModelDecl, ...]:
     return tagged
 
 
-_GENERATED: weakref.WeakKeyDictionary[Document, tuple[Model, bool]] = weakref.WeakKeyDictionary()
+_GENERATED: weakref.WeakKeyDictionary[History, tuple[Model, bool]] = weakref.WeakKeyDictionary()
 
 
 def is_generated_catalog(doc: Document) -> bool:
@@ -253,7 +253,7 @@ def is_generated_catalog(doc: Document) -> bool:
     writes none; a hand-kept model file usually explains itself in one).  Anything else
     with a ``<TreeNodesModel>`` is what an author or an editor wrote."""
     model = doc.model
-    hit = _GENERATED.get(doc)
+    hit = _GENERATED.get(doc.history)
     if hit is not None and hit[0] is model:
         return hit[1]
     root = model.root
@@ -264,7 +264,7 @@ def is_generated_catalog(doc: Document) -> bool:
         and list(model.root_child_names()) == ["TreeNodesModel"]
         and "<!--" not in doc.text
     )
-    _GENERATED[doc] = (model, found)
+    _GENERATED[doc.history] = (model, found)
     return found
 
 

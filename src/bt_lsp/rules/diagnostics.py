@@ -19,7 +19,7 @@ from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document
+    from bt_lsp.syntax.document import Document, History
 
 # The codes of these rules (see bt_lsp.rules.registry).
 XML_SYNTAX: Final = define("xml-syntax", Severity.ERROR, "the document is not well-formed XML", XML)
@@ -179,7 +179,7 @@ def sort_key(d: Diagnostic) -> tuple[int, int, str]:
 
 # For each document, the sections of its last model and those of them with diagnostics.
 _SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
-    Document, tuple[set[Section], set[Section]]
+    History, tuple[set[Section], set[Section]]
 ] = weakref.WeakKeyDictionary()
 
 
@@ -211,10 +211,10 @@ def compute(doc: Document) -> Capped:
         more = head.more
         sections = model.sections
         now = set(sections)
-        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc, (set(), set()))
+        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc.history, (set(), set()))
         with_diagnostics = with_diagnostics & now
         with_diagnostics.update(sec for sec in now - seen if _own(sec))
-        _SECTIONS_WITH_DIAGNOSTICS[doc] = (now, with_diagnostics)
+        _SECTIONS_WITH_DIAGNOSTICS[doc.history] = (now, with_diagnostics)
         if with_diagnostics:
             origins = model.origins
             index = dict(zip(sections, range(len(sections)), strict=True))

@@ -22,7 +22,7 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document
+    from bt_lsp.syntax.document import Document, History
 
 _ENTRY_CATEGORIES: Final[frozenset[str]] = frozenset(
     {"Action", "Condition", "Control", "Decorator", "SubTree"}
@@ -36,7 +36,7 @@ _ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "descrip
 
 # Model -> facts, keyed by document; a cached entry is valid while the document's model is
 # the same object (a document builds a new model after every edit).
-_CACHE: weakref.WeakKeyDictionary[Document, tuple[Model, str | None, DocumentFacts]] = (
+_CACHE: weakref.WeakKeyDictionary[History, tuple[Model, str | None, DocumentFacts]] = (
     weakref.WeakKeyDictionary()
 )
 
@@ -46,14 +46,14 @@ def facts_of(doc: Document, path: str | None = None) -> DocumentFacts:
     model = doc.model
     if path is None:
         path = doc.path
-    hit = _CACHE.get(doc)
+    hit = _CACHE.get(doc.history)
     if hit is not None and hit[0] is model and hit[1] == path:
         return hit[2]
     if model.head is None:
         facts = extract_facts(model, path)
     else:
         facts = extract_sections(model, path, hit[2] if hit is not None else None)
-    _CACHE[doc] = (model, path, facts)
+    _CACHE[doc.history] = (model, path, facts)
     return facts
 
 

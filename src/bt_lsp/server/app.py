@@ -149,12 +149,13 @@ class BtServer(LanguageServer):
         severity settings.  Sends nothing, so the worker thread may call it."""
         if not od.is_bt:
             return self.cpp.diagnostics(od)
-        if doc.utf8_size > self.settings.max_document_bytes:
-            result = size_limited(doc, self.settings.max_document_bytes)
-        elif od.path is not None:
-            result = self.project.diagnostics(od.path, doc)
-        else:
-            result = with_targets(doc, analyze(doc))
+        with doc.history.lock:  # the caches it shares with the open document's snapshots
+            if doc.utf8_size > self.settings.max_document_bytes:
+                result = size_limited(doc, self.settings.max_document_bytes)
+            elif od.path is not None:
+                result = self.project.diagnostics(od.path, doc)
+            else:
+                result = with_targets(doc, analyze(doc))
         settings = self.settings if od.path is None else self.project.settings_for(od.path)
         return with_severities(result, settings.severity)
 

@@ -27,6 +27,19 @@ from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
 from bt_lsp.syntax.text import LineIndex
 
 
+class History:
+    """What a document and its snapshots have in common: the key of the caches the rules
+    keep from one version to the next (a snapshot analysed on a worker thread finds what
+    the versions before it left, instead of starting again in proportion to the whole
+    document), and the lock held while one of them is analysed, so that two threads never
+    update those caches at once."""
+
+    __slots__ = ("__weakref__", "lock")
+
+    def __init__(self) -> None:
+        self.lock = threading.RLock()
+
+
 class Document:
     @with_gc_paused
     def __init__(self, text: str, path: str | None = None, *, scanned: bool = True) -> None:
@@ -47,6 +60,7 @@ class Document:
         # only to read or write attributes, never while building).
         self._lock = threading.Lock()
         self._edits = 0  # bumped by every edit: a model built before it is not kept
+        self.history = History()  # shared with the snapshots (see snapshot)
 
     @property
     def lines(self) -> LineIndex:

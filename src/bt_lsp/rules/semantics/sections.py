@@ -32,7 +32,7 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document
+    from bt_lsp.syntax.document import History
     from bt_lsp.syntax.text import LineIndex
 
 __all__ = ["check_sections"]
@@ -115,7 +115,7 @@ class _History:
     lines: set[Section] = dataclasses.field(default_factory=set)
 
 
-_HISTORY: weakref.WeakKeyDictionary[Document, _History] = weakref.WeakKeyDictionary()
+_HISTORY: weakref.WeakKeyDictionary[History, _History] = weakref.WeakKeyDictionary()
 
 
 def check_sections(st: State, check: Callable[[State, Sequence[Element]], None]) -> None:
@@ -148,9 +148,9 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
             sig = memo[dep] = _signature(ctx, dep)
             return sig
 
-    hist = _HISTORY.get(st.doc)
+    hist = _HISTORY.get(st.doc.history)
     if hist is None:
-        hist = _HISTORY[st.doc] = _History()
+        hist = _HISTORY[st.doc.history] = _History()
     sections, origins = model.sections, model.origins
     now = set(sections)
     same = hist.valid is not None and hist.settings == settings

@@ -44,7 +44,7 @@ from bt_lsp.rules.semantics.base import State, TreeScope, quoted
 from bt_lsp.syntax.elements import Element
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document
+    from bt_lsp.syntax.document import History
 
 # The codes of these rules (see bt_lsp.rules.registry).
 TREE_CHILD_COUNT: Final = define(
@@ -277,7 +277,7 @@ _Graph = tuple[
 ]
 # The last walk of each document, used again while its graph is the same: typing inside a
 # tree rarely changes which trees call which.
-_WALKS: weakref.WeakKeyDictionary[Document, tuple[_Graph, list[_Cycle]]] = (
+_WALKS: weakref.WeakKeyDictionary[History, tuple[_Graph, list[_Cycle]]] = (
     weakref.WeakKeyDictionary()
 )
 _LAST = itemgetter(-1)
@@ -301,12 +301,12 @@ def check_recursion(st: State) -> None:
         tuple(map(_CALLS, kept)),
         tuple(map(_PATH, kept)),
     )
-    last = _WALKS.get(st.doc)
+    last = _WALKS.get(st.doc.history)
     if last is not None and last[0] == graph_key:
         cycles = last[1]
     else:
         cycles = _walk(dict(zip(graph_key[2], kept, strict=True)), main, ctx.path)
-        _WALKS[st.doc] = (graph_key, cycles)
+        _WALKS[st.doc.history] = (graph_key, cycles)
     for tree_id, idx, shown in cycles:
         decl = ctx.trees[tree_id][-1]
         s, e = decl.call_offsets[idx]
