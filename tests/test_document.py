@@ -168,3 +168,13 @@ def test_an_edit_of_a_document_never_scanned_does_not_scan_it() -> None:
     text = (" " + BASE)[:5] + (" " + BASE)[9:]
     assert doc.text == text and doc.lines == LineIndex(text)
     assert doc.scan.tokens == Document(text).scan.tokens
+
+
+def test_a_whole_new_text_keeps_the_document_history() -> None:
+    """A client that sends the whole text at every change edits the same document: the
+    rules' caches, keyed by its history, continue; its snapshots share that history."""
+    doc = Document(BASE)
+    history = doc.history
+    doc.replace_all(BASE + " ")
+    assert doc.history is history and doc.snapshot().history is history
+    assert doc.text == BASE + " " and doc.lines == LineIndex(BASE + " ")

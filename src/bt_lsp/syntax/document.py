@@ -147,9 +147,11 @@ class Document:
         fresh = Document(text, self.path, scanned=scanned)
         with self._lock:
             edits = self._edits + 1
-            lock = self._lock
+            lock, history = self._lock, self.history
             self.__dict__.update(fresh.__dict__)
-            self._lock, self._edits = lock, edits
+            # The same document: its caches continue (a client that sends the whole
+            # text at every change still gets edits that cost what they changed).
+            self._lock, self._edits, self.history = lock, edits, history
 
     @property
     def model(self) -> Model:
