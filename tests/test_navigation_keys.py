@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from lxml import etree
 
-from bt_lsp.ide.blackboard import KeyForm, blackboard_keys, key_at, key_uses
+from bt_lsp.ide.blackboard import KeyForm, blackboard_keys, key_at, key_uses, tree_keys
 from bt_lsp.ide.places import Place
 from bt_lsp.ide.references import highlights, references
 from bt_lsp.ide.rename import RenamePlan, RenameRefused, prepare_rename, rename
@@ -97,6 +97,37 @@ def test_same_key_as_the_port() -> None:
         ("goal", KeyForm.SAME, spans[0]),
         ("speed", KeyForm.BARE_SAME, spans[1]),
     ]
+
+
+def test_the_uses_of_one_key_are_those_of_all_keys_filtered() -> None:
+    text, _, _ = cursor(KEYS)
+    doc = Document(text)
+    main = next(i for i, el in enumerate(doc.model.elements) if el.value("ID") == "Main")
+    every = key_uses(doc, main)
+    for key in {k.key for k in every} | {"nothing", "goal"}:
+        assert tree_keys(doc, main, key).uses == [k for k in every if k.key == key]
+
+
+def test_a_key_in_a_script_of_many_statements() -> None:
+    """Under the cursor and in its tree, a key of a script of 50,000 statements is found
+    by its word, as among every identifier of the script."""
+    code = "".join(f"a{i}:=1; " for i in range(50_000))
+    tree = f'<Script code="{code}"/><Sub in="{{a7}}"/>'
+    text = f'<root><BehaviorTree ID="T">{tree}</BehaviorTree></root>'
+    doc = Document(text)
+    start = text.index("a7:=")
+    for off in (start, start + 1, start + 2):  # its start, inside it, its end
+        found = key_at(doc, off)
+        assert found is not None and (found.key, found.start, found.end) == ("a7", start, start + 2)
+    found = key_at(doc, text.index("a70:=") + 3)
+    assert found is not None and found.key == "a70"
+    assert key_at(doc, text.index(":=1; a8") + 1) is None  # between two keys: none
+    uses = tree_keys(doc, 1, "a7").uses
+    assert [(k.form, text[k.start : k.end]) for k in uses] == [
+        (KeyForm.SCRIPT, "a7"),
+        (KeyForm.BRACES, "a7"),
+    ]
+    assert sorted(p.start for p in references(doc, start, {})) == [k.start for k in uses]
 
 
 # --- prepare ------------------------------------------------------------------------------

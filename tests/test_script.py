@@ -20,6 +20,7 @@ from bt_lsp.rules.script import (
     ScriptError,
     _Checker,
     check_script,
+    identifier_spans,
     identifiers,
 )
 
@@ -669,6 +670,27 @@ def test_identifiers_of_a_large_script() -> None:
     assert stop == len(code)
     assert [code[s:e] for s, e in spans][:4] == ["k0", "k0", "k1", "k1"]
     assert len(spans) == 10_000 and (spans, stop) == _identifiers_by_tokens(code)
+
+
+@settings(max_examples=1500, deadline=None)
+@given(_SCRIPT_TEXT, st.sampled_from(["a", "b", "k1", "@a", "true", "x_y", "é", "1e5"]))
+def test_identifier_spans_are_the_identifiers_of_one_word(code: str, extra: str) -> None:
+    """identifier_spans(code, word) is identifiers() filtered by word, for the words of
+    the script and others, whether the shortcut applies or the checker reads it."""
+    spans, stop = identifiers(code)
+    for word in {code[s:e] for s, e in spans} | {extra}:
+        expected = tuple((s, e) for s, e in spans if code[s:e] == word)
+        assert identifier_spans(code, word) == (expected, stop), word
+
+
+def test_identifier_spans_of_a_large_script() -> None:
+    code = "".join(f"k{i} := k{i}0 + 'k7' .. k7_ .. @k7; " for i in range(100_000))
+    found, stop = identifier_spans(code, "k7")
+    assert stop == len(code) and [code[s:e] for s, e in found] == ["k7"]
+    assert found[0][0] == code.index("k7 :=")
+    assert identifier_spans(code, "@k7")[0] == tuple(
+        (s, e) for s, e in identifiers(code)[0] if code[s:e] == "@k7"
+    )
 
 
 def test_plain_script_pattern_takes_the_common_scripts() -> None:

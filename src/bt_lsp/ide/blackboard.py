@@ -29,13 +29,14 @@ from __future__ import annotations
 
 import re
 from bisect import bisect_right
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
-from bt_lsp.rules.script import CONDITION_ATTRS, SCRIPT_PORTS, identifiers
+from bt_lsp.rules.script import CONDITION_ATTRS, SCRIPT_PORTS, identifier_spans, identifiers
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Element, Zone
 from bt_lsp.syntax.model import Model
@@ -174,13 +175,47 @@ def _port_key(
 _SCRIPT = KeyForm.SCRIPT  # (an enum member read from the class costs a lookup per key)
 
 
+_ASCII_WORD = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_")
+
+
+def _word_at(code: str, at: int) -> str:
+    """The word of an ASCII script that ends or starts at or holds ``at`` (the one before
+    it when two touch it): the only identifier there can be the key under ``at``."""
+    start = at
+    while start > 0 and code[start - 1] in _ASCII_WORD:
+        start -= 1
+    if start > 0 and code[start - 1] == "@":
+        start -= 1
+    end = at
+    if start == at and code[at : at + 1] == "@":
+        end += 1
+    while end < len(code) and code[end] in _ASCII_WORD:
+        end += 1
+    return code[start:end]
+
+
 def _script_keys(
-    doc: Document, el: Element, a: Attr, idx: int, tree: int, out: TreeKeys, at: int = -1
+    doc: Document,
+    el: Element,
+    a: Attr,
+    idx: int,
+    tree: int,
+    out: TreeKeys,
+    at: int = -1,
+    only: str | None = None,
 ) -> None:
-    """The keys of a script attribute; with ``at``, only those whose span holds it."""
+    """The keys of a script attribute; with ``at``, only those whose span holds it; with
+    ``only``, only that key (found without a span per identifier of the script)."""
     v = _Value(doc, el, a)
     code = v.decoded
-    spans, stop = identifiers(code)
+    if at >= 0 and v.offs is None and only is None and code.isascii():
+        local = at - v.base
+        word = _word_at(code, local) if 0 <= local <= len(code) else ""
+        if not word:
+            return  # no key of this script is under ``at``
+        only = word
+    spans: Sequence[tuple[int, int]]
+    spans, stop = identifiers(code) if only is None else identifier_spans(code, only)
     uses = out.uses
     name, quote = a.name, a.quote
     if v.offs is None:  # no references: decoded offsets are the text's, from the value's
@@ -206,25 +241,28 @@ def _is_port(name: str) -> bool:
     return not name.startswith("_") and bool(check_name(name, NameKind.PORT))
 
 
-def _element_keys(doc: Document, idx: int, tree: int, out: TreeKeys, at: int = -1) -> None:
-    """The key uses of node ``idx``; with ``at``, of its scripts only those holding it."""
+def _element_keys(
+    doc: Document, idx: int, tree: int, out: TreeKeys, at: int = -1, only: str | None = None
+) -> None:
+    """The key uses of node ``idx``; with ``at``, of its scripts only those holding it;
+    with ``only``, those of that key (and the unread script texts that may hold it)."""
     el = doc.model.elements[idx]
     if el.zone != Zone.NODE:
         return
     for a in el.attrs:
         value = a.value
-        if value is None:
-            continue
+        if value is None or (only is not None and only not in value and only != a.name):
+            continue  # (``{=}`` is the key named like its port)
         if a.name in CONDITION_ATTRS:
-            _script_keys(doc, el, a, idx, tree, out, at)
+            _script_keys(doc, el, a, idx, tree, out, at, only)
         elif not _is_port(a.name):
             continue  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
         elif is_blackboard_reference(value):
             k = _port_key(doc, el, a, idx, tree, value)
-            if k is not None:
+            if k is not None and (only is None or k.key == only):
                 out.uses.append(k)
         elif _is_script_port(el, a):
-            _script_keys(doc, el, a, idx, tree, out, at)
+            _script_keys(doc, el, a, idx, tree, out, at, only)
 
 
 def port_value_key(doc: Document, idx: int, a: Attr) -> KeyRef | None:
@@ -237,14 +275,17 @@ def port_value_key(doc: Document, idx: int, a: Attr) -> KeyRef | None:
     return _port_key(doc, el, a, idx, enclosing_tree(doc.model, idx), value)
 
 
-def tree_keys(doc: Document, tree: int) -> TreeKeys:
-    """Every key use in the nodes of one tree (by element index), in document order."""
+def tree_keys(doc: Document, tree: int, key: str | None = None) -> TreeKeys:
+    """Every key use in the nodes of one tree (by element index), in document order; with
+    ``key``, the uses of that key only, and only the unread script texts that hold it as
+    a word (what a request about one key needs: a script of 200,000 statements has
+    200,000 uses)."""
     model = doc.model
     out = TreeKeys()
     if not 0 <= tree < len(model.elements) or model.elements[tree].zone != Zone.TREE:
         return out
     for i in subtree_range(model, tree):
-        _element_keys(doc, i, tree, out)
+        _element_keys(doc, i, tree, out, only=key)
     return out
 
 

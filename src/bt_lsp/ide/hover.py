@@ -12,7 +12,7 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, key_uses
+from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, tree_keys
 from bt_lsp.ide.name_edits import elsewhere, occurrences
 from bt_lsp.ide.name_fixes import preferred_renaming
 from bt_lsp.ide.ports import builtins_in, ports_of
@@ -274,9 +274,7 @@ def _key_hover(w: _Writer, doc: Document, key: KeyRef, ctx: Context | None) -> N
     read: list[str] = []
     scripts: list[str] = []
     types: list[str] = []
-    for u in key_uses(doc, key.tree):
-        if u.key != key.key:
-            continue
+    for u in tree_keys(doc, key.tree, key.key).uses:
         el = model.elements[u.element]
         line = doc.lines.position(u.start, "utf-32")[0] + 1
         node = el.node_id or el.name

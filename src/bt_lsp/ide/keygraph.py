@@ -77,12 +77,14 @@ class KeyGraph:
         self.doc = doc
         self.others = others
         self.docs: list[tuple[str | None, Document]] = [(None, doc), *others.items()]
-        self._keys: dict[Tree, TreeKeys] = {}
+        self._keys: dict[tuple[Tree, str], TreeKeys] = {}
 
-    def keys(self, t: Tree) -> TreeKeys:
-        found = self._keys.get(t)
+    def keys(self, t: Tree, key: str) -> TreeKeys:
+        """The uses of ``key`` in ``t`` (and the unread script texts that may hold it):
+        only that key's, as a request is about one key and a tree may use 200,000."""
+        found = self._keys.get((t, key))
         if found is None:
-            found = self._keys[t] = tree_keys(t.doc, t.index)
+            found = self._keys[t, key] = tree_keys(t.doc, t.index, key)
         return found
 
     def refs(self, sym: Symbol) -> list[tuple[str | None, Document, NameRef]]:
@@ -162,7 +164,7 @@ class KeyGraph:
             for i, el in enumerate(d.model.elements):
                 if el.zone == Zone.TREE:
                     t = Tree(path, d, i)
-                    if mentions(self.keys(t), name):
+                    if mentions(self.keys(t, name), name):
                         out.append(t)
         return out
 
@@ -196,7 +198,7 @@ def port_targets(graph: KeyGraph, sym: PortSymbol, home: Tree | None = None) -> 
     homes = graph.trees(sym.owner)
     if home is not None and home not in homes:
         homes.insert(0, home)
-    uses = [(t, u) for t in homes for u in graph.keys(t).of(key)]
+    uses = [(t, u) for t in homes for u in graph.keys(t, key).uses]
     return KeyTargets(key, homes, uses, sym, graph.refs(sym))
 
 
@@ -206,7 +208,7 @@ def key_targets(graph: KeyGraph, home: Tree, key: str) -> KeyTargets:
         sym = PortSymbol("port", "tree", tid, key)
         if graph.refs(sym):
             return port_targets(graph, sym, home)
-    return KeyTargets(key, [home], [(home, u) for u in graph.keys(home).of(key)])
+    return KeyTargets(key, [home], [(home, u) for u in graph.keys(home, key).uses])
 
 
 def is_tree_port(sym: Symbol | None) -> TypeGuard[PortSymbol]:

@@ -234,7 +234,7 @@ def _check_key_movable(graph: KeyGraph, targets: KeyTargets, new_name: str) -> N
                 f"references in '{u.attr}' in {t.shown()}; write it out plainly first"
             )
     for t in homes:
-        if unread_mentions(graph.keys(t), key):
+        if unread_mentions(graph.keys(t, key), key):
             raise RenameRefused(
                 f"Cannot rename '{shown(key)}': a script in {t.shown()} has a syntax error "
                 f"before a '{shown(key)}' that may be this key; fix the script first"
@@ -244,7 +244,7 @@ def _check_key_movable(graph: KeyGraph, targets: KeyTargets, new_name: str) -> N
     for t in homes:
         group = graph.shared(t, key)
         for o in group:
-            if o not in homes and mentions(graph.keys(o), key):
+            if o not in homes and mentions(graph.keys(o, key), key):
                 raise RenameRefused(
                     f"Cannot rename '{shown(key)}': {o.shown()} shares it with {t.shown()} "
                     'through <SubTree _autoremap="true">, and renaming it in one tree '
@@ -267,7 +267,7 @@ def _check_no_merge(graph: KeyGraph, targets: KeyTargets, new_name: str) -> None
     for t in targets.homes:
         group = graph.shared(t, new_name)
         for o in group:
-            if mentions(graph.keys(o), new_name) or graph.has_port(o, new_name):
+            if mentions(graph.keys(o, new_name), new_name) or graph.has_port(o, new_name):
                 how = "" if o == t else f", shared with {t.shown()} through _autoremap"
                 _refuse_new_name(
                     new_name,
