@@ -11,10 +11,21 @@ from array import array
 from bisect import bisect_left
 from collections.abc import Sequence
 
-from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, StructureProblem, Zone, zone_in
+from bt_lsp.syntax.elements import (
+    EXPLICIT_TAGS,
+    SELF_CLOSED,
+    Element,
+    Own,
+    StructureProblem,
+    Zone,
+    of_row,
+    zone_in,
+)
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan
 from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
+from bt_lsp.syntax.table import ZONES as _ZONES
+from bt_lsp.syntax.table import Columns, ElementTable, offsets_code
 from bt_lsp.syntax.tokens import XML_SYNTAX, Kind, Token
 from bt_lsp.syntax.values import decode_value
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
@@ -25,24 +36,17 @@ _ZONE_PORT_DECL = Zone.PORT_DECL
 _ZONE_ROOT = Zone.ROOT
 
 
-def _zone_of(name: str, parent: Element | None, has_root: bool) -> Zone:
-    if parent is None:
-        return _ZONE_OUTSIDE if has_root else _ZONE_ROOT
-    return zone_in(name, parent.zone)
-
-
-def _check_xml_names(
-    tstart: int, tok: Token, checked: bool, problems: list[StructureProblem]
-) -> None:
+def _name_problems(tok: Token, checked: bool) -> tuple[tuple[int, str], ...]:
+    """The XML-name problems of a start tag's names, relative to the tag's start."""
+    found: list[tuple[int, str]] = []
     xp = cached_xml_name_problem(tok.name, checked and tok.name not in EXPLICIT_TAGS, False)
     if xp is not None:
-        at = tstart + 1 + xp[0]
-        problems.append(StructureProblem(at, at + 1, XML_SYNTAX, xp[1]))
+        found.append((1 + xp[0], xp[1]))
     for a in tok.attrs:
         xp = cached_xml_name_problem(a.name, checked, True)
         if xp is not None:
-            at = tstart + a.name_start + xp[0]
-            problems.append(StructureProblem(at, at + 1, XML_SYNTAX, xp[1]))
+            found.append((a.name_start + xp[0], xp[1]))
+    return tuple(found)
 
 
 _NON_SPACE = re.compile(r"[^ \t\r\n]")
@@ -51,13 +55,14 @@ _HEAD, _SECTION, _TAIL = 0, 1, 2
 
 
 class _Builder:
-    """Runs the element stack over tokens.  Offsets are stored relative to ``origin``,
-    token indexes relative to ``tok_origin``; elements are numbered in ``els`` (where,
-    for a section or the tail, element 0 is the root)."""
+    """Runs the element stack over tokens, writing each element as a row of ``cols``.
+    Offsets are stored relative to ``origin``, token indexes relative to ``tok_origin``
+    (for a section or the tail, row 0 is the root)."""
 
     __slots__ = (
-        "els",
+        "cols",
         "has_root",
+        "kids",
         "lexical",
         "origin",
         "problems",
@@ -71,15 +76,17 @@ class _Builder:
         text: str,
         origin: int,
         tok_origin: int,
-        els: list[Element],
+        cols: Columns,
         stack: list[int],
         has_root: bool,
     ) -> None:
         self.text = text
         self.origin = origin
         self.tok_origin = tok_origin
-        self.els = els
+        self.cols = cols
         self.stack = stack
+        # The children of each open element so far (closed into cols.flat).
+        self.kids: list[array[int]] = [array("i") for _ in stack]
         self.has_root = has_root
         self.problems: list[StructureProblem] = []
         self.lexical: list[StructureProblem] = []
@@ -89,31 +96,104 @@ class _Builder:
         start tag with only the root open, or, for a section, at the root's end tag;
         ``CLOSED``: a section closed the root; ``EOF``)."""
         n = len(tokens)
-        text, origin = self.text, self.origin
-        els, stack, problems, lexical = self.els, self.stack, self.problems, self.lexical
+        text, origin, tok_origin = self.text, self.origin, self.tok_origin
+        cols, stack, kids = self.cols, self.stack, self.kids
+        problems, lexical = self.problems, self.lexical
+        tags, zones = cols.tags, cols.zones
+        add_tag, add_zone, add_start = tags.append, zones.append, cols.starts.append
+        add_tindex, add_parent = cols.tindex.append, cols.parents.append
+        add_depth, add_extent = cols.depths.append, cols.extents.append
+        add_name_at, add_child_at = cols.names_at.append, cols.child_at.append
+        add_child_n = cols.child_n.append
         first = i
         start_kind, end_kind, text_kind = Kind.START, Kind.END, Kind.TEXT
-        node_zone = Zone.NODE
+        node_zone, port_decl = Zone.NODE, _ZONE_PORT_DECL
+        # The last start tag and parent zone seen, with its zone and name problems: a
+        # document of many equal tags is checked once per run of them.
+        last_tok: Token | None = None
+        last_pz = -1
+        last_zone = node_zone
+        last_names: tuple[tuple[int, str], ...] = ()
         while i < n:
             tok = tokens[i]
             kind = tok.kind
+            if kind == start_kind:
+                if tok.name == "BehaviorTree" and len(stack) > 1 and zones[stack[1]] == _ZONE_TREE:
+                    # A tree starts while the one above is not closed yet (it is being
+                    # typed): a <BehaviorTree> can only be a child of <root>, so the open
+                    # elements end here, and it starts the next tree.
+                    while len(stack) > 1:
+                        self._report_unclosed(self._pop(), before="<BehaviorTree>")
+                if (
+                    len(stack) == 1
+                    and stack[0] == 0
+                    and mode != _TAIL
+                    and (mode == _HEAD or i != first)
+                ):
+                    return i, OPEN
+                tstart = starts[i] - origin
+                if tok.problems:
+                    for p in tok.problems:
+                        lexical.append(
+                            StructureProblem(tstart + p.start, tstart + p.end, p.code, p.message)
+                        )
+                idx = len(tags)
+                if stack:
+                    parent = stack[-1]
+                    pz = zones[parent]
+                    if tok is not last_tok or pz != last_pz:
+                        last_zone = zone_in(tok.name, _ZONES[pz])
+                        last_names = _name_problems(tok, last_zone == node_zone)
+                        last_tok, last_pz = tok, pz
+                    zone = last_zone
+                    names = last_names
+                    kids[-1].append(idx)
+                else:
+                    parent = -1
+                    if self.has_root:
+                        zone = _ZONE_OUTSIDE
+                        problems.append(
+                            StructureProblem(
+                                tstart + 1,
+                                tstart + 1 + len(tok.name),
+                                XML_SYNTAX,
+                                f"Extra top-level element '<{tok.name}>'; a document has one root",
+                            )
+                        )
+                    else:
+                        zone = _ZONE_ROOT
+                    self.has_root = True
+                    names = _name_problems(tok, False)
+                add_tag(tok)
+                add_zone(zone)
+                add_start(tstart)
+                add_tindex(i - tok_origin)
+                add_parent(parent)
+                add_depth(len(stack))
+                add_name_at(-1)
+                add_child_at(0)
+                add_child_n(0)
+                if names:
+                    for at, message in names:
+                        problems.append(
+                            StructureProblem(tstart + at, tstart + at + 1, XML_SYNTAX, message)
+                        )
+                if tok.self_closing:
+                    add_extent(SELF_CLOSED)
+                else:
+                    add_extent(-1)
+                    stack.append(idx)
+                    kids.append(array("i"))
+                i += 1
+                continue
             if (
-                kind == start_kind
-                and tok.name == "BehaviorTree"
-                and len(stack) > 1
-                and els[stack[1]].zone == _ZONE_TREE
+                mode == _SECTION
+                and kind == end_kind
+                and len(stack) == 1
+                and stack[0] == 0
+                and tok.name == tags[0].name
             ):
-                # A tree starts while the one above is not closed yet (it is being typed):
-                # a <BehaviorTree> can only be a child of <root>, so the open elements end
-                # here, and it starts the next tree.
-                while len(stack) > 1:
-                    _report_unclosed(els[stack.pop()], problems, before="<BehaviorTree>")
-            at_root = len(stack) == 1 and stack[0] == 0
-            if at_root and mode != _TAIL:
-                if kind == start_kind and (mode == _HEAD or i != first):
-                    return i, OPEN
-                if mode == _SECTION and kind == end_kind and tok.name == els[0].name:
-                    return i, OPEN
+                return i, OPEN
             tstart = starts[i] - origin
             if tok.problems:
                 for p in tok.problems:
@@ -136,74 +216,122 @@ class _Builder:
                                 else "Text before the root element",
                             )
                         )
-            elif kind == start_kind:
-                parent = els[stack[-1]] if stack else None
-                zone = _zone_of(tok.name, parent, self.has_root)
-                if parent is None:
-                    if self.has_root:
-                        problems.append(
-                            StructureProblem(
-                                tstart + 1,
-                                tstart + 1 + len(tok.name),
-                                XML_SYNTAX,
-                                f"Extra top-level element '<{tok.name}>'; a document has one root",
-                            )
-                        )
-                    self.has_root = True
-                idx = len(els)
-                el = Element.of_tag(
-                    tok, zone, tstart, i - self.tok_origin, stack[-1] if stack else -1, len(stack)
-                )
-                els.append(el)
-                if parent is not None:
-                    children = parent.children
-                    if children:
-                        children.append(idx)  # type: ignore[attr-defined]  # an array
-                    else:  # ints in an array: a Python int would cost four times <A/>
-                        parent.children = array("q", (idx,))
-                _check_xml_names(tstart, tok, zone == node_zone, problems)
-                if not tok.self_closing:
-                    stack.append(idx)
             elif kind == end_kind:
-                closed = _close(tstart, tok, els, stack, problems)
-                if closed >= 0 and els[closed].zone == _ZONE_PORT_DECL:
-                    el = els[closed]
-                    el.content = _content(tokens, starts, text, el.token_index + self.tok_origin, i)
+                closed = self._close(tstart, tok)
+                if closed >= 0 and zones[closed] == port_decl:
+                    cols.contents[closed] = _content(
+                        tokens, starts, text, cols.tindex[closed] + tok_origin, i
+                    )
                 if mode == _SECTION and not stack:
                     return i + 1, CLOSED
             i += 1
         return i, EOF
 
+    def _pop(self) -> int:
+        """Close the innermost open element's list of children; its row."""
+        idx = self.stack.pop()
+        kids = self.kids.pop()
+        if kids:
+            cols = self.cols
+            cols.child_at[idx] = len(cols.flat)
+            cols.child_n[idx] = len(kids)
+            cols.flat.extend(kids)
+        return idx
+
+    def _close(self, tstart: int, tok: Token) -> int:
+        """Match an end tag to an open element, tolerating a few missing end tags; the
+        row of the element it closed, -1 if none."""
+        stack, tags = self.stack, self.cols.tags
+        name_s, name_e = tstart + tok.name_start, tstart + tok.name_end
+        match = -1
+        for depth in range(len(stack) - 1, max(-1, len(stack) - 65), -1):
+            if tags[stack[depth]].name == tok.name:
+                match = depth
+                break
+        if match == -1:
+            expected = f"; expected '</{tags[stack[-1]].name}>'" if stack else ""
+            self.problems.append(
+                StructureProblem(
+                    name_s if tok.name else tstart,
+                    name_e if tok.name else tstart + 2,
+                    XML_SYNTAX,
+                    f"Unexpected end tag '</{tok.name}>'{expected}",
+                )
+            )
+            return -1
+        while len(stack) > match + 1:
+            self._report_unclosed(self._pop(), closed_by=tok.name)
+        idx = self._pop()
+        cols = self.cols
+        at = cols.starts[idx]
+        cols.extents[idx] = tstart + tok.length - at
+        cols.names_at[idx] = name_s - at  # its ref: see Section.refs
+        return idx
+
+    def _report_unclosed(
+        self, idx: int, closed_by: str | None = None, before: str | None = None
+    ) -> None:
+        tag = self.cols.tags[idx]
+        if not tag.closed:
+            return  # its start tag already has an error; do not cascade
+        where = f" before '</{closed_by}>'" if closed_by is not None else ""
+        if before is not None:
+            where = f" before the next '{before}'"
+        at = self.cols.starts[idx] + 1
+        self.problems.append(
+            StructureProblem(
+                at, at + len(tag.name), XML_SYNTAX, f"Element '<{tag.name}>' is not closed{where}"
+            )
+        )
+
     def finish(self, keep_root: bool) -> None:
         """Report the elements left open at the end (the root too unless ``keep_root``)."""
         stack = self.stack
         while len(stack) > (1 if keep_root else 0):
-            _report_unclosed(self.els[stack.pop()], self.problems, closed_by=None)
+            self._report_unclosed(self._pop(), closed_by=None)
 
-    def section(self, ntokens: int, length: int, end: int, head: bool = False) -> Section:
+    def section(self, ntokens: int, length: int, end: int, root: Element | None = None) -> Section:
         root_end = None
+        cols = self.cols
         if end == CLOSED:
-            root = self.els[0]
-            root_end = (root.end, root.end_name_start)
+            at = cols.starts[0]
+            root_end = (at + cols.extents[0], at + cols.names_at[0])
         return Section(
             ntokens,
             length,
-            self.els[1:],
+            ElementTable(cols, 0, 0, 1),
             self.problems,
             self.lexical,
             end,
             root_end,
-            self.els[0] if head and self.els else None,
+            root,
         )
 
 
+def _stand_in(
+    cols: Columns, tag: Token, start: int, tindex: int, extent: int, name_at: int
+) -> None:
+    """Write row 0: the root, as a section or the tail is built with it."""
+    cols.tags.append(tag)
+    cols.zones.append(_ZONE_ROOT)
+    cols.starts.append(start)
+    cols.tindex.append(tindex)
+    cols.parents.append(-1)
+    cols.depths.append(0)
+    cols.extents.append(extent)
+    cols.names_at.append(name_at)
+    cols.child_at.append(0)
+    cols.child_n.append(0)
+
+
 def _section(
-    tokens: list[Token], starts: Sequence[int], text: str, i: int, root_name: str
+    tokens: list[Token], starts: Sequence[int], text: str, i: int, root_tag: Token, code: str
 ) -> tuple[Section, int, int]:
     """The section that starts at token ``i`` (a start tag with only the root open)."""
     origin = starts[i]
-    stand_in = Element(root_name, Zone.ROOT, -origin, -i, -1, 0, (), False, True)
-    b = _Builder(text, origin, i, [stand_in], [0], True)
+    cols = Columns(code)
+    _stand_in(cols, root_tag, -origin, -i, -1, -1)
+    b = _Builder(text, origin, i, cols, [0], True)
     j, end = b.run(tokens, starts, i, _SECTION)
     if end == EOF:
         b.finish(keep_root=True)
@@ -223,19 +351,21 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     # int object per token while the elements are made); an update reads a few.
     starts: Sequence[int] = scan.starts if change is not None else array("q", scan.starts)
     n = len(tokens)
-    hb = _Builder(text, 0, 0, [], [], False)
+    code = offsets_code(len(text))
+    hcols = Columns(code)
+    hb = _Builder(text, 0, 0, hcols, [], False)
     i, state = hb.run(tokens, starts, 0, _HEAD)
-    root = hb.els[0] if hb.els else None
+    root_tag = hcols.tags[0] if hcols.tags else None
     model = Model([], [], [])
     model._elements = model._refs = model._problems = None
-    model.root_element = root
     model.head_ntokens = i
+    root: Element | None = None
     sections: list[Section] = []
     origins: list[int] = []
     firsts: list[int] = []
     bases: list[int] = []
     names: list[str] = []
-    if state == OPEN and root is not None:
+    if state == OPEN and root_tag is not None:
         base = 1
         shift = 0
         reuse = (
@@ -276,68 +406,54 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
                     state = old.sections[-1].end
                     base = bases[-1] + len(sections[-1].elements)
                     break
-            sec, j, state = _section(tokens, starts, text, i, root.name)
+            sec, j, state = _section(tokens, starts, text, i, root_tag, code)
             sections.append(sec)
             origins.append(starts[i])
             firsts.append(i)
             bases.append(base)
-            names.append(sec.elements[0].name)
+            names.append(sec.top_name)
             base += len(sec.elements)
             i = j
         model.sections, model.origins, model.firsts, model.bases = sections, origins, firsts, bases
         model.top_names = names
         model.sections_end = i
-        root.children = list(bases)
+        root_start, root_tindex = hcols.starts[0], hcols.tindex[0]
+        extent = name_at = -1
         if state == CLOSED:
             re_ = sections[-1].root_end
             assert re_ is not None
-            o = origins[-1]
-            root.end, root.end_name_start = re_[0] + o, re_[1] + o if re_[1] >= 0 else -1
-        tb = _Builder(text, 0, 0, [root], [0] if state != CLOSED else [], True)
+            o = origins[-1] - root_start
+            extent, name_at = re_[0] + o, re_[1] + o if re_[1] >= 0 else -1
+        tcols = Columns(code)
+        _stand_in(tcols, root_tag, root_start, root_tindex, extent, name_at)
+        tb = _Builder(text, 0, 0, tcols, [0] if state != CLOSED else [], True)
         tb.run(tokens, starts, i, _TAIL)
         tb.finish(keep_root=False)
         model.tail_start = starts[i] if i < n else len(text)
         model.tail = tb.section(n - i, len(text) - model.tail_start, EOF)
         model.tail_base = base
+        # The root's children are the sections' tops, and any the tail adds.
+        children = array("i", bases)
+        at, count = tcols.child_at[0], tcols.child_n[0]
+        children.extend(map((base - 1).__add__, tcols.flat[at : at + count]))
+        root = of_row(
+            root_tag,
+            _ZONE_ROOT,
+            root_start,
+            root_tindex,
+            -1,
+            0,
+            tcols.extents[0],
+            tcols.names_at[0],
+            Own(children, None),
+            0,
+        )
     else:
         hb.finish(keep_root=False)
-    model.head = hb.section(i if sections else n, 0, EOF, head=True)
+        root = hcols.element(0) if root_tag is not None else None
+    model.root_element = root
+    model.head = hb.section(i if sections else n, 0, EOF, root)
     return model
-
-
-def _close(
-    tstart: int,
-    tok: Token,
-    elements: list[Element],
-    stack: list[int],
-    problems: list[StructureProblem],
-) -> int:
-    """Match an end tag to an open element, tolerating a few missing end tags; the index
-    of the element it closed, -1 if none."""
-    name_s, name_e = tstart + tok.name_start, tstart + tok.name_end
-    match = -1
-    for depth in range(len(stack) - 1, max(-1, len(stack) - 65), -1):
-        if elements[stack[depth]].name == tok.name:
-            match = depth
-            break
-    if match == -1:
-        expected = f"; expected '</{elements[stack[-1]].name}>'" if stack else ""
-        problems.append(
-            StructureProblem(
-                name_s if tok.name else tstart,
-                name_e if tok.name else tstart + 2,
-                XML_SYNTAX,
-                f"Unexpected end tag '</{tok.name}>'{expected}",
-            )
-        )
-        return -1
-    while len(stack) > match + 1:
-        _report_unclosed(elements[stack.pop()], problems, closed_by=tok.name)
-    idx = stack.pop()
-    el = elements[idx]
-    el.end = tstart + tok.length
-    el.end_name_start = name_s  # its ref: see Section.refs
-    return idx
 
 
 def _content(tokens: list[Token], starts: Sequence[int], text: str, first: int, stop: int) -> str:
@@ -352,21 +468,3 @@ def _content(tokens: list[Token], starts: Sequence[int], text: str, first: int, 
         elif tok.kind == Kind.CDATA and tok.closed:
             parts.append(text[s + 9 : s + tok.length - 3])
     return " ".join("".join(parts).split())
-
-
-def _report_unclosed(
-    el: Element,
-    problems: list[StructureProblem],
-    closed_by: str | None = None,
-    before: str | None = None,
-) -> None:
-    if not el.closed:
-        return  # its start tag already has an error; do not cascade
-    where = f" before '</{closed_by}>'" if closed_by is not None else ""
-    if before is not None:
-        where = f" before the next '{before}'"
-    problems.append(
-        StructureProblem(
-            el.name_start, el.name_end, XML_SYNTAX, f"Element '<{el.name}>' is not closed{where}"
-        )
-    )

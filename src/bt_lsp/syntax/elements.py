@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from enum import IntEnum, StrEnum
-from typing import Literal, NamedTuple
+from typing import Literal, NamedTuple, Protocol
 
 from bt_lsp.syntax.tokens import Attr, Kind, Token
 from bt_lsp.syntax.vocabulary import NameKind
@@ -120,47 +120,67 @@ class NameRef(NamedTuple):
         return self.role in DECLARING_ROLES
 
 
-# ``Element._end`` of an empty-element tag: its end is its start tag's (not kept: an int
-# per element costs four times what ``<A/>`` does).
-_SELF_CLOSED = -2
-# The children of an element that has none (shared; the builder makes a list for the
-# first child).
+# ``Element.extent`` of an empty-element tag: its end is its start tag's.
+SELF_CLOSED = -2
+# The children of an element that has none (shared).
 NO_CHILDREN: tuple[int, ...] = ()
 
 
-class Element:
-    """One element.  A document may be made of a hundred thousand ``<A/>``, so an element
-    is one slotted object that keeps only what it cannot derive: its name, attributes and
-    flags are those of its start tag (a token, shared by equal tags), the end of an empty
-    element and the end of its end tag's name are computed when read, and its children
-    are an array of ints (or a shared empty tuple)."""
+class Place(Protocol):
+    """Where an element's children and content are kept: the columns of its section
+    (:class:`bt_lsp.syntax.table.ElementTable`), or the element itself."""
 
-    __slots__ = (
-        "_end",
-        "children",
-        "content",
-        "depth",
-        "end_name_start",
-        "parent",
-        "tag",
-        "token_index",
-        "token_start",
-        "zone",
-    )
+    def children_of(self, local: int) -> Sequence[int]: ...
 
-    tag: Token
+    def content_of(self, local: int) -> str | None: ...
+
+
+class Own:
+    """The children and content of an element made on its own (not read from a table)."""
+
+    __slots__ = ("children", "content")
+
+    def __init__(self, children: Sequence[int], content: str | None) -> None:
+        self.children = children
+        self.content = content
+
+    def children_of(self, local: int) -> Sequence[int]:
+        return self.children
+
+    def content_of(self, local: int) -> str | None:
+        return self.content
+
+
+_ALONE = Own(NO_CHILDREN, None)
+
+
+class _Fields(NamedTuple):
+    tag: Token  # its start tag: name, attributes and flags (shared by equal tags)
     zone: Zone
     token_start: int
     token_index: int
     parent: int
     depth: int
-    _end: int
-    end_name_start: int
-    children: Sequence[int]
-    content: str | None
+    # Its end less its start; -1 if never closed, SELF_CLOSED for an empty element.
+    extent: int
+    # The start of its end tag's name less its start; -1 if none.
+    end_name_at: int
+    place: Place  # where its children and content are kept
+    local: int  # its row there
 
-    def __init__(
-        self,
+
+class Element(_Fields):
+    """One element.  A document may be made of a million ``<A/>``, so elements are not
+    kept: a section keeps its elements as columns of machine integers
+    (:class:`bt_lsp.syntax.table.ElementTable`) and an element is a tuple made when read.
+    Its name, attributes and flags are those of its start tag (a token shared by equal
+    tags); its end, its end tag's name, its children and its content are computed when
+    read.  Equal elements compare equal however they were made."""
+
+    __slots__ = ()
+
+    def __new__(
+        cls,
         name: str,
         zone: Zone,
         token_start: int,
@@ -177,56 +197,22 @@ class Element:
         # there); ``None`` for every other element.
         content: str | None = None,
         length: int = 0,  # the length of its start tag
-    ) -> None:
+    ) -> Element:
         tag = Token(
             Kind.START, length, length + 1, name, 1, 1 + len(name), attrs, self_closing, closed
         )
-        self._set(tag, zone, token_start, token_index, parent, depth)
-        if not self_closing:
-            self._end = end
-        self.end_name_start = end_name_start
-        self.children = children if children else NO_CHILDREN
-        self.content = content
-
-    @classmethod
-    def of_tag(
-        cls, tag: Token, zone: Zone, token_start: int, token_index: int, parent: int, depth: int
-    ) -> Element:
-        """The element that start tag ``tag`` (at ``token_start``, token ``token_index``)
-        opens: no end or children yet."""
-        el = cls.__new__(cls)
-        el._set(tag, zone, token_start, token_index, parent, depth)
-        el.end_name_start = -1
-        el.children = NO_CHILDREN
-        el.content = None
-        return el
-
-    def _set(
-        self, tag: Token, zone: Zone, token_start: int, token_index: int, parent: int, depth: int
-    ) -> None:
-        self.tag = tag
-        self.zone = zone
-        self.token_start = token_start
-        self.token_index = token_index
-        self.parent = parent
-        self.depth = depth
-        self._end = _SELF_CLOSED if tag.self_closing else -1
-
-    def moved(
-        self, origin: int, token_origin: int, parent: int, children: Sequence[int]
-    ) -> Element:
-        """This element ``origin`` code points and ``token_origin`` tokens further on."""
-        el = Element.__new__(Element)
-        el.tag, el.zone, el.depth, el.content = self.tag, self.zone, self.depth, self.content
-        el.token_start = self.token_start + origin
-        el.token_index = self.token_index + token_origin
-        el.parent = parent
-        end = self._end
-        el._end = end + origin if end >= 0 else end
-        ens = self.end_name_start
-        el.end_name_start = ens + origin if ens >= 0 else -1
-        el.children = children if children else NO_CHILDREN
-        return el
+        return of_row(
+            tag,
+            zone,
+            token_start,
+            token_index,
+            parent,
+            depth,
+            SELF_CLOSED if self_closing else (end - token_start if end >= 0 else -1),
+            end_name_start - token_start if end_name_start >= 0 else -1,
+            Own(children, content) if children or content is not None else _ALONE,
+            0,
+        )
 
     @property
     def name(self) -> str:
@@ -253,20 +239,34 @@ class Element:
     @property
     def end(self) -> int:
         """The offset after its end tag (or its start tag when empty); -1 if never closed."""
-        end = self._end
-        return self.token_start + self.length if end == _SELF_CLOSED else end
+        x = self.extent
+        if x >= 0:
+            return self.token_start + x
+        return self.token_start + self.tag.length if x == SELF_CLOSED else -1
 
-    @end.setter
-    def end(self, value: int) -> None:
-        self._end = value
+    @property
+    def end_name_start(self) -> int:
+        """The start of its end tag's name, -1 if none."""
+        x = self.end_name_at
+        return self.token_start + x if x >= 0 else -1
 
     @property
     def end_name_end(self) -> int:
         """The end of the end tag's name (which is the element's), -1 if none."""
-        ens = self.end_name_start
-        return ens + len(self.name) if ens >= 0 else -1
+        x = self.end_name_at
+        return self.token_start + x + len(self.tag.name) if x >= 0 else -1
 
-    def _fields(self) -> tuple[object, ...]:
+    @property
+    def children(self) -> Sequence[int]:
+        """The indexes of its child elements (in the coordinates it was read in)."""
+        return self.place.children_of(self.local)
+
+    @property
+    def content(self) -> str | None:
+        """The text inside a port declaration; ``None`` for every other element."""
+        return self.place.content_of(self.local)
+
+    def _key(self) -> tuple[object, ...]:
         return (
             self.name,
             self.zone,
@@ -279,19 +279,24 @@ class Element:
             self.closed,
             self.end,
             self.end_name_start,
-            self.children,
+            tuple(self.children),
             self.content,
         )
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Element):
             return NotImplemented
-        return self._fields() == other._fields()
+        return self._key() == other._key()
 
-    __hash__ = None  # type: ignore[assignment]  # mutable while the builder runs
+    def __ne__(self, other: object) -> bool:
+        if not isinstance(other, Element):
+            return NotImplemented
+        return self._key() != other._key()
+
+    __hash__ = None  # type: ignore[assignment]  # like the records it replaced
 
     def __repr__(self) -> str:
-        return f"Element({', '.join(map(repr, self._fields()))})"
+        return f"Element({', '.join(map(repr, self._key()))})"
 
     @property
     def name_start(self) -> int:
@@ -299,10 +304,10 @@ class Element:
 
     @property
     def name_end(self) -> int:
-        return self.token_start + 1 + len(self.name)
+        return self.token_start + 1 + len(self.tag.name)
 
     def attr(self, name: str) -> Attr | None:
-        for a in self.attrs:
+        for a in self.tag.attrs:
             if a.name == name:
                 return a
         return None
@@ -324,9 +329,33 @@ class Element:
     @property
     def node_id(self) -> str | None:
         """The node type: the ``ID`` of an explicit node or SubTree, else the tag name."""
-        if self.name in EXPLICIT_TAGS or self.name == "SubTree":
+        name = self.tag.name
+        if name in EXPLICIT_TAGS or name == "SubTree":
             return self.value("ID")
-        return self.name
+        return name
+
+
+def of_row(
+    tag: Token,
+    zone: Zone,
+    token_start: int,
+    token_index: int,
+    parent: int,
+    depth: int,
+    extent: int,
+    end_name_at: int,
+    place: Place,
+    local: int,
+) -> Element:
+    """The element of these fields (as a table row holds them)."""
+    return _new(
+        Element,
+        (tag, zone, token_start, token_index, parent, depth, extent, end_name_at, place, local),
+    )
+
+
+# Makes a tuple subclass from its fields without its constructor.
+_new = tuple.__new__
 
 
 class StructureProblem(NamedTuple):

@@ -4,8 +4,9 @@ A model made of sections (:func:`bt_lsp.syntax.builder.build`) holds the documen
 (the root element), its sections (:mod:`bt_lsp.syntax.sections`) and its tail; after an
 edit the sections the edit cannot have changed are the same objects as before, and so is
 everything derived from them and cached on them (diagnostics, declarations, semantic
-checks).  The whole-document views (``elements``, ``refs``, ``problems``) are made of
-absolute copies, built when first asked for.
+checks).  The whole-document views (``elements``, ``refs``, ``problems``) are in document
+coordinates, made when first asked for; the elements are read from the sections' columns
+(:mod:`bt_lsp.syntax.table`) each time, not kept.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import Any, overload
 from bt_lsp.syntax.elements import Element, NameRef, StructureProblem, Symbol, Zone
 from bt_lsp.syntax.gcpause import gc_paused
 from bt_lsp.syntax.sections import Part, Section, section_top
+from bt_lsp.syntax.table import ElementTable, Prefixed
 
 
 class _Lazy(Sequence[Any]):
@@ -160,7 +162,7 @@ class Model:
         """The section as a model of its own, in its coordinates; element 0 is ``root``
         (the document's, in document coordinates: only its attributes and its number of
         children mean anything here)."""
-        model = cls([root or _STAND_IN, *section.elements], (), section.problems)
+        model = cls(Prefixed(root or _STAND_IN, section.elements), (), section.problems)
         model._refs = None  # made when asked for (see Model.refs)
         model.local = section
         return model
@@ -307,35 +309,55 @@ class Model:
         root = self.root_element
         if root is None:
             return []
-        # Chunk 0 is the head (from element 1 on), then the sections, then the tail.
-        bases = [1, *self.bases]
-        nsec = len(self.sections)
+        head = self.head
+        assert head is not None
+        tables = [head.elements]  # already in document coordinates
+        tables.extend(
+            sec.elements.placed(o, f, b)
+            for sec, o, f, b in zip(
+                self.sections, self.origins, self.firsts, self.bases, strict=True
+            )
+        )
         if self.tail is not None:
-            bases.append(self.tail_base)
-            n = self.tail_base + len(self.tail.elements)
-        else:
-            assert self.head is not None
-            n = 1 + len(self.head.elements)
-        head, tail, tail_base = self.head, self.tail, self.tail_base
-        sections, origins, firsts, elem_bases = self.sections, self.origins, self.firsts, self.bases
+            tables.append(self.tail.elements.placed(0, 0, self.tail_base))
+        return _Chain(root, tables)
 
-        # (Not a method: the view must not refer back to the model, a cycle that only the
-        # cyclic collector could free.)
-        def make(c: int, j: int) -> Element:
-            if c == 0:
-                assert head is not None
-                return head.elements[j]  # already in document coordinates
-            if c > nsec:
-                assert tail is not None
-                return Part(tail, 0, 0, tail_base).element(tail.elements[j])
-            k = c - 1
-            part = Part(sections[k], origins[k], firsts[k], elem_bases[k])
-            return part.top() if j == 0 else part.element(sections[k].elements[j])
 
-        lazy = _Lazy(n, bases, make)
-        if n:
-            lazy._items[0] = root
-        return lazy
+class _Chain(Sequence[Element]):
+    """The root followed by the elements of each table in turn (the head's, each
+    section's and the tail's, in document coordinates); made when read, not kept."""
+
+    __slots__ = ("_bases", "_n", "_root", "_tables")
+
+    def __init__(self, root: Element, tables: list[ElementTable]) -> None:
+        self._root = root
+        self._tables = tables
+        self._bases = list(accumulate(map(len, tables), initial=1))[:-1]  # first of each
+        self._n = 1 + sum(map(len, tables))
+
+    def __len__(self) -> int:
+        return self._n
+
+    @overload
+    def __getitem__(self, i: int) -> Element: ...
+    @overload
+    def __getitem__(self, i: slice) -> Sequence[Element]: ...
+    def __getitem__(self, i: int | slice) -> Element | Sequence[Element]:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(self._n))]
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError(i)
+        if i == 0:
+            return self._root
+        k = bisect_right(self._bases, i) - 1
+        return self._tables[k][i - self._bases[k]]
+
+    def __iter__(self) -> Iterator[Element]:
+        yield self._root
+        for table in self._tables:
+            yield from table
 
 
 # The root of a section's own model when the document's is not at hand.

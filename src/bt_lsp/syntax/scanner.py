@@ -541,16 +541,46 @@ class Scan:
         return max(0, self.starts.index_at(offset))
 
 
+# A token whose scan looked this far at most is remembered for the ones that follow.
+_REPEAT_REACH = 64
+
+
 def scan(text: str) -> Scan:
     tokens: list[Token] = []
     starts = array("q")  # machine ints: a list would hold an int object per token
+    add_token, add_start = tokens.append, starts.append
+    startswith = text.startswith
     pos, n = 0, len(text)
+    # The text each of the last three tokens looked at: a token depends only on the text
+    # from its start to its reach, so where the same text comes again, so does the token
+    # (one comparison in C instead of a scan: documents repeat a tag, or a few in turn).
+    s1 = s2 = s3 = ""
+    t1 = t2 = t3 = _NO_TOKEN
     while pos < n:
-        tok = scan_token(text, pos)
-        tokens.append(tok)
-        starts.append(pos)
+        if s1 and startswith(s1, pos):
+            tok = t1
+        elif s2 and startswith(s2, pos):
+            tok, s1, t1, s2, t2 = t2, s2, t2, s1, t1
+        elif s3 and startswith(s3, pos):
+            tok, s1, t1, s2, t2, s3, t3 = t3, s3, t3, s1, t1, s2, t2
+        else:
+            tok = scan_token(text, pos)
+            reach = tok.reach
+            s3, t3, s2, t2 = s2, t2, s1, t1
+            # (Not a tag with attributes: those seldom repeat whole.)
+            s1 = (
+                text[pos : pos + reach]
+                if reach <= _REPEAT_REACH and pos + reach <= n and not tok.attrs
+                else ""
+            )
+            t1 = tok
+        add_token(tok)
+        add_start(pos)
         pos += tok.length
     return Scan(tokens, Starts.of(starts))
+
+
+_NO_TOKEN = Token(Kind.TEXT, 0, 0)
 
 
 @dataclass(frozen=True, slots=True)

@@ -25,9 +25,14 @@ from bt_lsp.syntax.elements import (
     model_symbol,
 )
 from bt_lsp.syntax.nametokens import name_refs, shared_symbol
+from bt_lsp.syntax.table import ElementTable
+from bt_lsp.syntax.tokens import Token
 
 _ROLE_NODE_TYPE_END = Role.NODE_TYPE_END
 _ZONE_NODE = Zone.NODE
+_ZONE_PORT_DECL = Zone.PORT_DECL
+
+_new = tuple.__new__
 
 OPEN, CLOSED, EOF = 0, 1, 2  # how a section ends: at root level, closing the root, at the end
 
@@ -58,7 +63,7 @@ class Section:
         self,
         ntokens: int,
         length: int,
-        elements: list[Element],
+        elements: ElementTable,
         problems: list[StructureProblem],
         lexical: list[StructureProblem],
         end: int,
@@ -79,6 +84,11 @@ class Section:
     def top(self) -> Element:
         """The root's child that starts the section (local element 1)."""
         return self.elements[0]
+
+    @property
+    def top_name(self) -> str:
+        """The name of its top element."""
+        return self.elements.columns.tags[1].name
 
     @property
     def refs(self) -> list[NameRef]:
@@ -131,29 +141,47 @@ class Section:
             yield from refs
             refs.clear()
         els = self.elements
-        for i, el in enumerate(els, 1):
-            p = el.parent
-            name_refs(el, i, els[p - 1] if p > 0 else None, refs)
-            if (
-                el.end_name_start >= 0
-                and el.zone == _ZONE_NODE
-                and el.name not in EXPLICIT_TAGS
-                and el.name != "SubTree"
-            ):  # the end tag of a compact node names its type too
-                refs.append(
-                    NameRef(
-                        el.end_name_start,
-                        el.end_name_end,
-                        el.name,
-                        None,
-                        _ROLE_NODE_TYPE_END,
-                        shared_symbol(model_symbol(el.name)),
-                        i,
-                    )
-                )
-            if refs:
+        cols = els.columns
+        tags, zones, starts, names_at = cols.tags, cols.zones, cols.starts, cols.names_at
+        # An element with the same start tag and zone as the one before has the same
+        # names moved: made from those (a document may be a million equal tags).
+        last_tag: Token | None = None
+        last_zone = -1
+        first_ts = 0
+        first: list[NameRef] = []
+        for i in range(1, len(tags)):
+            tag, zone, ts = tags[i], zones[i], starts[i]
+            if tag is last_tag and zone == last_zone:
+                d = ts - first_ts
+                for r in first:
+                    yield _new(NameRef, (r[0] + d, r[1] + d, r[2], r[3], r[4], r[5], i, r[7]))
+            else:
+                el = els[i - 1]
+                # Only a port declaration's names depend on its parent (made only for it).
+                p = el.parent
+                parent = els[p - 1] if p > 0 and zone == _ZONE_PORT_DECL else None
+                refs = []
+                name_refs(el, i, parent, refs)
+                if zone != _ZONE_PORT_DECL:
+                    last_tag, last_zone, first_ts, first = tag, zone, ts, refs
                 yield from refs
-                refs.clear()
+            at = names_at[i]
+            if (
+                at >= 0
+                and zone == _ZONE_NODE
+                and tag.name not in EXPLICIT_TAGS
+                and tag.name != "SubTree"
+            ):  # the end tag of a compact node names its type too
+                name = tag.name
+                yield NameRef(
+                    ts + at,
+                    ts + at + len(name),
+                    name,
+                    None,
+                    _ROLE_NODE_TYPE_END,
+                    shared_symbol(model_symbol(name)),
+                    i,
+                )
 
     def ref_at(self, offset: int) -> NameRef | None:
         """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
@@ -199,15 +227,12 @@ class Part:
         return self.elem_base + local - 1
 
     def element(self, el: Element) -> Element:
-        """An element of the section in document coordinates."""
-        # Children are never the root (local 0): a top element may have thousands.
-        children = el.children
-        return el.moved(
-            self.origin,
-            self.tok_origin,
-            self.element_index(el.parent),
-            list(map((self.elem_base - 1).__add__, children)) if children else children,
-        )
+        """An element of the section (read from its elements) in document coordinates."""
+        return self.elements()[el.local - 1]
+
+    def elements(self) -> ElementTable:
+        """The section's elements in document coordinates."""
+        return self.section.elements.placed(self.origin, self.tok_origin, self.elem_base)
 
     def top(self) -> Element:
         """The section's top element in document coordinates."""

@@ -317,7 +317,7 @@ def _run(
         made=st.made,
     )
     elements = local.elements
-    check(run, elements[1:] if isinstance(elements, list) else list(elements)[1:])
+    check(run, elements[1:])  # a view of the section's elements, not a copy
     line = lines.line_of(origin) if run.uses_lines else None
     out = capped(run.out, run.more)
     return _Entry(settings, line, {d: current(d) for d in deps}, out, out.more)
