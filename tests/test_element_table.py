@@ -81,7 +81,8 @@ def test_an_element_read_equals_one_made_alone() -> None:
         2
     ]
     alone = Element("A", Zone.NODE, 27, 2, 1, 2, el.attrs, False, True, 40, 38, length=9)
-    assert el == alone and not el != alone
+    assert el == alone
+    assert not el.__ne__(alone)  # != is the same comparison, not the tuples'
     assert alone.children == () and alone.content is None
     assert Element("R", Zone.ROOT, 0, 0, -1, 0, (), False, True, children=array("i", [1])) != el
 
@@ -97,3 +98,24 @@ def test_a_section_of_thousands_is_iterated_whole() -> None:
     first = next(it)
     assert first.name == "BehaviorTree" and len(sec.elements) == 5002
     assert sum(1 for _ in it) == 5001
+
+
+def test_a_run_of_equal_empty_elements_is_built_like_any_other() -> None:
+    # Equal tags in a row are added at once: each still has its own offset, token index
+    # and problems, and each child of <root> still starts a section.
+    body = "<A§/>" * 3
+    text = (
+        f'<root><BehaviorTree ID="T"><Sequence>{body}</Sequence></BehaviorTree>{"<X/>" * 3}</root>'
+    )
+    model = Document(text).model
+    at = text.index("<A§/>")
+    assert [(p.start, p.code) for p in model.problems] == [
+        (at + 2 + 5 * k, "xml-syntax") for k in range(3)
+    ]
+    assert [s.top_name for s in model.sections] == ["BehaviorTree", "X", "X", "X"]
+    els = list(model.elements)
+    assert [(e.name, e.token_start, e.token_index, e.parent, e.end) for e in els[3:6]] == [
+        ("A§", at + 5 * k, 3 + k, 2, at + 5 * k + 5) for k in range(3)
+    ]
+    assert list(els[2].children) == [3, 4, 5]
+    assert list(els[0].children) == [1, 6, 7, 8]

@@ -10,6 +10,7 @@ import re
 from array import array
 from bisect import bisect_left
 from collections.abc import Sequence
+from itertools import repeat
 
 from bt_lsp.syntax.elements import (
     EXPLICIT_TAGS,
@@ -180,10 +181,20 @@ class _Builder:
                         )
                 if tok.self_closing:
                     add_extent(SELF_CLOSED)
-                else:
-                    add_extent(-1)
-                    stack.append(idx)
-                    kids.append(array("i"))
+                    i += 1
+                    if (
+                        i < n
+                        and tokens[i] is tok
+                        and parent >= 0
+                        and (parent > 0 or mode == _TAIL)  # (the root's child ends a part)
+                        and not tok.problems
+                        and tok.name != "BehaviorTree"
+                    ):
+                        i = self._run_of(tok, zone, names, tokens, starts, i, n)
+                    continue
+                add_extent(-1)
+                stack.append(idx)
+                kids.append(array("i"))
                 i += 1
                 continue
             if (
@@ -226,6 +237,50 @@ class _Builder:
                     return i + 1, CLOSED
             i += 1
         return i, EOF
+
+    def _run_of(
+        self,
+        tok: Token,
+        zone: int,
+        names: tuple[tuple[int, str], ...],
+        tokens: list[Token],
+        starts: Sequence[int],
+        i: int,
+        n: int,
+    ) -> int:
+        """Add the empty elements of ``tok`` that follow from token ``i`` (siblings of
+        the one just added, in ``zone``), as many as there are in a row, all at once;
+        returns the token after them."""
+        j = i + 1
+        while j < n and tokens[j] is tok:
+            j += 1
+        k = j - i
+        cols, stack = self.cols, self.stack
+        idx = len(cols.tags)
+        origin = self.origin
+        cols.tags.extend(repeat(tok, k))
+        cols.zones.extend(bytes((zone,)) * k)
+        run = starts[i:j]
+        cols.starts.extend(map((-origin).__add__, run) if origin else run)
+        cols.tindex.extend(range(i - self.tok_origin, j - self.tok_origin))
+        cols.parents.extend(array("i", (stack[-1],)) * k)
+        cols.depths.extend(array("i", (len(stack),)) * k)
+        code = cols.extents.typecode
+        cols.extents.extend(array(code, (SELF_CLOSED,)) * k)
+        cols.names_at.extend(array(code, (-1,)) * k)
+        zeros = array("i", (0,)) * k
+        cols.child_at.extend(zeros)
+        cols.child_n.extend(zeros)
+        self.kids[-1].extend(range(idx, idx + k))
+        if names:
+            problems = self.problems
+            for s in run:
+                tstart = s - origin
+                for at, message in names:
+                    problems.append(
+                        StructureProblem(tstart + at, tstart + at + 1, XML_SYNTAX, message)
+                    )
+        return j
 
     def _pop(self) -> int:
         """Close the innermost open element's list of children; its row."""
@@ -349,7 +404,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     tokens = scan.tokens
     # A full build reads every start: from one array of machine ints (a list would hold an
     # int object per token while the elements are made); an update reads a few.
-    starts: Sequence[int] = scan.starts if change is not None else array("q", scan.starts)
+    starts: Sequence[int] = scan.starts if change is not None else scan.starts.toarray()
     n = len(tokens)
     code = offsets_code(len(text))
     hcols = Columns(code)

@@ -180,6 +180,13 @@ class Offsets(Sequence[int]):
             out.extend(map(base.__add__, block))
         return out
 
+    def toarray(self) -> array[int]:
+        """The offsets in one array of machine integers (made block by block, in C)."""
+        out = array("q")
+        for base, block in zip(self._bases, self._blocks, strict=True):
+            out.extend(map(base.__add__, block) if base else block)
+        return out
+
     def bisect_right(self, offset: int) -> int:
         """The number of offsets at or before ``offset`` (as :func:`bisect.bisect_right`)."""
         b = bisect_right(self._bases, offset) - 1
