@@ -26,7 +26,7 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan
 from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
 from bt_lsp.syntax.table import ZONES as _ZONES
-from bt_lsp.syntax.table import Columns, ElementTable, offsets_code
+from bt_lsp.syntax.table import Columns, ElementTable, keeps, offsets_code
 from bt_lsp.syntax.tokens import XML_SYNTAX, Kind, Token
 from bt_lsp.syntax.values import decode_value
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
@@ -354,7 +354,7 @@ class _Builder:
         return Section(
             ntokens,
             length,
-            ElementTable(cols, 0, 0, 1),
+            ElementTable(cols, 0, 0, 1, keep=keeps(length, len(cols) - 1)),
             self.problems,
             self.lexical,
             end,

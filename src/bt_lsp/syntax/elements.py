@@ -156,6 +156,9 @@ _ALONE = Own(NO_CHILDREN, None)
 
 class _Fields(NamedTuple):
     tag: Token  # its start tag: name, attributes and flags (shared by equal tags)
+    # Its start tag's name and attributes (read as often as the rules read an element).
+    name: str
+    attrs: tuple[Attr, ...]
     zone: Zone
     token_start: int
     token_index: int
@@ -213,14 +216,6 @@ class Element(_Fields):
             Own(children, content) if children or content is not None else _ALONE,
             0,
         )
-
-    @property
-    def name(self) -> str:
-        return self.tag.name
-
-    @property
-    def attrs(self) -> tuple[Attr, ...]:
-        return self.tag.attrs
 
     @property
     def self_closing(self) -> bool:
@@ -350,7 +345,20 @@ def of_row(
     """The element of these fields (as a table row holds them)."""
     return _new(
         Element,
-        (tag, zone, token_start, token_index, parent, depth, extent, end_name_at, place, local),
+        (
+            tag,
+            tag.name,
+            tag.attrs,
+            zone,
+            token_start,
+            token_index,
+            parent,
+            depth,
+            extent,
+            end_name_at,
+            place,
+            local,
+        ),
     )
 
 

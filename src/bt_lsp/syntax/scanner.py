@@ -543,6 +543,11 @@ class Scan:
 
 # A token whose scan looked this far at most is remembered for the ones that follow.
 _REPEAT_REACH = 64
+# Of each window of tokens looked up so, at least half must be found, or the next
+# tokens are scanned without looking (where a document does not repeat itself, looking
+# costs more than it finds).
+_WINDOW = 256
+_PAUSE = 2048
 
 
 def scan(text: str) -> Scan:
@@ -556,13 +561,25 @@ def scan(text: str) -> Scan:
     # (one comparison in C instead of a scan: documents repeat a tag, or a few in turn).
     s1 = s2 = s3 = ""
     t1 = t2 = t3 = _NO_TOKEN
+    looked = found = pause = 0
     while pos < n:
+        if pause:
+            pause -= 1
+            tok = scan_token(text, pos)
+            add_token(tok)
+            add_start(pos)
+            pos += tok.length
+            continue
+        looked += 1
         if s1 and startswith(s1, pos):
             tok = t1
+            found += 1
         elif s2 and startswith(s2, pos):
             tok, s1, t1, s2, t2 = t2, s2, t2, s1, t1
+            found += 1
         elif s3 and startswith(s3, pos):
             tok, s1, t1, s2, t2, s3, t3 = t3, s3, t3, s1, t1, s2, t2
+            found += 1
         else:
             tok = scan_token(text, pos)
             reach = tok.reach
@@ -574,6 +591,11 @@ def scan(text: str) -> Scan:
                 else ""
             )
             t1 = tok
+        if looked == _WINDOW:
+            if 2 * found < _WINDOW:
+                pause = _PAUSE
+                s1 = s2 = s3 = ""
+            looked = found = 0
         add_token(tok)
         add_start(pos)
         pos += tok.length

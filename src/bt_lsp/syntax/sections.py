@@ -141,10 +141,14 @@ class Section:
             yield from refs
             refs.clear()
         els = self.elements
+        if els.kept:  # made already, or to be made once anyway
+            yield from self._kept_refs(els)
+            return
         cols = els.columns
         tags, zones, starts, names_at = cols.tags, cols.zones, cols.starts, cols.names_at
         # An element with the same start tag and zone as the one before has the same
-        # names moved: made from those (a document may be a million equal tags).
+        # names moved: made from those (a document may be a million equal tags), without
+        # making the element.
         last_tag: Token | None = None
         last_zone = -1
         first_ts = 0
@@ -166,22 +170,25 @@ class Section:
                     last_tag, last_zone, first_ts, first = tag, zone, ts, refs
                 yield from refs
             at = names_at[i]
-            if (
-                at >= 0
-                and zone == _ZONE_NODE
-                and tag.name not in EXPLICIT_TAGS
-                and tag.name != "SubTree"
-            ):  # the end tag of a compact node names its type too
-                name = tag.name
-                yield NameRef(
-                    ts + at,
-                    ts + at + len(name),
-                    name,
-                    None,
-                    _ROLE_NODE_TYPE_END,
-                    shared_symbol(model_symbol(name)),
-                    i,
-                )
+            if at >= 0 and zone == _ZONE_NODE:
+                end_ref = _end_ref(tag.name, ts + at, i)
+                if end_ref is not None:
+                    yield end_ref
+
+    @staticmethod
+    def _kept_refs(els: ElementTable) -> Iterator[NameRef]:
+        refs: list[NameRef] = []
+        for i, el in enumerate(els, 1):
+            zone = el.zone
+            p = el.parent
+            name_refs(el, i, els[p - 1] if p > 0 and zone == _ZONE_PORT_DECL else None, refs)
+            if zone == _ZONE_NODE and el.end_name_at >= 0:
+                end_ref = _end_ref(el.name, el.token_start + el.end_name_at, i)
+                if end_ref is not None:
+                    refs.append(end_ref)
+            if refs:
+                yield from refs
+                refs.clear()
 
     def ref_at(self, offset: int) -> NameRef | None:
         """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
@@ -264,6 +271,16 @@ def section_top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> E
     el = Part(sec, origin, tok_origin, elem_base).element(sec.elements[0])
     sec.cache["top"] = (origin, tok_origin, elem_base, el)
     return el
+
+
+def _end_ref(name: str, at: int, i: int) -> NameRef | None:
+    """The name token of the end tag at ``at`` of compact node ``i``: it names the node's
+    type too."""
+    if name in EXPLICIT_TAGS or name == "SubTree":
+        return None
+    return NameRef(
+        at, at + len(name), name, None, _ROLE_NODE_TYPE_END, shared_symbol(model_symbol(name)), i
+    )
 
 
 def _start(r: NameRef) -> int:

@@ -14,6 +14,7 @@ from __future__ import annotations
 from array import array
 from collections.abc import Iterator, Sequence
 from itertools import chain, repeat
+from operator import itemgetter
 from typing import overload
 
 from bt_lsp.syntax.elements import NO_CHILDREN, Element, Zone, of_row
@@ -21,6 +22,8 @@ from bt_lsp.syntax.tokens import Token
 
 ZONES: tuple[Zone, ...] = tuple(Zone)
 _new = tuple.__new__
+_NAME = itemgetter(3)  # Token.name
+_ATTRS = itemgetter(6)  # Token.attrs
 # Machine integers of 4 bytes hold the offsets of any text below 2 GiB.
 _SMALL = 2**31 - 1
 # Rows made at a time when the elements are iterated.
@@ -76,30 +79,75 @@ class Columns:
         return ElementTable(self, 0, 0, 1, k, k + 1)[0]
 
 
-class ElementTable(Sequence[Element]):
-    """Rows ``lo .. hi - 1`` of some columns as elements, placed ``origin`` code points,
-    ``tok_origin`` tokens and ``base - 1`` elements further on (a local row ``k > 0`` is
-    element ``base - 1 + k`` there; row 0, the root, stays element 0)."""
+class _Placement:
+    """Where the rows of some columns sit: ``origin`` code points, ``tok_origin`` tokens
+    and ``base - 1`` elements further on (a local row ``k > 0`` is element
+    ``base - 1 + k`` there; row 0, the root, stays element 0).  An element read from
+    them finds its children and content here (it refers to this, not to the table that
+    may keep it: no cycle)."""
 
-    __slots__ = ("_cols", "_hi", "_lo", "base", "origin", "tok_origin")
+    __slots__ = ("base", "cols", "origin", "tok_origin")
 
-    def __init__(
-        self, cols: Columns, origin: int, tok_origin: int, base: int, lo: int = 1, hi: int = -1
-    ) -> None:
-        self._cols = cols
+    def __init__(self, cols: Columns, origin: int, tok_origin: int, base: int) -> None:
+        self.cols = cols
         self.origin = origin
         self.tok_origin = tok_origin
         self.base = base
+
+    def children_of(self, local: int) -> Sequence[int]:
+        c = self.cols
+        n = c.child_n[local]
+        if not n:
+            return NO_CHILDREN
+        at = c.child_at[local]
+        kids = c.flat[at : at + n]
+        shift = self.base - 1
+        return array("i", map(shift.__add__, kids)) if shift else kids
+
+    def content_of(self, local: int) -> str | None:
+        return self.cols.contents.get(local)
+
+
+class ElementTable(Sequence[Element]):
+    """Rows ``lo .. hi - 1`` of some columns as elements, placed ``origin`` code points,
+    ``tok_origin`` tokens and ``base - 1`` elements further on (see :class:`_Placement`).
+
+    With ``keep``, the elements are made once and kept: for rows that stand for enough
+    text (:func:`keeps`), where keeping them costs a small part of the text and saves
+    making them again at every pass of the rules and requests."""
+
+    __slots__ = ("_hi", "_items", "_keep", "_lo", "_place")
+
+    def __init__(
+        self,
+        cols: Columns,
+        origin: int,
+        tok_origin: int,
+        base: int,
+        lo: int = 1,
+        hi: int = -1,
+        keep: bool = False,
+    ) -> None:
+        self._place = _Placement(cols, origin, tok_origin, base)
         self._lo = lo
         self._hi = len(cols.tags) if hi < 0 else hi
+        self._keep = keep
+        self._items: list[Element] | None = None
 
     @property
     def columns(self) -> Columns:
-        return self._cols
+        return self._place.cols
+
+    @property
+    def kept(self) -> bool:
+        """Whether its elements are kept once made (see :func:`keeps`)."""
+        return self._keep
 
     def placed(self, origin: int, tok_origin: int, base: int) -> ElementTable:
         """The same rows placed elsewhere."""
-        return ElementTable(self._cols, origin, tok_origin, base, self._lo, self._hi)
+        return ElementTable(
+            self._place.cols, origin, tok_origin, base, self._lo, self._hi, self._keep
+        )
 
     def __len__(self) -> int:
         return self._hi - self._lo
@@ -114,45 +162,56 @@ class ElementTable(Sequence[Element]):
             start, stop, step = i.indices(n)
             if step != 1:
                 return [self[j] for j in range(start, stop, step)]
-            stop = max(start, stop)
+            if start == 0 and stop >= n:
+                return self
+            pl = self._place
+            lo = self._lo
             return ElementTable(
-                self._cols,
-                self.origin,
-                self.tok_origin,
-                self.base,
-                self._lo + start,
-                self._lo + stop,
+                pl.cols, pl.origin, pl.tok_origin, pl.base, lo + start, lo + max(start, stop)
             )
         if i < 0:
             i += n
         if not 0 <= i < n:
             raise IndexError(i)
+        if self._keep:
+            return self._kept()[i]
         k = self._lo + i
-        c = self._cols
+        pl = self._place
+        c = pl.cols
         p = c.parents[k]
         return of_row(
             c.tags[k],
             ZONES[c.zones[k]],
-            c.starts[k] + self.origin,
-            c.tindex[k] + self.tok_origin,
-            p + self.base - 1 if p > 0 else p,
+            c.starts[k] + pl.origin,
+            c.tindex[k] + pl.tok_origin,
+            p + pl.base - 1 if p > 0 else p,
             c.depths[k],
             c.extents[k],
             c.names_at[k],
-            self,
+            pl,
             k,
         )
 
     def __iter__(self) -> Iterator[Element]:
+        if self._keep:
+            return iter(self._kept())
         lo, hi = self._lo, self._hi
         return chain.from_iterable(
             self._rows(a, min(hi, a + _CHUNK)) for a in range(lo, hi, _CHUNK)
         )
 
+    def _kept(self) -> list[Element]:
+        items = self._items
+        if items is None:
+            items = self._items = list(self._rows(self._lo, self._hi))
+        return items
+
     def _rows(self, a: int, b: int) -> Iterator[Element]:
         """Rows ``a .. b - 1``, made in C."""
-        c = self._cols
-        shift = self.base - 1
+        pl = self._place
+        c = pl.cols
+        origin, tok_origin, shift = pl.origin, pl.tok_origin, pl.base - 1
+        tags = c.tags[a:b]
         parents: Iterator[int] | array[int] = c.parents[a:b]
         if shift and min(parents, default=1) <= 0:  # the root's children: not moved
             parents = (p + shift if p > 0 else p for p in parents)
@@ -162,33 +221,30 @@ class ElementTable(Sequence[Element]):
             _new,
             repeat(Element),
             zip(
-                c.tags[a:b],
+                tags,
+                map(_NAME, tags),
+                map(_ATTRS, tags),
                 map(ZONES.__getitem__, c.zones[a:b]),
-                map(self.origin.__add__, c.starts[a:b]) if self.origin else c.starts[a:b],
-                map(self.tok_origin.__add__, c.tindex[a:b]) if self.tok_origin else c.tindex[a:b],
+                map(origin.__add__, c.starts[a:b]) if origin else c.starts[a:b],
+                map(tok_origin.__add__, c.tindex[a:b]) if tok_origin else c.tindex[a:b],
                 parents,
                 c.depths[a:b],
                 c.extents[a:b],
                 c.names_at[a:b],
-                repeat(self),
+                repeat(pl),
                 range(a, b),
             ),
         )
 
-    # -- what an element reads from its place (see bt_lsp.syntax.elements.Place) -----------
 
-    def children_of(self, local: int) -> Sequence[int]:
-        c = self._cols
-        n = c.child_n[local]
-        if not n:
-            return NO_CHILDREN
-        at = c.child_at[local]
-        kids = c.flat[at : at + n]
-        shift = self.base - 1
-        return array("i", map(shift.__add__, kids)) if shift else kids
+def keeps(length: int, elements: int) -> bool:
+    """Whether the elements of a text of ``length`` code points are kept once made: when
+    they stand for 40 code points or more each (a kept element costs about 230 bytes;
+    rows of tiny elements are read again instead)."""
+    return length >= _KEPT_LENGTH * elements
 
-    def content_of(self, local: int) -> str | None:
-        return self._cols.contents.get(local)
+
+_KEPT_LENGTH = 40
 
 
 class Prefixed(Sequence[Element]):
