@@ -63,6 +63,33 @@ def test_every_diagnostic_range_slices_its_token() -> None:
     assert {"Main Tree", "s&#7;", "Open.Door", "door.id"} <= spans
 
 
+_KIND_PIECES = st.sampled_from(
+    ["<root", " ", ">", "/", "x", "<ro", "ot ", "\n", "<Behavior", "Tree>", "<TreeNodesModel"]
+)
+_KIND_TEXT = st.lists(_KIND_PIECES, max_size=8).map("".join)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    _KIND_TEXT,
+    st.booleans(),
+    st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1), _KIND_TEXT), max_size=6),
+)
+def test_the_kind_after_edits_is_that_of_the_text(
+    text: str, scanned: bool, edits: list[tuple[float, float, str]]
+) -> None:
+    """An edit finds whether the text is still BT XML around itself (a marker before it
+    stays, one may appear only around it): always what a search of the whole text says."""
+    doc = Document(text, scanned=scanned)
+    assert doc.is_bt == looks_like_bt(text)
+    for a, b, new in edits:
+        start = int(a * len(text))
+        end = start + int(b * (len(text) - start))
+        doc.edit(start, end, new)
+        text = text[:start] + new + text[end:]
+        assert doc.is_bt == looks_like_bt(text), text
+
+
 def test_looks_like_bt() -> None:
     assert looks_like_bt("<root>")
     assert looks_like_bt("<?xml?><root BTCPP_format='4'/>")

@@ -9,14 +9,19 @@ from __future__ import annotations
 
 import queue
 from collections.abc import Callable, Iterator
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
 
 import pytest
 
 from bt_lsp.rules import facts
-from bt_lsp.server.background import _prepare
+from bt_lsp.server.background import CPP_WORKER_CHARS, WORKER_CHARS, Background, _prepare
+from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from tests.server.test_framing import TIMEOUT, RawServer, frame, msg
+
+if TYPE_CHECKING:
+    from bt_lsp.server.app import BtServer
 
 SMALL_URI = "untitled:small.xml"
 BIG_URI = "untitled:big.xml"
@@ -243,6 +248,77 @@ def test_a_close_right_after_the_open_waits_its_turn(session: Session) -> None:
     assert not [m for m in s.log if published(BIG_URI, code="unknown-node")(m)]
     s.raw.write(frame(msg("textDocument/didOpen", open_params(BIG_URI, big, version=3))))
     s.until(published(BIG_URI, 3, "unknown-node"))
+
+
+def test_a_held_request_that_is_cancelled_is_answered_at_once(session: Session) -> None:
+    """A request on a document still being prepared that the client cancels gets
+    RequestCancelled before the document is ready (before its first publication), the
+    other held requests their answers after it, in their order."""
+    s = session
+    big = big_document("Frobnicate")
+    cancel = frame(msg("$/cancelRequest", {"id": 15}))
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+        + hover(BIG_URI, 14, line=3)
+        + symbols(BIG_URI, 15)
+        + hover(BIG_URI, 16, line=3)
+        + cancel
+        + frame(msg("$/cancelRequest", {"id": 999}))  # nothing of that id: ignored
+        + hover(SMALL_URI, 17)
+    )
+    cancelled = s.until(answer(15))
+    assert s.log[cancelled]["error"]["code"] == -32800
+    assert cancelled < s.until(published(BIG_URI))
+    assert cancelled < s.until(answer(14)) < s.until(answer(16))
+    assert "result" in s.log[s.until(answer(14))] and "result" in s.log[s.until(answer(16))]
+    assert [m for m in s.log if answer(15)(m)] == [s.log[cancelled]]  # one answer only
+    s.until(published(BIG_URI, 1, "unknown-node"))
+    s.raw.write(hover(SMALL_URI, 18))
+    s.until(answer(18))
+    assert [m for m in s.log if answer(15)(m)] == [s.log[cancelled]]
+
+
+def test_a_large_document_that_is_not_bt_is_told_apart_on_the_worker(session: Session) -> None:
+    """Whether a large text is BT XML (a search of all of it when it is not) is found
+    while it is prepared: a launch file gets no diagnostics, and an edit that makes it
+    BT XML (found around the edit, not by another search) gets them."""
+    s = session
+    uri = "untitled:launch.xml"
+    body = "".join(f'  <node pkg="p{i}" exec="e" name="n{i}"/>\n' for i in range(8_000))
+    text = "<launch>\n" + body + "</launch>\n"
+    assert len(text) > 256 * 1024
+    s.raw.write(
+        frame(msg("textDocument/didOpen", open_params(uri, text)))
+        + hover(uri, 19, line=1, character=5)
+        + hover(SMALL_URI, 20)
+    )
+    assert s.log[s.until(answer(19))].get("result") is None  # not BT: nothing to say
+    s.until(answer(20))
+    assert all(m["params"]["diagnostics"] == [] for m in s.log if published(uri)(m))
+    end = {"line": 1, "character": 0}
+    change = {
+        "textDocument": {"uri": uri, "version": 2},
+        "contentChanges": [{"range": {"start": end, "end": end}, "text": "<root>\n"}],
+    }
+    s.raw.write(frame(msg("textDocument/didChange", change)))
+    assert s.log[s.until(published(uri, 2))]["params"]["diagnostics"] != []
+
+
+def test_what_is_analysed_on_the_worker() -> None:
+    """Large BT documents, and C++ documents from 32 KiB (tree-sitter's parse)."""
+    background = Background(cast("BtServer", None))
+
+    def od(text: str, language: str, path: str | None = None) -> OpenDocument:
+        found = OpenDocument("file:///x", Document(text), 1, language, Path(path) if path else None)
+        found.refresh_kind()
+        return found
+
+    cpp = "// x\n" * (CPP_WORKER_CHARS // 5 + 1)
+    assert background.wants(od(cpp, "cpp")) and background.wants(od(cpp, "plaintext", "/a.hpp"))
+    assert not background.wants(od(cpp[: CPP_WORKER_CHARS - 10], "cpp"))
+    assert not background.wants(od(cpp, "plaintext"))  # neither BT nor C++
+    bt = "<root>" + " " * WORKER_CHARS + "</root>"
+    assert background.wants(od(bt, "xml")) and not background.wants(od(bt[:-2000], "xml"))
 
 
 def test_the_worker_prepares_what_the_first_requests_read() -> None:

@@ -18,8 +18,10 @@ from pathlib import Path
 import pytest
 import pytest_lsp
 from lsprotocol import types
+from pygls.uris import from_fs_path
 from pytest_lsp import ClientServerConfig
 
+from bt_lsp.server.background import CPP_WORKER_CHARS
 from tests.server.conftest import SERVER_COMMAND, TIMEOUT, BtClient, make_client
 
 _TMP = Path(tempfile.mkdtemp(prefix="bt-lsp-cpp-"))
@@ -201,3 +203,28 @@ async def test_a_bad_id_registered_in_cpp_is_renamed_there_first(cpp_client: BtC
     await cpp_client.diagnostics_until(
         main, lambda ds: any(d.code == "invalid-port-value" for d in ds)
     )
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_large_cpp_document_is_read_on_the_worker(cpp_client: BtClient) -> None:
+    """A C++ document of more than 32 KiB gets its name diagnostics from the worker
+    thread, for its latest text, like a small one."""
+    filler = "".join(f"// padding line {i}\n" for i in range(3_000))
+    text = REGISTER.read_text().replace('("BatteryOk")', '("Big Battery")') + filler
+    assert len(text) > CPP_WORKER_CHARS
+    uri = from_fs_path(str(WS / "scratch" / "big_register.cpp")) or ""
+    cpp_client.text_document_did_open(
+        types.DidOpenTextDocumentParams(
+            text_document=types.TextDocumentItem(uri=uri, language_id="cpp", version=1, text=text)
+        )
+    )
+    try:
+        (d,) = await cpp_client.diagnostics_until(
+            uri, lambda ds: any(d.code == "cpp-model-name" for d in ds)
+        )
+        line = text.splitlines()[d.range.start.line]
+        assert line[d.range.start.character : d.range.end.character] == '"Big Battery"'
+        cpp_client.replace(uri, 2, text.replace('("Big Battery")', '("BigBattery")'))
+        await cpp_client.diagnostics_until(uri, lambda ds: not ds)
+    finally:
+        cpp_client.close(uri)

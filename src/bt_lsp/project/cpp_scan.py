@@ -17,6 +17,7 @@ import json
 import os
 import re
 import tempfile
+import threading
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -89,6 +90,7 @@ class Scanner:
     # sees the same files and keeps what it can).
     memo: LinkMemo = field(default_factory=LinkMemo, repr=False)
     _lazy: set[str] = field(default_factory=set, repr=False)
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def facts(self, path: str, data: bytes) -> FileFacts:
         """The facts of ``data`` (the text of ``path``), from memory, the cache or a parse.
@@ -96,6 +98,10 @@ class Scanner:
         The same bytes object as last time (a caller that keeps what it read) is not even
         hashed again.
         """
+        with self._lock:  # the catalogs' thread and the analysis worker share the parser
+            return self._facts_of(path, data)
+
+    def _facts_of(self, path: str, data: bytes) -> FileFacts:
         kept = self._facts.get(path)
         if kept is not None and kept[0] is data:
             return kept[2]

@@ -43,7 +43,7 @@ from bt_lsp.server.project import (
 from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.text import Encoding, normalize_encoding, positions_of
+from bt_lsp.syntax.text import Encoding, normalize_encoding
 
 log = logging.getLogger(__name__)
 
@@ -148,7 +148,7 @@ class BtServer(LanguageServer):
         """The diagnostics of ``doc`` (``od``'s document or a snapshot of it) after
         severity settings.  Sends nothing, so the worker thread may call it."""
         if not od.is_bt:
-            return self.cpp.diagnostics(od)
+            return self.cpp.diagnostics(od, doc)
         with doc.history.lock:  # the caches it shares with the open document's snapshots
             if doc.utf8_size > self.settings.max_document_bytes:
                 result = size_limited(doc, self.settings.max_document_bytes)
@@ -201,13 +201,14 @@ class BtServer(LanguageServer):
         pushed first, found without its full analysis (:mod:`bt_lsp.rules.early_names`)."""
         return not self.pull_diagnostics and len(od.doc.text) >= EARLY_NAMES_CHARS
 
-    def publish_early_names(self, od: OpenDocument, found: list[Diagnostic]) -> None:
+    def publish_early_names(
+        self, od: OpenDocument, found: list[Diagnostic], at: dict[int, tuple[int, int]]
+    ) -> None:
         """Publish ``found``, the early name diagnostics of ``od`` (found on the worker
-        thread while it is prepared), ahead of the complete set."""
+        thread while it is prepared, with the positions ``at`` of their offsets), ahead
+        of the complete set."""
         settings = self.settings if od.path is None else self.project.settings_for(od.path)
         found = with_severities(found, settings.severity)
-        text = od.doc.text
-        at = positions_of(text, [o for d in found for o in (d.start, d.end)], self.encoding)
         self.text_document_publish_diagnostics(
             types.PublishDiagnosticsParams(
                 uri=od.uri,

@@ -36,8 +36,10 @@ from typing import TYPE_CHECKING, Any
 from bt_lsp.rules.context import facts_of
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.early_names import early_name_diagnostics
+from bt_lsp.server.cpp import is_cpp
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.text import Encoding, positions_of
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -46,7 +48,12 @@ if TYPE_CHECKING:
 # a megabyte takes a few hundred milliseconds to analyse the first time.
 WORKER_CHARS = 256 * 1024
 
+# A C++ document's diagnostics (tree-sitter's parse, then its string literals) take
+# about 0.6 ms per KiB: from this size they are found on the worker thread too.
+CPP_WORKER_CHARS = 32 * 1024
+
 Key = tuple[int | None, int, int]
+_Early = tuple[list[Diagnostic], dict[int, tuple[int, int]]]  # diagnostics, positions
 
 
 def _prepare(doc: Document, is_bt: bool, waiting: Sequence[object] = ()) -> None:
@@ -123,12 +130,38 @@ class Background:
         loop = asyncio.get_running_loop()
         self._held[od.uri] = held = _Held(od)
         pool = self._worker()
-        if od.is_bt and self._server.wants_early_names(od):
-            early = loop.run_in_executor(pool, early_name_diagnostics, od.doc.text)
-            early.add_done_callback(lambda f: self._early(held, f))
-        work = loop.run_in_executor(pool, _prepare, od.doc, od.is_bt, held.messages)
+        early = loop.run_in_executor(pool, self._kind_and_early_names, od)
+        early.add_done_callback(lambda f: self._early(held, f))
+        work = loop.run_in_executor(pool, lambda: _prepare(od.doc, od.is_bt, held.messages))
         work.add_done_callback(lambda f: self._prepared(held, f, ready))
         return True
+
+    def _kind_and_early_names(self, od: OpenDocument) -> _Early | None:
+        """On the worker thread: whether ``od`` is BT XML (a search of its whole text when
+        it is not) and, for clients that are pushed diagnostics, its early name
+        diagnostics with their positions (a line index of the text when it has CR)."""
+        od.refresh_kind()
+        if not od.is_bt or not self._server.wants_early_names(od):
+            return None
+        text = od.doc.text
+        found = early_name_diagnostics(text)
+        if found is None:
+            return None
+        at = positions_of(text, [o for d in found for o in (d.start, d.end)], self._encoding())
+        return found, at
+
+    def _encoding(self) -> Encoding:
+        return self._server.encoding
+
+    def cancel_held(self, msg_id: object) -> bool:
+        """Whether a request with ``msg_id`` was held for a document being prepared (it
+        is dropped: the caller answers it RequestCancelled at once)."""
+        for held in self._held.values():
+            for k, message in enumerate(held.messages):
+                if getattr(message, "id", None) == msg_id and hasattr(message, "method"):
+                    del held.messages[k]
+                    return True
+        return False
 
     def holds(self, message: Any) -> bool:
         """Hold ``message`` if it is about a document being prepared (handled, in order,
@@ -145,7 +178,7 @@ class Background:
     def preparing(self, uri: str) -> bool:
         return uri in self._held
 
-    def _early(self, held: _Held, work: asyncio.Future[list[Diagnostic] | None]) -> None:
+    def _early(self, held: _Held, work: asyncio.Future[_Early | None]) -> None:
         """On the loop: publish the early names while the document is still being
         prepared (nothing newer about it is known until then)."""
         if work.cancelled() or self._held.get(held.od.uri) is not held:
@@ -158,7 +191,7 @@ class Background:
             return
         found = work.result()
         if found is not None:
-            self._server.publish_early_names(held.od, found)
+            self._server.publish_early_names(held.od, *found)
 
     def _prepared(self, held: _Held, work: asyncio.Future[None], ready: Callable[[], None]) -> None:
         """On the loop: the document is ready; then the messages held for it."""
@@ -184,8 +217,11 @@ class Background:
     # -- analysing ---------------------------------------------------------------------------
 
     def wants(self, od: OpenDocument) -> bool:
-        """Whether ``od`` is analysed on the worker thread."""
-        return od.is_bt and len(od.doc.text) >= WORKER_CHARS
+        """Whether ``od`` is analysed on the worker thread: a large BT document, or a C++
+        document of :data:`CPP_WORKER_CHARS` (its tree-sitter parse and literals)."""
+        if od.is_bt:
+            return len(od.doc.text) >= WORKER_CHARS
+        return len(od.doc.text) >= CPP_WORKER_CHARS and is_cpp(od)
 
     def busy(self, od: OpenDocument) -> bool:
         """Whether an analysis of ``od``'s current state is under way (or ``od`` is being
@@ -234,7 +270,8 @@ class Background:
             result = work.result()
         current = server.docs.get(od.uri) is od and server.diagnostics_key(od) == job.key
         if result is not None and current:
-            od.doc.adopt(job.snapshot)
+            if od.is_bt:  # (a C++ document has no model to hand on)
+                od.doc.adopt(job.snapshot)
             server.diagnostics_computed(od, job.key, result)
         else:
             result = None

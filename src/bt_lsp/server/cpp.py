@@ -30,6 +30,7 @@ from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.server.state import OpenDocument
+from bt_lsp.syntax.document import Document
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -172,11 +173,12 @@ class CppService:
         self._rescan = None
         self.ls.refresh_all()  # each document's context asks for its (now stale) catalog
 
-    def diagnostics(self, od: OpenDocument) -> list[Diagnostic]:
-        """The name-rule diagnostics of an open C++ document's string literals."""
+    def diagnostics(self, od: OpenDocument, doc: Document | None = None) -> list[Diagnostic]:
+        """The name-rule diagnostics of an open C++ document's string literals (of
+        ``doc``, a snapshot of it: a large one is read on the worker thread)."""
         if not is_cpp(od) or self.models is None:
             return []
-        text = od.doc.text
+        text = (doc or od.doc).text
         facts = self.models.scanner.facts(
             str(od.path or od.uri), text.encode("utf-8", "surrogatepass")
         )

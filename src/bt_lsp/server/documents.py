@@ -53,8 +53,8 @@ def register(server: BtServer) -> None:
             item.language_id,
             Path(path) if path else None,
         )
-        od.refresh_kind()
-        if not ls.background.prepare(od, lambda: _opened(ls, od)):
+        if not ls.background.prepare(od, lambda: _opened(ls, od)):  # which finds its kind
+            od.refresh_kind()
             _opened(ls, od)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
@@ -73,9 +73,9 @@ def register(server: BtServer) -> None:
             else:  # a large new text is scanned on the worker thread, not here
                 od.doc.replace_all(change.text, scanned=len(change.text) < WORKER_CHARS)
         od.version = params.text_document.version
-        od.refresh_kind()
         if not od.doc.scanned and ls.background.prepare(od, lambda: _changed(ls, od, was_bt)):
-            return
+            return  # (its kind found there too)
+        od.refresh_kind()
         _changed(ls, od, was_bt)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)

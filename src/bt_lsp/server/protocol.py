@@ -31,6 +31,8 @@ from bt_lsp.server import jsonrpc
 from bt_lsp.server.convert import RawJson
 from bt_lsp.server.framing import Body
 
+REQUEST_CANCELLED = types.LSPErrorCodes.RequestCancelled.value
+
 
 class BtProtocol(LanguageServerProtocol):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
@@ -224,6 +226,13 @@ class BtProtocol(LanguageServerProtocol):
         background = getattr(self._server, "background", None)
         if background is not None and background.holds(message):
             return  # about a large document being prepared: handled once it is ready
+        if (
+            method == types.CANCEL_REQUEST
+            and background is not None
+            and background.cancel_held(getattr(message.params, "id", None))
+        ):  # a request held for such a document: answered at once, not once it is ready
+            self._send_error(message.params.id, REQUEST_CANCELLED, "the request was cancelled")
+            return
         super().handle_message(message)
 
     def _forward(self, method: str, params: Any) -> Generator[Any, Any, None]:

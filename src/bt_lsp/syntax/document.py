@@ -55,6 +55,7 @@ class Document:
         self._base: Model | None = None
         self._change: Rescan | None = None
         self._is_bt: bool | None = None
+        self._bt_end = -1  # where the first BT marker ends (with _is_bt True)
         self._utf8_size: int | None = None
         # Guards the state read to build a model against an edit on another thread (held
         # only to read or write attributes, never while building).
@@ -130,7 +131,8 @@ class Document:
         if self._scan is None:  # never scanned (a text that is not BT): scanned when used
             self.text = new_full
             self._model = self._base = self._change = self.own_diagnostics = None
-            self._is_bt = self._utf8_size = None
+            self._utf8_size = None
+            self._kind_after(start, len(new_text))
             return
         self._scan, change = rescan(self._scan, new_full, start, end, len(new_text))
         self.text = new_full
@@ -140,8 +142,23 @@ class Document:
             self._change = self._change.then(change)
         self._model = None
         self.own_diagnostics = None
-        self._is_bt = None
+        self._kind_after(start, len(new_text))
         self._utf8_size = None
+
+    def _kind_after(self, start: int, inserted: int) -> None:
+        """:attr:`is_bt` after an edit at ``start`` that wrote ``inserted`` characters,
+        without searching the whole text (a document that is not BT XML would be, at
+        every keystroke): a marker before the edit stays the first; a text without one
+        gains one only around the edit."""
+        if self._is_bt and self._bt_end <= start:
+            return
+        if self._is_bt is False:
+            lo = max(0, start - _MARKER_REACH)
+            m = _BT_MARKERS.search(self.text, lo, start + inserted + _MARKER_REACH)
+            if m is not None:
+                self._is_bt, self._bt_end = True, m.end()
+            return
+        self._is_bt = None
 
     def replace_all(self, text: str, *, scanned: bool = True) -> None:
         fresh = Document(text, self.path, scanned=scanned)
@@ -178,7 +195,8 @@ class Document:
     def is_bt(self) -> bool:
         """Whether the text :func:`looks_like_bt` (remembered until the next edit)."""
         if self._is_bt is None:
-            self._is_bt = looks_like_bt(self.text)
+            m = _BT_MARKERS.search(self.text)
+            self._is_bt, self._bt_end = m is not None, m.end() if m is not None else -1
         return self._is_bt
 
     @property
@@ -193,6 +211,7 @@ class Document:
 
 
 _BT_MARKERS = re.compile(r"<(?:BehaviorTree|TreeNodesModel)[\s/>]|<root[\s/>]")
+_MARKER_REACH = len("<TreeNodesModel>")  # the longest match
 
 
 def looks_like_bt(text: str) -> bool:
