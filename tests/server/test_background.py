@@ -10,12 +10,19 @@ from __future__ import annotations
 import queue
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, cast
 
 import pytest
 
 from bt_lsp.rules import facts
-from bt_lsp.server.background import CPP_WORKER_CHARS, WORKER_CHARS, Background, _prepare
+from bt_lsp.server.background import (
+    CPP_WORKER_CHARS,
+    WORKER_CHARS,
+    Background,
+    _Held,
+    _prepare,
+)
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from tests.server.test_framing import TIMEOUT, RawServer, frame, msg
@@ -336,6 +343,28 @@ def test_the_worker_prepares_what_the_first_requests_read() -> None:
     other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
     _prepare(other, False)  # not BT: the line index only
     assert not other.scanned and facts._CACHE.get(other.history) is None
+
+
+def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:
+    """With a documentSymbol request held for it, the worker makes the outline once the
+    model is ready (its sections keep their JSON, which the request reads on the loop,
+    not sharing the interpreter with the analysis); without, it makes none."""
+    server = cast("BtServer", SimpleNamespace(encoding="utf-16"))
+    background = Background(server)
+    for waiting, made in (
+        ([SimpleNamespace(method="textDocument/documentSymbol", id=1)], True),
+        ([SimpleNamespace(method="textDocument/hover", id=2)], False),
+    ):
+        doc = Document(big_document("Frobnicate"), BIG_URI, scanned=False)
+        od = OpenDocument(BIG_URI, doc, 1, "xml")
+        od.refresh_kind()
+        background._prepare_for(_Held(od, list(waiting)))
+        sections = doc.model.sections
+        assert len(sections) == 1
+        assert ("outline-json" in sections[0].cache) is made
+        if made:
+            text = sections[0].cache["outline-json"].text
+            assert text.startswith('{"name": "Main", "detail": "BehaviorTree"')
 
 
 def test_a_snapshot_continues_the_caches_of_its_document(monkeypatch: pytest.MonkeyPatch) -> None:

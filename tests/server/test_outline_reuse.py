@@ -137,19 +137,27 @@ def test_a_changed_model_category_rebuilds_the_sections_that_show_it() -> None:
     assert '"detail": "Condition Check"' not in again and '"detail": "Action Check"' in again
 
 
-def test_a_kept_outline_shares_its_repeated_json_pieces() -> None:
-    """A section's outline JSON is kept as pieces between its numbers; the pieces that
-    repeat (most of them) are one object each, not a copy per symbol."""
+def test_a_kept_outline_is_its_json_text_only() -> None:
+    """What a section keeps of its outline is the JSON it was written as (no symbols, no
+    pieces): an edit that moves it (new lines before it, or new text before it on its
+    first line) moves the numbers in that text, and the outline is the fresh one."""
     text = (
         '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
         + ("<AlwaysSuccess/>\n" * 200)
-        + "</Sequence></BehaviorTree></root>\n"
+        + '</Sequence></BehaviorTree><BehaviorTree ID="U"><Sequence name="line"/>'
+        + "</BehaviorTree></root>\n"
     )
-    doc = Document(text)
-    outline_json(doc, Context.from_document(doc), "utf-16")
-    templates = [
-        kept[2] for s in doc.model.sections if (kept := s.cache.get("outline-json")) is not None
-    ]
-    pieces = [p for t in templates for p in t.texts]
-    assert len(pieces) > 800
-    assert len({id(p) for p in pieces}) < len(pieces) // 50
+    for enc in ENCODINGS:
+        doc = Document(text)
+        first = outline_json(doc, Context.from_document(doc), enc)
+        secs = doc.model.sections
+        assert all("outline" not in s.cache for s in secs)
+        kept = [s.cache["outline-json"] for s in secs]
+        slots = ("categories", "column", "enc", "line", "text")
+        assert all(type(k).__slots__ == slots for k in kept)
+        assert first == "[" + ", ".join(k.text for k in kept) + "]"
+        for new in ("x😋 ", "\r\n", "\n"):  # in the first tree, on the second's first line
+            at = doc.text.index("</Sequence></BehaviorTree><BehaviorTree")
+            doc.edit(at, at, new)
+            assert outline_json(doc, Context.from_document(doc), enc) == fresh(doc, enc)
+            assert doc.model.sections[1].cache["outline-json"] is kept[1]  # moved, kept

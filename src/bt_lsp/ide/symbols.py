@@ -201,14 +201,24 @@ class OutlinePart:
     outline: SectionOutline
 
 
-def section_outline(doc: Document, k: int, ctx: Context) -> SectionOutline:
+def categories_hold(categories: dict[str, str], ctx: Context) -> bool:
+    """Whether the custom node types' categories an outline showed are still ``ctx``'s."""
+    return all(_category(n, ctx) == c for n, c in categories.items())
+
+
+# The outline of a section its caller keeps in another form (see :func:`outline_parts`).
+KEPT = SectionOutline([], {})
+
+
+def section_outline(doc: Document, k: int, ctx: Context, *, keep: bool = True) -> SectionOutline:
     """The outline of section ``k`` of ``doc``'s model, kept on the section (which later
     versions share while it is unchanged) for as long as the categories it shows are the
-    context's: an outline after an edit costs the sections the edit changed."""
+    context's: an outline after an edit costs the sections the edit changed.  With
+    ``keep`` false it is made without keeping it (a caller that keeps its JSON only)."""
     model = doc.model
     sec = model.sections[k]
     found: SectionOutline | None = sec.cache.get("outline")
-    if found is not None and all(_category(n, ctx) == c for n, c in found.categories.items()):
+    if found is not None and categories_hold(found.categories, ctx):
         return found
     tokens = doc.scan.tokens
     tok_origin = model.firsts[k]
@@ -221,14 +231,19 @@ def section_outline(doc: Document, k: int, ctx: Context) -> SectionOutline:
     used: dict[str, str] = {}
     # Local element j + 1 is sec.elements[j]; local 0 (the root) is never a symbol.
     symbols = _outline(enumerate(sec.elements, 1), ctx, end_of, used)
-    found = sec.cache["outline"] = SectionOutline(symbols, used)
+    found = SectionOutline(symbols, used)
+    if keep:
+        sec.cache["outline"] = found
     return found
 
 
-def outline_parts(doc: Document, ctx: Context | None = None) -> list[OutlinePart]:
+def outline_parts(
+    doc: Document, ctx: Context | None = None, kept: Callable[[Section], bool] | None = None
+) -> list[OutlinePart]:
     """:func:`document_symbols` in pieces: the head's symbols, each section's (kept
     between versions, see :func:`section_outline`) and the tail's.  A model that is not
-    made of sections is one piece."""
+    made of sections is one piece.  With ``kept``, a section it says the caller keeps
+    in its own form gets :data:`KEPT`, and the others' outlines are not kept."""
     if ctx is None:
         ctx = Context.from_document(doc)
     model = doc.model
@@ -248,7 +263,12 @@ def outline_parts(doc: Document, ctx: Context | None = None) -> list[OutlinePart
     if head is not None:
         out.append(head)
     for k, (sec, origin) in enumerate(zip(model.sections, model.origins, strict=True)):
-        out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx)))
+        if kept is None:
+            out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx)))
+        elif kept(sec):
+            out.append(OutlinePart(origin, sec, KEPT))
+        else:
+            out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx, keep=False)))
     if model.tail is not None:
         tail = loose(model.tail_base, model.tail_base + len(model.tail.elements))
         if tail is not None:

@@ -7,12 +7,12 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import tempfile
 from bisect import bisect_right
 from collections.abc import Callable, Sequence
 from itertools import repeat
 from pathlib import Path
-from sys import intern
 from typing import TYPE_CHECKING
 
 from lsprotocol import types
@@ -29,7 +29,14 @@ from bt_lsp.ide.references import references as find_references
 from bt_lsp.ide.rename import RenameRefused
 from bt_lsp.ide.rename import prepare_rename as rename_target
 from bt_lsp.ide.rename import rename as plan_rename
-from bt_lsp.ide.symbols import DocSymbol, SymbolKind, outline_parts, workspace_symbols
+from bt_lsp.ide.symbols import (
+    KEPT,
+    DocSymbol,
+    SymbolKind,
+    categories_hold,
+    outline_parts,
+    workspace_symbols,
+)
 from bt_lsp.project.index import links
 from bt_lsp.rules.context import Context
 from bt_lsp.server.convert import RawJson, to_range, to_text_edit, workspace_edit
@@ -45,6 +52,7 @@ from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.gcpause import with_gc_paused
+from bt_lsp.syntax.sections import Section
 from bt_lsp.syntax.text import Encoding, LineIndex
 
 if TYPE_CHECKING:
@@ -240,42 +248,59 @@ def document_symbols_json(lines: LineIndex, top: Sequence[DocSymbol], enc: Encod
     return RawJson(f"[{_symbols_text(lines, top, enc)}]")
 
 
-# Marks a number of a template in its JSON text (``json.dumps`` never writes a raw NUL).
-_MARK = "\x00"
+class _Rendered:
+    """A section's outline as the JSON text it was last written as, with the position
+    (``line``, ``column``) its section started at then, the encoding, and the custom
+    node types' categories it shows: only the text is kept, neither the symbols nor
+    pieces to fill in (they took a large outline's server to 32 times its document).
+    Where the section moved, its numbers are moved in the text (:meth:`at`)."""
 
+    __slots__ = ("categories", "column", "enc", "line", "text")
 
-class _Template:
-    """A section's symbols as JSON text with its line numbers (and the columns on its
-    first line) left open: ``texts`` are the pieces between the numbers, each number
-    relative to the section's first line (``2k``) or to its first column (``2k + 1``).
-    Rendered for where the section is; the last rendering is kept, so that a section an
-    edit did not move costs nothing."""
+    def __init__(
+        self, text: str, line: int, column: int, enc: Encoding, categories: dict[str, str]
+    ) -> None:
+        self.text, self.line, self.column = text, line, column
+        self.enc, self.categories = enc, categories
 
-    __slots__ = ("at", "numbers", "text", "texts")
+    def at(self, line: int, column: int) -> str:
+        """The text for a section that now starts at (``line``, ``column``)."""
+        dl, dc = line - self.line, column - self.column
+        if dl or dc:
+            if dc:  # the columns on the section's first line move too
+                first = str(self.line)
 
-    def __init__(self, marked: str) -> None:
-        pieces = marked.split(_MARK)
-        # Most pieces are the same few (`, "character": `): shared, they cost a pointer
-        # each, where a copy of each took most of a large outline's memory.
-        self.texts = list(map(intern, pieces[0::2]))
-        self.numbers = list(map(int, pieces[1::2]))
-        self.at: tuple[int, int] | None = None
-        self.text = ""
+                def move(m: re.Match[str]) -> str:
+                    row, col = m[1], int(m[2])
+                    return _POSITION % (int(row) + dl, col + dc if row == first else col)
 
-    def render(self, line: int, column: int) -> str:
-        if self.at != (line, column):
-            base = (line, column)
-            texts = self.texts
-            out = [texts[0]]
-            for k, n in enumerate(self.numbers, 1):
-                out.append(str((n >> 1) + base[n & 1]))
-                out.append(texts[k])
-            self.text = "".join(out)
-            self.at = base
+                self.text = _POSITIONS.sub(move, self.text)
+            else:
+                moved: dict[str, str] = {}  # a line's positions are written alike
+
+                def move_line(m: re.Match[str]) -> str:
+                    row = m[1]
+                    found = moved.get(row)
+                    if found is None:
+                        found = moved[row] = _LINE % (int(row) + dl)
+                    return found
+
+                self.text = _LINES.sub(move_line, self.text)
+            self.line, self.column = line, column
         return self.text
 
 
-def _template(lines: LineIndex, origin: int, top: Sequence[DocSymbol], enc: Encoding) -> _Template:
+_POSITIONS = re.compile(r'"line": (\d+), "character": (\d+)')
+_POSITION = '"line": %d, "character": %d'
+_LINES = re.compile(r'"line": (\d+)')
+_LINE = '"line": %d'
+
+
+def _section_text(
+    lines: LineIndex, origin: int, top: Sequence[DocSymbol], enc: Encoding, line0: int
+) -> str:
+    """The JSON of a section's symbols (offsets from ``origin``, which is on line
+    ``line0``) in document coordinates."""
     order = _pre_order(top)
     pos: Callable[[int], str]
     if lines.plain_columns(enc):
@@ -284,65 +309,63 @@ def _template(lines: LineIndex, origin: int, top: Sequence[DocSymbol], enc: Enco
         reach = max(max(s.end, s.sel_end) for s, _ in order) if order else 0
         _, starts = lines.starts_between(origin, origin + reach)
         local = [start - origin for start in starts]  # local[0] <= 0: the first line's
+        col0 = -local[0] if local else 0
 
         def pos(offset: int) -> str:
             k = bisect_right(local, offset) - 1
-            if k <= 0:  # on the first line: the column counts from the section's
-                return f'{{"line": {_MARK}0{_MARK}, "character": {_MARK}{offset << 1 | 1}{_MARK}}}'
-            return f'{{"line": {_MARK}{k << 1}{_MARK}, "character": {offset - local[k]}}}'
+            if k <= 0:  # on the first line
+                return f'{{"line": {line0}, "character": {col0 + offset}}}'
+            return f'{{"line": {line0 + k}, "character": {offset - local[k]}}}'
 
     else:
         at = lines.positions(
-            [origin + o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)]
-            + [origin],
+            [origin + o for s, _ in order for o in (s.start, s.end, s.sel_start, s.sel_end)],
             enc,
         )
-        line0, col0 = at[origin]
-        marked: dict[int, str] = {}  # each position's JSON, its numbers marked
-        for o, (line, col) in at.items():
-            if line == line0:
-                marked[o - origin] = (
-                    f'{{"line": {_MARK}0{_MARK}, '
-                    f'"character": {_MARK}{(col - col0) << 1 | 1}{_MARK}}}'
-                )
-            else:
-                marked[o - origin] = (
-                    f'{{"line": {_MARK}{(line - line0) << 1}{_MARK}, "character": {col}}}'
-                )
-        pos = marked.__getitem__
+
+        def pos(offset: int) -> str:
+            line, col = at[origin + offset]
+            return f'{{"line": {line}, "character": {col}}}'
+
     out: list[str] = []
 
     def rng(start: int, end: int) -> str:
         return f'{{"start": {pos(start)}, "end": {pos(end)}}}'
 
     _write(order, out, rng)
-    return _Template("".join(out))
+    return "".join(out)
 
 
 @with_gc_paused  # a large outline makes hundreds of thousands of objects at once
 def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
     """:func:`document_symbols_json` of the document's outline, made of its sections'
-    pieces: a section's JSON is kept on it (with its outline, see
-    :func:`bt_lsp.ide.symbols.section_outline`) and only re-rendered where it moved to a
-    new line or first column, so that the outline after an edit costs what the edit
-    changed."""
+    pieces: a section's JSON is kept on it (with the categories it shows, see
+    :func:`bt_lsp.ide.symbols.section_outline`) and only its numbers moved where it
+    moved, so that the outline after an edit costs what the edit changed."""
     lines = doc.lines
+
+    def kept(sec: Section) -> bool:
+        found: _Rendered | None = sec.cache.get("outline-json")
+        return found is not None and found.enc == enc and categories_hold(found.categories, ctx)
+
     texts: list[str] = []
-    parts = outline_parts(doc, ctx)
+    parts = outline_parts(doc, ctx, kept)
     origins = lines.positions([p.origin for p in parts if p.section is not None], enc)
     for part in parts:
         sec = part.section
-        if not part.outline.symbols:
-            continue
         if sec is None:
-            texts.append(_symbols_text(lines, part.outline.symbols, enc))
+            if part.outline.symbols:
+                texts.append(_symbols_text(lines, part.outline.symbols, enc))
             continue
-        kept = sec.cache.get("outline-json")
-        if kept is None or kept[0] is not part.outline or kept[1] != enc:
-            kept = (part.outline, enc, _template(lines, part.origin, part.outline.symbols, enc))
-            sec.cache["outline-json"] = kept
-        template: _Template = kept[2]
-        texts.append(template.render(*origins[part.origin]))
+        line, column = origins[part.origin]
+        if part.outline is KEPT:
+            text = sec.cache["outline-json"].at(line, column)
+        else:
+            symbols = part.outline.symbols
+            text = _section_text(lines, part.origin, symbols, enc, line) if symbols else ""
+            sec.cache["outline-json"] = _Rendered(text, line, column, enc, part.outline.categories)
+        if text:
+            texts.append(text)
     return RawJson("[" + ", ".join(texts) + "]")
 
 
