@@ -201,28 +201,28 @@ class BtServer(LanguageServer):
         pushed first, found without its full analysis (:mod:`bt_lsp.rules.early_names`)."""
         return not self.pull_diagnostics and len(od.doc.text) >= EARLY_NAMES_CHARS
 
-    def publish_early_names(
+    def early_names_json(
         self, od: OpenDocument, found: list[Diagnostic], at: dict[int, tuple[int, int]]
-    ) -> None:
-        """Publish ``found``, the early name diagnostics of ``od`` (found on the worker
-        thread while it is prepared, with the positions ``at`` of their offsets), ahead
-        of the complete set."""
+    ) -> str:
+        """The params of the publication of ``found``, the early name diagnostics of
+        ``od`` (with the positions ``at`` of their offsets), as JSON text: written on the
+        worker thread while ``od`` is prepared, published by the loop ahead of the
+        complete set."""
         settings = self.settings if od.path is None else self.project.settings_for(od.path)
         found = with_severities(found, settings.severity)
-        self.text_document_publish_diagnostics(
-            types.PublishDiagnosticsParams(
-                uri=od.uri,
-                diagnostics=[
-                    diagnostic_at(
-                        types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
-                        d,
-                        self.code_descriptions,
-                    )
-                    for d in found
-                ],
-                version=od.version,
-            )
+        params = types.PublishDiagnosticsParams(
+            uri=od.uri,
+            diagnostics=[
+                diagnostic_at(
+                    types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
+                    d,
+                    self.code_descriptions,
+                )
+                for d in found
+            ],
+            version=od.version,
         )
+        return json.dumps(self.protocol._converter.unstructure(params))
 
     def schedule(self, uri: str) -> None:
         """Diagnostics are due for ``uri``: push them after the debounce delay (clients

@@ -28,6 +28,7 @@ once.
 from __future__ import annotations
 
 import asyncio
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -41,7 +42,7 @@ from bt_lsp.server.lookup import context_of
 from bt_lsp.server.navigation import outline_json
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.text import Encoding, positions_of
+from bt_lsp.syntax.text import positions_of
 
 if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
@@ -55,7 +56,8 @@ WORKER_CHARS = 256 * 1024
 CPP_WORKER_CHARS = 32 * 1024
 
 Key = tuple[int | None, int, int]
-_Early = tuple[list[Diagnostic], dict[int, tuple[int, int]]]  # diagnostics, positions
+PUBLISH_DIAGNOSTICS = "textDocument/publishDiagnostics"
+_EARLY_WAIT = 1.0  # seconds the worker waits at most for the loop to publish the names
 
 
 def _prepare(doc: Document, is_bt: bool, waiting: Sequence[object] = ()) -> None:
@@ -136,8 +138,8 @@ class Background:
         loop = asyncio.get_running_loop()
         self._held[od.uri] = held = _Held(od)
         pool = self._worker()
-        early = loop.run_in_executor(pool, self._kind_and_early_names, od)
-        early.add_done_callback(lambda f: self._early(held, f))
+        early = loop.run_in_executor(pool, self._kind_and_early_names, held, loop)
+        early.add_done_callback(lambda f: self._early_failed(held, f))
         work = loop.run_in_executor(pool, self._prepare_for, held)
         work.add_done_callback(lambda f: self._prepared(held, f, ready))
         return True
@@ -153,22 +155,27 @@ class Background:
             server = self._server
             outline_json(od.doc, context_of(server, od), server.encoding)
 
-    def _kind_and_early_names(self, od: OpenDocument) -> _Early | None:
-        """On the worker thread: whether ``od`` is BT XML (a search of its whole text when
-        it is not) and, for clients that are pushed diagnostics, its early name
-        diagnostics with their positions (a line index of the text when it has CR)."""
+    def _kind_and_early_names(self, held: _Held, loop: asyncio.AbstractEventLoop) -> None:
+        """On the worker thread: whether the document is BT XML (a search of its whole
+        text when it is not) and, for clients that are pushed diagnostics, its early name
+        diagnostics, their positions (a line index of the text when it has CR) and the
+        JSON of their publication, which the loop then only writes.  The worker waits
+        for it (a moment) before it goes on: the loop does not share the interpreter
+        with the scan meanwhile, and the first diagnostics come that much sooner."""
+        od = held.od
         od.refresh_kind()
-        if not od.is_bt or not self._server.wants_early_names(od):
-            return None
+        server = self._server
+        if not od.is_bt or not server.wants_early_names(od):
+            return
         text = od.doc.text
         found = early_name_diagnostics(text)
         if found is None:
-            return None
-        at = positions_of(text, [o for d in found for o in (d.start, d.end)], self._encoding())
-        return found, at
-
-    def _encoding(self) -> Encoding:
-        return self._server.encoding
+            return
+        at = positions_of(text, [o for d in found for o in (d.start, d.end)], server.encoding)
+        params = server.early_names_json(od, found, at)
+        written = threading.Event()
+        loop.call_soon_threadsafe(self._early, held, params, written)
+        written.wait(_EARLY_WAIT)
 
     def cancel_held(self, msg_id: object) -> bool:
         """Whether a request with ``msg_id`` was held for a document being prepared (it
@@ -195,20 +202,23 @@ class Background:
     def preparing(self, uri: str) -> bool:
         return uri in self._held
 
-    def _early(self, held: _Held, work: asyncio.Future[_Early | None]) -> None:
+    def _early(self, held: _Held, params: str, written: threading.Event) -> None:
         """On the loop: publish the early names while the document is still being
         prepared (nothing newer about it is known until then)."""
-        if work.cancelled() or self._held.get(held.od.uri) is not held:
+        try:
+            if self._held.get(held.od.uri) is held:
+                self._server.bt_protocol.notify_json(PUBLISH_DIAGNOSTICS, params)
+        finally:
+            written.set()
+
+    def _early_failed(self, held: _Held, work: asyncio.Future[None]) -> None:
+        if work.cancelled():
             return
         exc = work.exception()
         if exc is not None:  # the complete set follows anyway
             self._server.log_message(
                 f"bt-lsp: error finding the early name diagnostics of {held.od.uri}: {exc!r}"
             )
-            return
-        found = work.result()
-        if found is not None:
-            self._server.publish_early_names(held.od, *found)
 
     def _prepared(self, held: _Held, work: asyncio.Future[None], ready: Callable[[], None]) -> None:
         """On the loop: the document is ready; then the messages held for it."""
