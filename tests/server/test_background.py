@@ -351,9 +351,12 @@ def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:
     not sharing the interpreter with the analysis); without, it makes none."""
     server = cast("BtServer", SimpleNamespace(encoding="utf-16"))
     background = Background(server)
-    for waiting, made in (
-        ([SimpleNamespace(method="textDocument/documentSymbol", id=1)], True),
-        ([SimpleNamespace(method="textDocument/hover", id=2)], False),
+    outline = SimpleNamespace(method="textDocument/documentSymbol", id=1)
+    hover_ = SimpleNamespace(method="textDocument/hover", id=2)
+    for waiting, made, index in (
+        ([outline, hover_], True, True),
+        ([outline], True, False),  # the name index is left for later
+        ([hover_], False, True),
     ):
         doc = Document(big_document("Frobnicate"), BIG_URI, scanned=False)
         od = OpenDocument(BIG_URI, doc, 1, "xml")
@@ -362,6 +365,7 @@ def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:
         sections = doc.model.sections
         assert len(sections) == 1
         assert ("outline-json" in sections[0].cache) is made
+        assert (doc.model._by_symbol is not None) is index  # for the hover
         if made:
             text = sections[0].cache["outline-json"].text
             assert text.startswith('{"name": "Main", "detail": "BehaviorTree"')

@@ -150,10 +150,14 @@ class Background:
         loop while the analysis ran on the worker, the two shared the interpreter and the
         outline of 8 MB took 6 s to come."""
         od = held.od
-        _prepare(od.doc, od.is_bt, held.messages)
-        if od.is_bt and any(_is_outline(m) for m in list(held.messages)):
-            server = self._server
-            outline_json(od.doc, context_of(server, od), server.encoding)
+        if not (od.is_bt and any(map(_is_outline, list(held.messages)))):
+            _prepare(od.doc, od.is_bt, held.messages)
+            return
+        _prepare(od.doc, od.is_bt)  # the name index after the outline, if another waits
+        server = self._server
+        outline_json(od.doc, context_of(server, od), server.encoding)
+        if not all(map(_is_outline, list(held.messages))):
+            _ = od.doc.model.by_symbol
 
     def _kind_and_early_names(self, held: _Held, loop: asyncio.AbstractEventLoop) -> None:
         """On the worker thread: whether the document is BT XML (a search of its whole
