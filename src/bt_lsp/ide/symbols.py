@@ -3,7 +3,7 @@ entries and ports, the includes) and the workspace symbol search."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
 from operator import attrgetter
@@ -240,6 +240,13 @@ def section_outline(doc: Document, k: int, ctx: Context, *, keep: bool = True) -
 def outline_parts(
     doc: Document, ctx: Context | None = None, kept: Callable[[Section], bool] | None = None
 ) -> list[OutlinePart]:
+    """:func:`iter_outline_parts` as a list."""
+    return list(iter_outline_parts(doc, ctx, kept))
+
+
+def iter_outline_parts(
+    doc: Document, ctx: Context | None = None, kept: Callable[[Section], bool] | None = None
+) -> Iterator[OutlinePart]:
     """:func:`document_symbols` in pieces: the head's symbols, each section's (kept
     between versions, see :func:`section_outline`) and the tail's.  A model that is not
     made of sections is one piece.  With ``kept``, a section it says the caller keeps
@@ -248,7 +255,8 @@ def outline_parts(
         ctx = Context.from_document(doc)
     model = doc.model
     if model.head is None:
-        return [OutlinePart(0, None, SectionOutline(document_symbols(doc, ctx), {}))]
+        yield OutlinePart(0, None, SectionOutline(document_symbols(doc, ctx), {}))
+        return
     els = model.elements
 
     def end_of(el: Element) -> int:
@@ -258,22 +266,20 @@ def outline_parts(
         found = _outline(((i, els[i]) for i in range(first, stop)), ctx, end_of)
         return OutlinePart(0, None, SectionOutline(found, {})) if found else None
 
-    out: list[OutlinePart] = []
     head = loose(1, 1 + len(model.head.elements))
     if head is not None:
-        out.append(head)
+        yield head
     for k, (sec, origin) in enumerate(zip(model.sections, model.origins, strict=True)):
         if kept is None:
-            out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx)))
+            yield OutlinePart(origin, sec, section_outline(doc, k, ctx))
         elif kept(sec):
-            out.append(OutlinePart(origin, sec, KEPT))
+            yield OutlinePart(origin, sec, KEPT)
         else:
-            out.append(OutlinePart(origin, sec, section_outline(doc, k, ctx, keep=False)))
+            yield OutlinePart(origin, sec, section_outline(doc, k, ctx, keep=False))
     if model.tail is not None:
         tail = loose(model.tail_base, model.tail_base + len(model.tail.elements))
         if tail is not None:
-            out.append(tail)
-    return out
+            yield tail
 
 
 @dataclass(frozen=True, slots=True)

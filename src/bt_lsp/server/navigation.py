@@ -34,7 +34,7 @@ from bt_lsp.ide.symbols import (
     DocSymbol,
     SymbolKind,
     categories_hold,
-    outline_parts,
+    iter_outline_parts,
     workspace_symbols,
 )
 from bt_lsp.project.index import links
@@ -349,13 +349,14 @@ def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
         return found is not None and found.enc == enc and categories_hold(found.categories, ctx)
 
     texts: list[str] = []
-    parts = outline_parts(doc, ctx, kept)
-    origins = lines.positions([p.origin for p in parts if p.section is not None], enc)
-    for part in parts:
+    model = doc.model
+    # Section by section: only one section's symbols at a time, not all of them.
+    origins = lines.positions(model.origins if model.head is not None else (), enc)
+    for part in iter_outline_parts(doc, ctx, kept):
         sec = part.section
         if sec is None:
             if part.outline.symbols:
-                texts.append(_symbols_text(lines, part.outline.symbols, enc))
+                texts.extend((_symbols_text(lines, part.outline.symbols, enc), ", "))
             continue
         line, column = origins[part.origin]
         if part.outline is KEPT:
@@ -365,8 +366,11 @@ def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
             text = _section_text(lines, part.origin, symbols, enc, line) if symbols else ""
             sec.cache["outline-json"] = _Rendered(text, line, column, enc, part.outline.categories)
         if text:
-            texts.append(text)
-    return RawJson("[" + ", ".join(texts) + "]")
+            texts.extend((text, ", "))
+    if not texts:
+        return RawJson("[]")
+    texts[0], texts[-1] = "[" + texts[0], "]"  # one join, no copy of it
+    return RawJson("".join(texts))
 
 
 # --- features -----------------------------------------------------------------------------

@@ -79,15 +79,17 @@ class BtProtocol(LanguageServerProtocol):
         try:
             result = getattr(data, "result", None)
             if isinstance(result, RawJson) and getattr(data, "error", None) is None:
-                body = f'{{"jsonrpc": "2.0", "id": {json.dumps(data.id)}, "result": {result}}}'
+                # In pieces: an outline of 8 MB is 26 MB of JSON, not copied into a body.
+                head = f'{{"jsonrpc": "2.0", "id": {json.dumps(data.id)}, "result": '
+                parts = [head, result, "}"]
             else:
-                body = json.dumps(data, default=self._serialize_message)
+                parts = [json.dumps(data, default=self._serialize_message)]
         except Exception as exc:
             msg_id = getattr(data, "id", None) if not isinstance(data, dict) else data.get("id")
             is_response = hasattr(data, "result") or hasattr(data, "error")
             self.log(f"bt-lsp: internal error serialising a message: {exc!r}")
             if is_response and jsonrpc.valid_id(msg_id):
-                body = json.dumps(
+                error = json.dumps(
                     {
                         "jsonrpc": "2.0",
                         "id": msg_id,
@@ -97,9 +99,10 @@ class BtProtocol(LanguageServerProtocol):
                         },
                     }
                 )
+                parts = [error]
             else:
                 return
-        self._write(body)
+        self._write_parts(parts)
 
     def notify_json(self, method: str, params: str) -> None:
         """A notification whose params are already JSON text."""
@@ -107,21 +110,35 @@ class BtProtocol(LanguageServerProtocol):
             self._write(f'{{"jsonrpc": "2.0", "method": {json.dumps(method)}, "params": {params}}}')
 
     def _write(self, body: str) -> None:
-        data = body.encode(self.CHARSET)
+        self._write_parts([body])
+
+    def _write_parts(self, parts: list[str]) -> None:
+        """Write one message whose body is ``parts`` joined: with headers (stdio, TCP)
+        each part is written as it is encoded, so a large body is never copied into
+        one; a websocket gets one frame."""
+        data = [part.encode(self.CHARSET) for part in parts]
         header = (
-            f"Content-Length: {len(data)}\r\n"
+            f"Content-Length: {sum(map(len, data))}\r\n"
             f"Content-Type: {self.CONTENT_TYPE}; charset={self.CHARSET}\r\n\r\n"
         ).encode("ascii")
         assert self.writer is not None
         try:
-            res = self.writer.write(header + data if self._include_headers else data)
-            if inspect.isawaitable(res):
-                self._writes.add(task := asyncio.ensure_future(res))
-                task.add_done_callback(self._writes.discard)
+            if not self._include_headers:
+                self._wrote(self.writer.write(b"".join(data)))
+                return
+            self._wrote(self.writer.write(header + data[0] if len(data) == 1 else header))
+            if len(data) > 1:
+                for chunk in data:
+                    self._wrote(self.writer.write(chunk))
         except BrokenPipeError:
             raise
         except Exception as error:
             self._server._report_server_error(error, JsonRpcInternalError)
+
+    def _wrote(self, res: Any) -> None:
+        if inspect.isawaitable(res):
+            self._writes.add(task := asyncio.ensure_future(res))
+            task.add_done_callback(self._writes.discard)
 
     def _send_error(self, msg_id: Any, code: int, message: str) -> None:
         """An error response; ``id: null`` is written out (the converter drops None)."""
