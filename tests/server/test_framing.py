@@ -275,3 +275,45 @@ def test_before_initialize() -> None:
         s.still_serving(5)
     finally:
         s.close()
+
+
+def test_a_large_body_is_read_in_one_exact_read() -> None:
+    """A body larger than a chunk is asked of the input in one read of what is missing
+    (one hop to the reading thread, not one per pipe-full); the input ending early
+    ends the stream, as chunked reads do."""
+    import asyncio
+
+    from bt_lsp.server.framing import CHUNK, Framer, Stream
+
+    body = json.dumps({"jsonrpc": "2.0", "method": "x", "params": {"t": "a" * (4 * CHUNK)}})
+    data = f"Content-Length: {len(body)}\r\n\r\n{body}".encode()
+
+    def run(data: bytes) -> tuple[object, list[tuple[str, int]]]:
+        calls: list[tuple[str, int]] = []
+        pos = 0
+
+        async def read(n: int) -> bytes:
+            nonlocal pos
+            chunk = data[pos : pos + min(n, 1000)]
+            pos += len(chunk)
+            calls.append(("read", len(chunk)))
+            return chunk
+
+        async def read_exact(n: int) -> bytes:
+            nonlocal pos
+            chunk = data[pos : pos + n]
+            pos += len(chunk)
+            calls.append(("exact", len(chunk)))
+            return chunk
+
+        async def main() -> object:
+            found = await Framer(Stream(read, read_exact), lambda _: None).next()
+            return None if found is None else found.value
+
+        return asyncio.run(main()), calls
+
+    value, calls = run(data)
+    assert value == json.loads(body)
+    assert [c for c in calls if c[0] == "exact"] == [("exact", len(data) - 1000)]
+    value, calls = run(data[:-10])  # cut short: no message
+    assert value is None

@@ -93,12 +93,13 @@ class _Reader:
                 return True
             good_models.add(tag)
         # The model keeps a tag's first MAX_ATTRS attributes (the rest are only counted).
-        keys = attrib.keys() if len(attrib) <= MAX_ATTRS else islice(attrib, MAX_ATTRS)
-        new_keys = set(keys) - good_keys
-        if new_keys:
-            if not all_valid_port_uses(new_keys):
-                return True
-            good_keys |= new_keys
+        if not good_keys.issuperset(attrib):  # (most tags: known attributes, no new set)
+            keys = attrib.keys() if len(attrib) <= MAX_ATTRS else islice(attrib, MAX_ATTRS)
+            new_keys = set(keys) - good_keys
+            if new_keys:
+                if not all_valid_port_uses(new_keys):
+                    return True
+                good_keys |= new_keys
         value = attrib.get("ID")
         if value is not None and value not in good_models:
             if violations(value, _MODEL, Role.NODE_ID):

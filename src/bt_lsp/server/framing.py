@@ -36,8 +36,15 @@ def shown(data: bytes) -> str:
 class Stream:
     """A byte stream read in chunks, with lines, exact reads, a pushback and resync."""
 
-    def __init__(self, read: Callable[[int], Awaitable[bytes]]) -> None:
+    def __init__(
+        self,
+        read: Callable[[int], Awaitable[bytes]],
+        read_exact: Callable[[int], Awaitable[bytes]] | None = None,
+    ) -> None:
         self._read = read
+        # Reads that many bytes unless the input ends first: a large body in one call,
+        # not a chunk of the pipe's size per call (each a hop to a reading thread).
+        self._read_exact = read_exact
         self._buf = bytearray()
         self.eof = False
 
@@ -85,6 +92,12 @@ class Stream:
 
     async def exactly(self, n: int) -> bytes | None:
         """``n`` bytes, or ``None`` if the input ends first."""
+        missing = n - len(self._buf)
+        if missing > CHUNK and self._read_exact is not None and not self.eof:
+            chunk = await self._read_exact(missing)
+            self._buf += chunk
+            if len(chunk) < missing:
+                self.eof = True
         while len(self._buf) < n:
             if not await self._fill():
                 return None

@@ -26,10 +26,13 @@ log = logging.getLogger(__name__)
 
 
 async def read_loop(
-    server: BtServer, read: Callable[[int], Awaitable[bytes]], stop: threading.Event
+    server: BtServer,
+    read: Callable[[int], Awaitable[bytes]],
+    stop: threading.Event,
+    read_exact: Callable[[int], Awaitable[bytes]] | None = None,
 ) -> None:
     protocol = server.bt_protocol
-    framer = Framer(Stream(read), protocol.log)
+    framer = Framer(Stream(read, read_exact), protocol.log)
     while not stop.is_set():
         body = await framer.next()
         if body is None:
@@ -46,8 +49,12 @@ def start_io(server: BtServer, stdin: BinaryIO | None, stdout: BinaryIO | None) 
         loop = asyncio.get_running_loop()
         return await loop.run_in_executor(server.thread_pool, source.read1, n)
 
+    async def read_exact(n: int) -> bytes:  # (a message body: n bytes are due)
+        loop = asyncio.get_running_loop()
+        return await loop.run_in_executor(server.thread_pool, source.read, n)
+
     try:
-        asyncio.run(read_loop(server, read, stop))
+        asyncio.run(read_loop(server, read, stop, read_exact))
     except BrokenPipeError:
         log.error("the connection to the client is lost")
     except (KeyboardInterrupt, SystemExit):
