@@ -6,6 +6,7 @@ combines them (:mod:`bt_lsp.rules.context`); here alone so that neither imports 
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -134,6 +135,6 @@ class FactsLayout:
 
     sections: Sequence[Section]
     origins: Sequence[int]
-    trees_at: list[int]
-    models_at: list[int]
-    subtree_models_at: list[int]
+    trees_at: array[int]  # machine integers: a document may have twenty thousand trees
+    models_at: array[int]
+    subtree_models_at: array[int]

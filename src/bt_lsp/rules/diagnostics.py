@@ -8,10 +8,12 @@ from __future__ import annotations
 import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
+from itertools import compress, count
 from typing import TYPE_CHECKING, Final
 
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
+from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.syntax.elements import NameRef, Role
 from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
@@ -92,6 +94,11 @@ class Capped(list[Diagnostic]):
         self.more = more
 
 
+#: What a source without findings keeps: one object for them all (most sections of a large
+#: document have none).  Results of :func:`capped` are read, never changed.
+NO_DIAGNOSTICS: Final = Capped()
+
+
 def more_of(diags: Iterable[Diagnostic]) -> int:
     """How many diagnostics were found beyond those of ``diags`` (see :class:`Capped`)."""
     return diags.more if isinstance(diags, Capped) else 0
@@ -100,6 +107,8 @@ def more_of(diags: Iterable[Diagnostic]) -> int:
 def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTICS) -> Capped:
     """``diags`` sorted by position (stable), the first ``maximum`` kept; ``more``: how
     many were already left out before."""
+    if not diags and not more:
+        return NO_DIAGNOSTICS
     diags.sort(key=sort_key)
     if len(diags) > maximum:
         more += len(diags) - maximum
@@ -179,7 +188,7 @@ def sort_key(d: Diagnostic) -> tuple[int, int, str]:
 
 # For each document, the sections of its last model and those of them with diagnostics.
 _SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
-    History, tuple[set[Section], set[Section]]
+    History, tuple[list[Section], set[Section]]
 ] = weakref.WeakKeyDictionary()
 
 
@@ -210,15 +219,14 @@ def compute(doc: Document) -> Capped:
         out = list(head)
         more = head.more
         sections = model.sections
-        now = set(sections)
-        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc.history, (set(), set()))
-        with_diagnostics = with_diagnostics & now
-        with_diagnostics.update(sec for sec in now - seen if _own(sec))
-        _SECTIONS_WITH_DIAGNOSTICS[doc.history] = (now, with_diagnostics)
+        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc.history, ([], set()))
+        p, q = common_ends(seen, sections)
+        with_diagnostics = with_diagnostics.difference(seen[p : len(seen) - q])
+        with_diagnostics.update(sec for sec in sections[p : len(sections) - q] if _own(sec))
+        _SECTIONS_WITH_DIAGNOSTICS[doc.history] = (sections, with_diagnostics)
         if with_diagnostics:
             origins = model.origins
-            index = dict(zip(sections, range(len(sections)), strict=True))
-            for k in sorted(index[sec] for sec in with_diagnostics):
+            for k in compress(count(), map(with_diagnostics.__contains__, sections)):
                 o = origins[k]
                 own = _own(sections[k])
                 more += own.more

@@ -7,6 +7,7 @@ per section (kept on the section), so that an edit costs what its own sections d
 from __future__ import annotations
 
 import weakref
+from array import array
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
@@ -120,11 +121,11 @@ class _Cut:
     def splice(
         self,
         old: tuple[D, ...],
-        old_at: list[int],
+        old_at: array[int],
         new: tuple[D, ...],
-        new_at: list[int],
+        new_at: array[int],
         move: _Mover,
-    ) -> tuple[tuple[D, ...], list[int]]:
+    ) -> tuple[tuple[D, ...], array[int]]:
         """One kind of declaration: the old ones of the sections kept, the new ones of the
         sections in between, and where each section's begin."""
         first, stop = self.first, self.stop
@@ -141,6 +142,15 @@ class _Cut:
         return decls, at
 
 
+def local_facts(section: Section) -> DocumentFacts | None:
+    """What ``section`` declares, in its coordinates, if it was extracted (``None`` if not)."""
+    local: DocumentFacts | TreeDecl | None = section.cache.get("facts")
+    if type(local) is TreeDecl:
+        return DocumentFacts(None, (local,), (), ())
+    assert local is None or isinstance(local, DocumentFacts)
+    return local
+
+
 def _extract_all(
     sections: Sequence[Section], origins: Sequence[int], root: Element | None, path: str | None
 ) -> DocumentFacts:
@@ -148,21 +158,23 @@ def _extract_all(
     trees: list[TreeDecl] = []
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
-    trees_at: list[int] = []
-    models_at: list[int] = []
-    subs_at: list[int] = []
+    trees_at, models_at, subs_at = array("q"), array("q"), array("q")
     for section, o in zip(sections, origins, strict=True):
         trees_at.append(len(trees))
         models_at.append(len(models))
         subs_at.append(len(subtree_models))
-        local: DocumentFacts | None = section.cache.get("facts")
+        local: DocumentFacts | TreeDecl | None = section.cache.get("facts")
         if local is None:
-            local = section.cache["facts"] = extract_facts(Model.of_section(section, root), None)
-        if not local.models and not local.subtree_models and len(local.trees) == 1:
-            t = local.trees[0]  # the usual section: one tree
+            local = extract_facts(Model.of_section(section, root), None)
+            if not local.models and not local.subtree_models and len(local.trees) == 1:
+                local = local.trees[0]  # the usual section, one tree: kept alone
+            section.cache["facts"] = local
+        if type(local) is TreeDecl:
+            t = local
             # Made without the named tuple's constructor, as every tree of a first analysis.
             trees.append(_new(TreeDecl, (t.id, path, t.start + o, t.end + o, t.calls, t[5])))
             continue
+        assert isinstance(local, DocumentFacts)
         if local.trees:
             trees.extend(_moved_trees(local.trees, o, path))
         if local.models:
@@ -293,7 +305,16 @@ class _OpenTree:
     def close(self, path: str | None) -> TreeDecl:
         s = self.start
         spans = tuple([(a - s, b - s) for a, b in self.spans])
-        return TreeDecl(self.id, path, s, self.end, tuple(self.calls), spans)
+        # Trees written alike call at the same offsets: one tuple for them all (bounded).
+        shared = _SPANS.get(spans)
+        if shared is None:
+            if len(_SPANS) >= 4096:
+                _SPANS.clear()
+            shared = _SPANS[spans] = spans
+        return TreeDecl(self.id, path, s, self.end, tuple(self.calls), shared)
+
+
+_SPANS: dict[tuple[tuple[int, int], ...], tuple[tuple[int, int], ...]] = {}
 
 
 @dataclass(slots=True)

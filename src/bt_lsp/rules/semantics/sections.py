@@ -22,10 +22,13 @@ from __future__ import annotations
 import dataclasses
 import weakref
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from typing import TYPE_CHECKING, Final, TypeVar
+from itertools import compress, count
+from typing import TYPE_CHECKING, Final, TypeVar, cast
 
-from bt_lsp.rules.context import Context, DocumentFacts, ModelDecl, TreeDecl
+from bt_lsp.rules.context import Context, ModelDecl, TreeDecl
 from bt_lsp.rules.diagnostics import Diagnostic, capped
+from bt_lsp.rules.facts import local_facts
+from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.rules.semantics.base import State
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.model import Model
@@ -38,79 +41,102 @@ if TYPE_CHECKING:
 __all__ = ["check_sections"]
 
 V = TypeVar("V")
-# A context lookup: (field, key); key None stands for the whole mapping (iterated).
-Dep = tuple[str, str | None]
 
+# The mappings of the context a run records its lookups in, by index.  A lookup is a
+# field's index and a key (``None`` stands for the whole mapping, iterated).
 _FIELDS: Final = ("models", "subtree_models", "trees", "workspace_trees")
 _KEY: Final = "semantics"
+# Per field, what was looked up (or what changed): keys.
+Keys = tuple[set[str | None], ...]
+# The signature of a lookup now: (field index, key) -> signature.
+Current = Callable[[int, "str | None"], object]
 
 
 class _Recording(Mapping[str, V]):
     """A mapping of the context that notes which keys a rule looked up."""
 
-    __slots__ = ("_deps", "_field", "_inner")
+    __slots__ = ("_inner", "_keys")
 
-    def __init__(self, inner: Mapping[str, V], field: str, deps: set[Dep]) -> None:
+    def __init__(self, inner: Mapping[str, V], keys: set[str | None]) -> None:
         self._inner = inner
-        self._field = field
-        self._deps = deps
+        self._keys = keys
 
     def __getitem__(self, key: str) -> V:
-        self._deps.add((self._field, key))
+        self._keys.add(key)
         return self._inner[key]
 
     def __contains__(self, key: object) -> bool:
         if isinstance(key, str):
-            self._deps.add((self._field, key))
+            self._keys.add(key)
         return key in self._inner
 
     def __iter__(self) -> Iterator[str]:
-        self._deps.add((self._field, None))
+        self._keys.add(None)
         return iter(self._inner)
 
     def __len__(self) -> int:
-        self._deps.add((self._field, None))
+        self._keys.add(None)
         return len(self._inner)
 
 
-def _content(value: ModelDecl | tuple[TreeDecl, ...]) -> object:
-    """A context entry without positions."""
+def _content(value: ModelDecl | tuple[TreeDecl, ...], own: str | None) -> object:
+    """A context entry without positions (a tree's ID is its key).  Made for every tree a
+    section calls, so the usual one, a single definition in the document ``own`` itself,
+    is its calls alone (a tuple of strings, never equal to the other forms, whose second
+    item is a tuple or whose first is)."""
     if isinstance(value, ModelDecl):
         return (value.id, value.category, value.ports, value.path)
-    return tuple((d.id, d.path, d.calls) for d in value)
+    if len(value) == 1:
+        d = value[0]
+        return d.calls if d.path == own else (d.path, d.calls)
+    return tuple([(d.path, d.calls) for d in value])
 
 
-def _signature(ctx: Context, dep: Dep) -> object:
-    field, key = dep
-    mapping: Mapping[str, ModelDecl | tuple[TreeDecl, ...]] = getattr(ctx, field)
+def _signature(
+    mapping: Mapping[str, ModelDecl | tuple[TreeDecl, ...]], key: str | None, own: str | None
+) -> object:
     if key is None:
-        return tuple((k, _content(v)) for k, v in mapping.items())
+        return tuple([(k, _content(v, own)) for k, v in mapping.items()])
     value = mapping.get(key)
-    return None if value is None else _content(value)
+    return None if value is None else _content(value, own)
 
 
-@dataclasses.dataclass(slots=True)
 class _Entry:
-    """The results of one section and what they depend on."""
+    """The results of one section and what they depend on: ``deps`` holds a flat
+    ``(field, key, signature)`` triple for each context entry looked up (one tuple: a
+    document may have twenty thousand sections)."""
 
-    settings: tuple[object, ...]
-    line: int | None  # the line the section starts on, when a message names a line
-    deps: dict[Dep, object]  # the signature of each context entry looked up
-    out: list[Diagnostic]  # the first MAX_DIAGNOSTICS by position
-    more: int = 0  # how many more were found
+    __slots__ = ("deps", "line", "more", "out", "settings")
+
+    def __init__(
+        self,
+        settings: tuple[object, ...],
+        line: int | None,  # the line the section starts on, when a message names a line
+        deps: tuple[object, ...],
+        out: list[Diagnostic],  # the first MAX_DIAGNOSTICS by position
+        more: int = 0,  # how many more were found
+    ) -> None:
+        self.settings = settings
+        self.line = line
+        self.deps = deps
+        self.out = out
+        self.more = more
 
 
 @dataclasses.dataclass(slots=True)
 class _History:
     """The last check of a document: the settings, the signature of every context entry
-    looked up by its sections (so that the next check compares each entry once), what
+    looked up by its sections and found (so that the next check compares each entry once;
+    most lookups find nothing, and a key absent from these counts as absent then), what
     the context was combined from besides the document itself, and its sections (all of
     them valid then), with those that have diagnostics and those that name lines."""
 
     settings: tuple[object, ...] = ()
-    sigs: dict[Dep, object] = dataclasses.field(default_factory=dict)
+    sigs: tuple[dict[str | None, object], ...] = dataclasses.field(
+        default_factory=lambda: tuple({} for _ in _FIELDS)
+    )
     sources: tuple[object, ...] = ()
-    valid: set[Section] | None = None
+    sections: list[Section] | None = None
     with_diagnostics: set[Section] = dataclasses.field(default_factory=set)
     lines: set[Section] = dataclasses.field(default_factory=set)
 
@@ -139,84 +165,84 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
         st.v3,
         root is not None and len(root.children) > 1,
     )
-    memo: dict[Dep, object] = {}
+    mappings: list[Mapping[str, ModelDecl | tuple[TreeDecl, ...]]] = [
+        getattr(ctx, f) for f in _FIELDS
+    ]
+    memo: tuple[dict[str | None, object], ...] = tuple({} for _ in _FIELDS)
 
-    def current(dep: Dep) -> object:
+    def current(field: int, key: str | None) -> object:
+        found = memo[field]
         try:
-            return memo[dep]
+            return found[key]
         except KeyError:
-            sig = memo[dep] = _signature(ctx, dep)
+            sig = found[key] = _signature(mappings[field], key, ctx.path)
             return sig
 
     hist = _HISTORY.get(st.doc.history)
     if hist is None:
         hist = _HISTORY[st.doc.history] = _History()
     sections, origins = model.sections, model.origins
-    now = set(sections)
-    same = hist.valid is not None and hist.settings == settings
-    # The context entries that changed since the last check: a section that was valid
-    # then is valid now unless it looked one of them up.
-    touched = _touched(hist.valid, now, hist.sources, ctx) if same else None
-    if touched is None:
-        changed = {d for d, sig in hist.sigs.items() if current(d) != sig}
-    else:
-        changed = set()
-        sigs = hist.sigs
-        candidates: list[Dep] = [(f, key) for key in touched for f in _FIELDS]
-        if touched:
-            candidates.extend((f, None) for f in _FIELDS)
-        for d in candidates:
-            if d in sigs and current(d) != sigs[d]:
-                changed.add(d)
+    n = len(sections)
+    old = hist.sections
+    same = old is not None and hist.settings == settings
+    # The sections both checks begin and end with; those between are new (``came``).
+    p, q = common_ends(old, sections) if old is not None else (0, 0)
+    went = old[p : len(old) - q] if old is not None else []
+    changed: Keys = tuple(set() for _ in _FIELDS)
+    if same:
+        # The context entries that changed since the last check: a section that was valid
+        # then is valid now unless it looked one of them up.
+        touched = _touched(went, sections[p : n - q], hist.sources, ctx)
+        if touched is None:
+            _all_changed(hist.sigs, mappings, current, changed)
+        elif touched:
+            for f, sigs in enumerate(hist.sigs):
+                for key in touched:
+                    if sigs.get(key) != current(f, key):
+                        changed[f].add(key)
+                if None in sigs and sigs[None] != current(f, None):
+                    changed[f].add(None)
     lines = st.doc.lines
-    index: dict[Section, int] | None = None
-    todo: list[Section] = []
+    todo: list[tuple[Section, int]] = []
 
     def keep(sec: Section, found: _Entry) -> None:
         """``sec``'s results are valid: file it under what the next check looks at."""
-        valid.add(sec)
         if found.out:
             with_diagnostics.add(sec)
         if found.line is not None:
             line_dependent.add(sec)
 
-    if same and not changed:
-        assert hist.valid is not None
-        valid = hist.valid & now
-        todo.extend(now - valid)
-        with_diagnostics = hist.with_diagnostics & valid
-        line_dependent = hist.lines & valid
+    if same and not any(changed):
+        todo.extend(zip(sections[p : n - q], origins[p : n - q], strict=True))
+        with_diagnostics = hist.with_diagnostics.difference(went)
+        line_dependent = hist.lines.difference(went)
         if line_dependent:
-            index = dict(zip(sections, range(len(sections)), strict=True))
+            index = dict(zip(sections, range(n), strict=True))
             for sec in list(line_dependent):
+                origin = origins[index[sec]]
                 entry: _Entry = sec.cache[_KEY]
-                if entry.line != lines.line_of(origins[index[sec]]):
-                    valid.discard(sec)
+                if entry.line != lines.line_of(origin):
                     with_diagnostics.discard(sec)
                     line_dependent.discard(sec)
-                    todo.append(sec)
+                    todo.append((sec, origin))
     else:
-        trusted = hist.valid if same and hist.valid is not None else set()
-        valid, with_diagnostics, line_dependent = set(), set(), set()
-        for sec, origin in zip(sections, origins, strict=True):
+        with_diagnostics, line_dependent = set(), set()
+        for k, (sec, origin) in enumerate(zip(sections, origins, strict=True)):
             found: _Entry | None = sec.cache.get(_KEY)
-            if found is not None and sec in trusted:
-                ok = (
-                    found.line is None or found.line == lines.line_of(origin)
-                ) and changed.isdisjoint(found.deps)
+            if found is not None and same and (k < p or k >= n - q):  # valid last time
+                ok = (found.line is None or found.line == lines.line_of(origin)) and _unaffected(
+                    found.deps, changed
+                )
             else:
                 ok = _still_valid(found, settings, lines, origin, current)
             if ok:
                 assert found is not None
                 keep(sec, found)
             else:
-                todo.append(sec)
+                todo.append((sec, origin))
     if todo:
-        if index is None:
-            index = dict(zip(sections, range(len(sections)), strict=True))
         recording = _RecordingContext(ctx)
-        for sec in todo:
-            origin = origins[index[sec]]
+        for sec, origin in todo:
             found = sec.cache.get(_KEY)
             if not _still_valid(found, settings, lines, origin, current):
                 found = _run(st, sec, origin, root, settings, check, current, lines, recording)
@@ -224,21 +250,45 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
             assert found is not None
             keep(sec, found)
     if with_diagnostics:
-        if index is None:
-            index = dict(zip(sections, range(len(sections)), strict=True))
         out = st.out
-        for sec in with_diagnostics:
-            origin = origins[index[sec]]
-            entry = sec.cache[_KEY]
+        for k in compress(count(), map(with_diagnostics.__contains__, sections)):
+            origin = origins[k]
+            entry = sections[k].cache[_KEY]
             st.more += entry.more
             out.extend(
                 Diagnostic(d.start + origin, d.end + origin, d.code, d.message, d.severity, d.data)
                 for d in entry.out
             )
     hist.settings = settings
-    hist.sigs.update(memo)
+    for sigs, now in zip(hist.sigs, memo, strict=True):
+        for looked, sig in now.items():
+            if sig is None:
+                sigs.pop(looked, None)
+            else:
+                sigs[looked] = sig
     hist.sources = ctx.sources
-    hist.valid, hist.with_diagnostics, hist.lines = valid, with_diagnostics, line_dependent
+    hist.sections, hist.with_diagnostics, hist.lines = sections, with_diagnostics, line_dependent
+
+
+def _all_changed(
+    sigs: tuple[dict[str | None, object], ...],
+    mappings: Sequence[Mapping[str, object]],
+    current: Current,
+    changed: Keys,
+) -> None:
+    """Add to ``changed`` every context entry that may differ from the last check: those
+    found then whose signature changed, and every key present now that was not then (it
+    may have been looked up and missed)."""
+    for f, (was, mapping) in enumerate(zip(sigs, mappings, strict=True)):
+        changed[f].update(key for key, sig in was.items() if current(f, key) != sig)
+        changed[f].update(key for key in mapping if key not in was)
+
+
+def _unaffected(deps: tuple[object, ...], changed: Keys) -> bool:
+    """Whether none of the lookups ``deps`` (flat triples) is among ``changed``."""
+    if not any(changed):
+        return True
+    return all(key not in changed[f] for f, key, _ in _triples(deps))
 
 
 def _still_valid(
@@ -246,27 +296,36 @@ def _still_valid(
     settings: tuple[object, ...],
     lines: LineIndex,
     origin: int,
-    current: Callable[[Dep], object],
+    current: Current,
 ) -> bool:
     """Whether remembered results hold, every context entry they read compared."""
-    return (
-        entry is not None
-        and entry.settings == settings
-        and (entry.line is None or entry.line == lines.line_of(origin))
-        and all(current(d) == sig for d, sig in entry.deps.items())
+    if (
+        entry is None
+        or entry.settings != settings
+        or (entry.line is not None and entry.line != lines.line_of(origin))
+    ):
+        return False
+    return all(current(f, key) == sig for f, key, sig in _triples(entry.deps))
+
+
+def _triples(deps: tuple[object, ...]) -> Iterator[tuple[int, str | None, object]]:
+    """The ``(field, key, signature)`` triples of a flat ``deps``."""
+    return cast(
+        "Iterator[tuple[int, str | None, object]]",
+        zip(deps[::3], deps[1::3], deps[2::3], strict=True),
     )
 
 
 def _touched(
-    before: set[Section] | None, now: set[Section], sources: tuple[object, ...], ctx: Context
+    went: Sequence[Section], came: Sequence[Section], sources: tuple[object, ...], ctx: Context
 ) -> set[str] | None:
     """The names declared by the sections that came or went since the last check, when
     nothing else can have changed the context (``None`` when something else may have)."""
-    if before is None or not ctx.sources or ctx.sources != sources:
+    if not ctx.sources or ctx.sources != sources:
         return None
     touched: set[str] = set()
-    for sec in now.symmetric_difference(before):
-        facts: DocumentFacts | None = sec.cache.get("facts")
+    for sec in (*went, *came):
+        facts = local_facts(sec)
         if facts is None:
             return None
         touched.update(t.id for t in facts.trees)
@@ -277,18 +336,19 @@ def _touched(
 
 class _RecordingContext:
     """The context as the runs over sections see it: the same, except that its mappings
-    note in ``deps`` what a run looks up (cleared before each run)."""
+    note in ``keys`` what a run looks up (cleared before each run)."""
 
-    __slots__ = ("ctx", "deps")
+    __slots__ = ("ctx", "keys")
 
     def __init__(self, ctx: Context) -> None:
-        self.deps: set[Dep] = set()
+        self.keys: Keys = tuple(set() for _ in _FIELDS)
+        models, subtree_models, trees, workspace_trees = self.keys
         self.ctx = dataclasses.replace(
             ctx,
-            models=_Recording(ctx.models, "models", self.deps),
-            subtree_models=_Recording(ctx.subtree_models, "subtree_models", self.deps),
-            trees=_Recording(ctx.trees, "trees", self.deps),
-            workspace_trees=_Recording(ctx.workspace_trees, "workspace_trees", self.deps),
+            models=_Recording(ctx.models, models),
+            subtree_models=_Recording(ctx.subtree_models, subtree_models),
+            trees=_Recording(ctx.trees, trees),
+            workspace_trees=_Recording(ctx.workspace_trees, workspace_trees),
         )
 
 
@@ -299,12 +359,12 @@ def _run(
     root: Element | None,
     settings: tuple[object, ...],
     check: Callable[[State, Sequence[Element]], None],
-    current: Callable[[Dep], object],
+    current: Current,
     lines: LineIndex,
     recording: _RecordingContext,
 ) -> _Entry:
-    deps = recording.deps
-    deps.clear()
+    for keys in recording.keys:
+        keys.clear()
     local = Model.of_section(sec, root)
     run = State(
         st.doc,
@@ -320,4 +380,8 @@ def _run(
     check(run, elements[1:])  # a view of the section's elements, not a copy
     line = lines.line_of(origin) if run.uses_lines else None
     out = capped(run.out, run.more)
-    return _Entry(settings, line, {d: current(d) for d in deps}, out, out.more)
+    deps: list[object] = []
+    for f, keys in enumerate(recording.keys):
+        for key in keys:
+            deps += (f, key, current(f, key))
+    return _Entry(settings, line, tuple(deps), out, out.more)
