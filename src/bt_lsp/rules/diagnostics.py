@@ -8,17 +8,19 @@ from __future__ import annotations
 import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from itertools import compress, count
+from itertools import chain, compress, count
 from typing import TYPE_CHECKING, Final
 
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.rules.section_diff import common_ends
-from bt_lsp.syntax.elements import NameRef, Role
+from bt_lsp.syntax.elements import Element, NameRef, Role, Symbol, Zone
 from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
+from bt_lsp.syntax.nametokens import name_refs
 from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
+from bt_lsp.syntax.tokens import Token
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document, History
@@ -199,9 +201,99 @@ def _own(section: Section) -> Capped:
     if out is None:
         found = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
         found.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
-        found.extend(ref_diagnostics(section.iter_refs()))
-        out = section.cache["diagnostics"] = capped(found)
+        more = _section_name_diagnostics(section, found)
+        out = section.cache["diagnostics"] = capped(found, more)
     return out
+
+
+# What the name rules find in one start tag where it sits: each finding's offsets from
+# the tag's start, code, message, severity and data; and the symbols its names denote.
+_TagNames = tuple[tuple[tuple[int, int, str, str, Severity, NameData], ...], tuple[Symbol, ...]]
+# By tag (a token shared by equal tags, kept here so that its id stays its own) and zone,
+# as ``id(tag) << 4 | zone``: a document of a hundred thousand ``<Frob/>`` checks one.
+# Bounded.
+_TAG_NAMES: dict[int, tuple[Token, _TagNames]] = {}
+# Zones in which no token is a name (see bt_lsp.syntax.nametokens).
+_NAMELESS: Final = frozenset({Zone.MODELS, Zone.INCLUDE, Zone.OTHER, Zone.OUTSIDE})
+
+
+def _tag_names(el: Element, parent: Element | None) -> _TagNames:
+    """What the name rules find in ``el``'s start tag (see :data:`_TagNames`)."""
+    refs: list[NameRef] = []
+    name_refs(el, 0, parent, refs)
+    ts = el.token_start
+    found: list[tuple[int, int, str, str, Severity, NameData]] = []
+    symbols: dict[Symbol, None] = {}
+    for start, end, text, kind, role, symbol, _element, _quote in refs:
+        if symbol is not None:
+            symbols[symbol] = None
+        if kind is None:
+            continue
+        vs = violations(text, kind, role)
+        if vs:
+            data = NameData(text, kind, role)
+            found.extend(
+                (start - ts, end - ts, v.code, v.message, defined(v.code).severity, data)
+                for v in vs
+            )
+    return tuple(found), tuple(symbols)
+
+
+def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
+    """Add the name-rule diagnostics of ``section`` to ``out`` and note the section's
+    symbols (:meth:`Section.symbols`) on the way.  Each distinct start tag is checked once
+    (equal tags are one token); once ``out`` holds twice :data:`MAX_DIAGNOSTICS`, only the
+    first by position are kept and later findings past them are counted, not made: the
+    count returned."""
+    seen: dict[int, _TagNames] = {}  # this section's tags (alive while it runs)
+    shared = _TAG_NAMES
+    symbols: dict[Symbol, None] = {}
+    more = 0
+    limit: tuple[int, int, str] | None = None
+    els = section.elements
+    root = section.root
+    nameless = _NAMELESS
+    port_decl = Zone.PORT_DECL
+    for el in chain((root,), els) if root is not None else els:
+        zone = el.zone
+        if zone in nameless:
+            continue
+        tag = el.tag
+        key = id(tag) << 4 | zone
+        found = seen.get(key)
+        if found is None:
+            if zone == port_decl:  # its symbols depend on the entry it is in: not kept
+                p = el.parent
+                found = _tag_names(el, els[p - 1] if p > 0 else None)
+            else:
+                hit = shared.get(key)
+                if hit is not None and hit[0] is tag:
+                    found = hit[1]
+                else:
+                    found = _tag_names(el, None)
+                    if len(shared) >= _MAX_CACHED:
+                        shared.clear()
+                    shared[key] = (tag, found)
+                seen[key] = found
+            for symbol in found[1]:
+                symbols[symbol] = None
+        if not found[0]:
+            continue
+        ts = el.token_start
+        for rs, re_, code, message, severity, data in found[0]:
+            start, end = ts + rs, ts + re_
+            if limit is not None and (start, end, code) >= limit:
+                more += 1  # past the first MAX_DIAGNOSTICS found: never kept
+                continue
+            out.append(Diagnostic(start, end, code, message, severity, data))
+            if len(out) >= 2 * MAX_DIAGNOSTICS:
+                out.sort(key=sort_key)  # stable: the first found first among equals
+                more += len(out) - MAX_DIAGNOSTICS
+                del out[MAX_DIAGNOSTICS:]
+                limit = sort_key(out[-1])
+    if "symbols" not in section.cache:  # what Section.symbols() would make from its names
+        section.cache["symbols"] = tuple(symbols)
+    return more
 
 
 def compute(doc: Document) -> Capped:

@@ -18,14 +18,16 @@ Each module's docstring lists its codes with their severity and range.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
+from bt_lsp.rules.codes import FixData, Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Capped, capped
 from bt_lsp.rules.semantics import document, models, nodes, ports, trees
 from bt_lsp.rules.semantics.base import State, TreeScope
 from bt_lsp.rules.semantics.sections import check_sections
 from bt_lsp.syntax.elements import Element, Zone
+from bt_lsp.syntax.tokens import Token
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
@@ -52,19 +54,61 @@ def check(doc: Document, ctx: Context) -> Capped:
 def check_elements(st: State, elements: Sequence[Element]) -> None:
     """The rules of single elements, in document order (``<BehaviorTree>`` elements start
     the scope of the nodes that follow).  They run section by section: see
-    :mod:`bt_lsp.rules.semantics.sections` for what they may read."""
+    :mod:`bt_lsp.rules.semantics.sections` for what they may read.
+
+    What the node checks find in a start tag is the same wherever it is written, unless
+    they read more than the tag and the number of children (a blackboard key's first use,
+    a script's text, a ``<SubTree>`` call, the children of a ``ReactiveSequence``): equal
+    tags are one token, so the findings of such a node are remembered by its token for
+    the run, and a document of a hundred thousand ``<Frob/>`` checks one."""
     scope = TreeScope(None)
+    tags: dict[int, tuple[Token, int, tuple[_Finding, ...] | Literal[False] | None]] = {}
     # Members bound once: reading one from its enum class is slow in Python 3.11.
     node, tree, entry, port_decl = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
+    add = st.add
     for el in elements:
         zone = el.zone
         if zone == node:
             document.check_depth(st, el, scope.depth_flagged)
-            res = nodes.check_node(st, el)
-            is_subtree = el.name == "SubTree" or (st.v3 and el.name == "SubTreePlus")
-            if is_subtree:
+            tag = el.tag
+            name = tag.name
+            if name == "SubTree" or (st.v3 and name == "SubTreePlus"):
+                res = nodes.check_node(st, el)
                 trees.check_call(st, el, scope)
-            ports.check_attributes(st, el, res, scope, is_subtree)
+                ports.check_attributes(st, el, res, scope, True)
+                continue
+            n = len(el.children)
+            hit = tags.get(id(tag))
+            if hit is None or hit[0] is not tag or hit[1] != n:
+                # Seen once: checked as it is (most tags of most documents are unique).
+                tags[id(tag)] = (tag, n, None)
+                res = nodes.check_node(st, el)
+                ports.check_attributes(st, el, res, scope, False)
+                continue
+            found = hit[2]
+            if found is not None:
+                if found is False:  # what it finds depends on more than its tag
+                    res = nodes.check_node(st, el)
+                    ports.check_attributes(st, el, res, scope, False)
+                    continue
+                ts = el.token_start
+                for s, e, code, message, severity, data in found:
+                    add(ts + s, ts + e, code, message, severity, data)
+                continue
+            # Seen twice: checked and remembered, if its findings are the tag's alone.
+            recorded: list[_Finding] = []
+            st.record, st.pure = recorded, True
+            res = nodes.check_node(st, el)
+            ports.check_attributes(st, el, res, scope, False)
+            st.record = None
+            ts = el.token_start
+            tags[id(tag)] = (
+                tag,
+                n,
+                tuple([(s - ts, e - ts, c, m, sev, d) for s, e, c, m, sev, d in recorded])
+                if st.pure
+                else False,
+            )
         elif zone == tree:
             scope = TreeScope(el)
             trees.begin_tree(st, el)
@@ -72,3 +116,7 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
             models.check_entry(st, el)
         elif zone == port_decl:
             models.check_port_decl(st, el)
+
+
+# What a rule gave State.add: start, end, code, message, severity, data.
+_Finding = tuple[int, int, str, str, Severity | None, FixData | None]

@@ -156,12 +156,19 @@ class State:
     # a hundred thousand times costs one finding (the run over one section records
     # what it read, so each run has its own).
     memo: dict[object, object] = field(default_factory=dict)
+    # While a node's checks run to be remembered for its start tag (see
+    # semantics.check_elements): what they add, as given to add, and whether they read
+    # only the tag and the number of children (``pure``; a rule that reads anything else
+    # clears it).
+    record: list[tuple[int, int, str, str, Severity | None, FixData | None]] | None = None
+    pure: bool = True
 
     def line_of(self, offset: int) -> int:
         """The 0-based document line of ``offset`` (in this run's coordinates).  Messages
         that name a line depend on where their section is: the section's results are kept
         only as long as it starts on the same line."""
         self.uses_lines = True
+        self.pure = False
         return self.doc.lines.line_of(self.origin + offset)
 
     def add(
@@ -173,6 +180,8 @@ class State:
         severity: Severity | None = None,
         data: FixData | None = None,
     ) -> None:
+        if self.record is not None:
+            self.record.append((start, end, code, message, severity, data))
         limit = self.limit
         if limit is not None and (start, end, code) >= limit:
             self.more += 1  # after the first MAX_DIAGNOSTICS found: never kept

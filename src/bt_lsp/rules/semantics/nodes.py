@@ -376,6 +376,7 @@ def _children(st: State, el: Element, res: Resolved) -> None:
 
 
 def _reactive(st: State, el: Element) -> None:
+    st.pure = False  # reads the children
     elements = st.model.elements
     asyncs = 0
     for ci in el.children:

@@ -424,6 +424,7 @@ def _blackboard_use(
     res: Resolved,
     scope: TreeScope,
 ) -> None:
+    st.pure = False  # the first use of a key in the tree counts
     canon = canonical_type(port.type)
     if canon is None:
         return

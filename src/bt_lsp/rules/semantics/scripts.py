@@ -50,6 +50,7 @@ def check(st: State, el: Element, a: Attr) -> None:
         stripped = code.rstrip(" \t\r\n")
         start, end = len(stripped) - 1, len(stripped)
     vs, ve = el.span_of_value(a)
+    st.pure = False  # reads the text (two spellings of one value may be one token)
     rs, re_ = raw_span(st.text[vs:ve], start, end)
     message = f"Script error in {a.name}: {err.message}"
     if legacy_ok:
