@@ -73,7 +73,9 @@ def test_a_lookup_that_missed_counts_when_another_document_declares_it() -> None
         f'<BehaviorTree ID="T{i}"><Sequence><Frob/><AlwaysSuccess/></Sequence></BehaviorTree>\n'
         for i in range(30)
     )
-    main = Document(f'<root BTCPP_format="4" main_tree_to_execute="T0">\n{trees}</root>\n', "/w/main.xml")
+    main = Document(
+        f'<root BTCPP_format="4" main_tree_to_execute="T0">\n{trees}</root>\n', "/w/main.xml"
+    )
     declared = '<root BTCPP_format="4"><TreeNodesModel><Action ID="Frob"/></TreeNodesModel></root>'
     models = Document(declared, "/w/models.xml")
     empty = Document('<root BTCPP_format="4"><TreeNodesModel/></root>', "/w/models.xml")
