@@ -89,6 +89,33 @@ def test_a_lookup_that_missed_counts_when_another_document_declares_it() -> None
     assert unknown(empty) == 30
 
 
+def test_findings_that_depend_on_the_context_are_not_shared_between_trees() -> None:
+    # In T1 the second tag of type Frob (written otherwise: another token) finds the type
+    # already resolved in the run; T2's must still look it up itself, so that declaring
+    # Frob later checks T2 again.
+    trees = (
+        '<BehaviorTree ID="T1"><Sequence><Frob/><Frob /></Sequence></BehaviorTree>\n'
+        '<BehaviorTree ID="T2"><Sequence><Frob /><AlwaysSuccess/></Sequence></BehaviorTree>\n'
+    )
+    main = Document(
+        f'<root BTCPP_format="4" main_tree_to_execute="T1">\n{trees}</root>\n', "/w/m.xml"
+    )
+    declared = Document(
+        '<root BTCPP_format="4"><TreeNodesModel><Action ID="Frob"><input_port name="a"/>'
+        "</Action></TreeNodesModel></root>",
+        "/w/models.xml",
+    )
+    empty = Document('<root BTCPP_format="4"><TreeNodesModel/></root>', "/w/models.xml")
+
+    def codes(other: Document) -> list[str]:
+        ctx = Context.combine(main, [("/w/models.xml", other, False)])
+        return sorted(d.code for d in analyze(main, ctx) if d.code != "no-main-tree")
+
+    assert codes(empty) == ["unknown-node"] * 3
+    assert codes(declared) == ["missing-required-port"] * 3  # a hint: a is not given
+    assert codes(empty) == ["unknown-node"] * 3
+
+
 def test_a_section_without_findings_keeps_the_shared_empty_result() -> None:
     doc = Document(HEAD + "<AlwaysSuccess/>" + TAIL)
     analyze(doc)

@@ -71,7 +71,7 @@ def extract_sections(
     """
     sections, origins = model.sections, model.origins
     if before is None or before.layout is None or before.path != path:
-        return _extract_all(sections, origins, model.root, path)
+        return _extract_all(sections, origins, path)
     layout = before.layout
     old_sections, old_origins = layout.sections, layout.origins
     n_old, n_new = len(old_sections), len(sections)
@@ -84,7 +84,7 @@ def extract_sections(
     if p == n_old == n_new:
         return before
     delta = origins[n_new - q] - old_origins[n_old - q] if q else 0
-    mid = _extract_all(sections[p : n_new - q], origins[p : n_new - q], model.root, path)
+    mid = _extract_all(sections[p : n_new - q], origins[p : n_new - q], path)
     assert mid.layout is not None
     cut = _Cut(p, n_old - q, delta, path)
     trees, trees_at = cut.splice(
@@ -142,17 +142,14 @@ class _Cut:
         return decls, at
 
 
-def local_facts(section: Section) -> DocumentFacts | None:
-    """What ``section`` declares, in its coordinates, if it was extracted (``None`` if not)."""
-    local: DocumentFacts | TreeDecl | None = section.cache.get("facts")
-    if type(local) is TreeDecl:
-        return DocumentFacts(None, (local,), (), ())
-    assert local is None or isinstance(local, DocumentFacts)
-    return local
+def local_facts(section: Section) -> DocumentFacts:
+    """What ``section`` declares, in its coordinates (made again when asked: keeping it on
+    each section would cost a declaration per tree twice)."""
+    return _extract(section.elements, None)  # its root declares nothing
 
 
 def _extract_all(
-    sections: Sequence[Section], origins: Sequence[int], root: Element | None, path: str | None
+    sections: Sequence[Section], origins: Sequence[int], path: str | None
 ) -> DocumentFacts:
     """The declarations of ``sections`` (at ``origins``), with their layout."""
     trees: list[TreeDecl] = []
@@ -163,24 +160,7 @@ def _extract_all(
         trees_at.append(len(trees))
         models_at.append(len(models))
         subs_at.append(len(subtree_models))
-        local: DocumentFacts | TreeDecl | None = section.cache.get("facts")
-        if local is None:
-            local = extract_facts(Model.of_section(section, root), None)
-            if not local.models and not local.subtree_models and len(local.trees) == 1:
-                local = local.trees[0]  # the usual section, one tree: kept alone
-            section.cache["facts"] = local
-        if type(local) is TreeDecl:
-            t = local
-            # Made without the named tuple's constructor, as every tree of a first analysis.
-            trees.append(_new(TreeDecl, (t.id, path, t.start + o, t.end + o, t.calls, t[5])))
-            continue
-        assert isinstance(local, DocumentFacts)
-        if local.trees:
-            trees.extend(_moved_trees(local.trees, o, path))
-        if local.models:
-            models.extend(_moved_models(local.models, o, path))
-        if local.subtree_models:
-            subtree_models.extend(_moved_models(local.subtree_models, o, path))
+        _extract_into(section.elements, path, o, trees, models, subtree_models)
     trees_at.append(len(trees))
     models_at.append(len(models))
     subs_at.append(len(subtree_models))
@@ -237,14 +217,32 @@ def _id_span(el: Element) -> tuple[str | None, int, int]:
 
 def extract_facts(model: Model, path: str | None) -> DocumentFacts:
     """One pass over the elements: trees with their calls, and the model entries."""
+    return _extract(model.elements, path)
+
+
+def _extract(elements: Iterable[Element], path: str | None) -> DocumentFacts:
+    """:func:`extract_facts` of ``elements``."""
     trees: list[TreeDecl] = []
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
+    _extract_into(elements, path, 0, trees, models, subtree_models)
+    return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
+
+
+def _extract_into(
+    elements: Iterable[Element],
+    path: str | None,
+    origin: int,
+    trees: list[TreeDecl],
+    models: list[ModelDecl],
+    subtree_models: list[ModelDecl],
+) -> None:
+    """Add the declarations of ``elements``, placed ``origin`` code points further on."""
     tree: _OpenTree | None = None
     entry: _OpenEntry | None = None
     # Members bound once: reading one from its enum class is slow in Python 3.11.
     node, tree_zone, entry_zone, port_zone = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
-    for el in model.elements:
+    for el in elements:
         zone = el.zone
         if zone == node:
             if tree is not None and el.name == "SubTree":
@@ -255,10 +253,10 @@ def extract_facts(model: Model, path: str | None) -> DocumentFacts:
             continue
         if el.depth <= 1 or zone == entry_zone:
             if tree is not None:
-                trees.append(tree.close(path))
+                trees.append(tree.close(path, origin))
                 tree = None
             if entry is not None:
-                decl = entry.close(path)
+                decl = entry.close(path, origin)
                 (subtree_models if decl.category == "SubTree" else models).append(decl)
                 entry = None
         if zone == tree_zone:
@@ -287,11 +285,10 @@ def extract_facts(model: Model, path: str | None) -> DocumentFacts:
                     )
                 )
     if tree is not None:
-        trees.append(tree.close(path))
+        trees.append(tree.close(path, origin))
     if entry is not None:
-        decl = entry.close(path)
+        decl = entry.close(path, origin)
         (subtree_models if decl.category == "SubTree" else models).append(decl)
-    return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
 
 
 @dataclass(slots=True)
@@ -302,7 +299,7 @@ class _OpenTree:
     calls: list[str] = field(default_factory=list)
     spans: list[tuple[int, int]] = field(default_factory=list)
 
-    def close(self, path: str | None) -> TreeDecl:
+    def close(self, path: str | None, origin: int) -> TreeDecl:
         s = self.start
         spans = tuple([(a - s, b - s) for a, b in self.spans])
         # Trees written alike call at the same offsets: one tuple for them all (bounded).
@@ -311,7 +308,8 @@ class _OpenTree:
             if len(_SPANS) >= 4096:
                 _SPANS.clear()
             shared = _SPANS[spans] = spans
-        return TreeDecl(self.id, path, s, self.end, tuple(self.calls), shared)
+        calls = tuple(self.calls)
+        return _new(TreeDecl, (self.id, path, s + origin, self.end + origin, calls, shared))
 
 
 _SPANS: dict[tuple[tuple[int, int], ...], tuple[tuple[int, int], ...]] = {}
@@ -325,5 +323,7 @@ class _OpenEntry:
     end: int
     ports: list[PortModel] = field(default_factory=list)
 
-    def close(self, path: str | None) -> ModelDecl:
-        return ModelDecl(self.id, self.category, tuple(self.ports), path, self.start, self.end)
+    def close(self, path: str | None, origin: int) -> ModelDecl:
+        return ModelDecl(
+            self.id, self.category, tuple(self.ports), path, self.start + origin, self.end + origin
+        )

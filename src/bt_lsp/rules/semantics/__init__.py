@@ -18,16 +18,14 @@ Each module's docstring lists its codes with their severity and range.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
-from bt_lsp.rules.codes import FixData, Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Capped, capped
 from bt_lsp.rules.semantics import document, models, nodes, ports, trees
-from bt_lsp.rules.semantics.base import State, TreeScope
+from bt_lsp.rules.semantics.base import Finding, State, TagFindings, TreeScope
 from bt_lsp.rules.semantics.sections import check_sections
 from bt_lsp.syntax.elements import Element, Zone
-from bt_lsp.syntax.tokens import Token
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
@@ -59,10 +57,14 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
     What the node checks find in a start tag is the same wherever it is written, unless
     they read more than the tag and the number of children (a blackboard key's first use,
     a script's text, a ``<SubTree>`` call, the children of a ``ReactiveSequence``): equal
-    tags are one token, so the findings of such a node are remembered by its token for
-    the run, and a document of a hundred thousand ``<Frob/>`` checks one."""
+    tags are one token, so the findings of such a node are remembered by its token, for
+    the run, or for every run of the check when they looked nothing up in the context
+    (a built-in node): a document of a hundred thousand ``<Frob/>`` checks one, and one of
+    twenty thousand trees its ``<Sequence>`` once."""
     scope = TreeScope(None)
-    tags: dict[int, tuple[Token, int, tuple[_Finding, ...] | Literal[False] | None]] = {}
+    tags = st.tags
+    shared = st.shared_tags
+    lookups = st.lookups
     # Members bound once: reading one from its enum class is slow in Python 3.11.
     node, tree, entry, port_decl = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
     add = st.add
@@ -78,15 +80,12 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
                 ports.check_attributes(st, el, res, scope, True)
                 continue
             n = len(el.children)
-            hit = tags.get(id(tag))
-            if hit is None or hit[0] is not tag or hit[1] != n:
-                # Seen once: checked as it is (most tags of most documents are unique).
-                tags[id(tag)] = (tag, n, None)
-                res = nodes.check_node(st, el)
-                ports.check_attributes(st, el, res, scope, False)
-                continue
-            found = hit[2]
-            if found is not None:
+            key = id(tag)
+            hit = tags.get(key)
+            if hit is None and shared is not None:
+                hit = shared.get(key)
+            if hit is not None and hit[0] is tag and hit[1] == n:
+                found = hit[2]
                 if found is False:  # what it finds depends on more than its tag
                     res = nodes.check_node(st, el)
                     ports.check_attributes(st, el, res, scope, False)
@@ -95,20 +94,34 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
                 for s, e, code, message, severity, data in found:
                     add(ts + s, ts + e, code, message, severity, data)
                 continue
-            # Seen twice: checked and remembered, if its findings are the tag's alone.
-            recorded: list[_Finding] = []
+            recorded: list[Finding] = []
             st.record, st.pure = recorded, True
+            before = lookups[0] if lookups is not None else -1
             res = nodes.check_node(st, el)
             ports.check_attributes(st, el, res, scope, False)
             st.record = None
-            ts = el.token_start
-            tags[id(tag)] = (
-                tag,
-                n,
-                tuple([(s - ts, e - ts, c, m, sev, d) for s, e, c, m, sev, d in recorded])
-                if st.pure
-                else False,
-            )
+            memo = tags
+            if not st.pure:
+                kept: TagFindings = (tag, n, False)
+            else:
+                ts = el.token_start
+                kept = (
+                    tag,
+                    n,
+                    tuple([(s - ts, e - ts, c, m, sev, d) for s, e, c, m, sev, d in recorded]),
+                )
+                if (
+                    shared is not None
+                    and lookups is not None
+                    and lookups[0] == before
+                    and res is not None
+                    and res.origin == "builtin"
+                ):  # a built-in, nothing read of the context (nor of what a run kept of
+                    # it, such as an unknown type's finding): valid for every run
+                    memo = shared
+            if len(memo) >= _MAX_TAGS:
+                memo.clear()
+            memo[key] = kept
         elif zone == tree:
             scope = TreeScope(el)
             trees.begin_tree(st, el)
@@ -118,5 +131,6 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
             models.check_port_decl(st, el)
 
 
-# What a rule gave State.add: start, end, code, message, severity, data.
-_Finding = tuple[int, int, str, str, Severity | None, FixData | None]
+# How many tags a memo of check_elements holds at most (a document's tags are mostly
+# unique: the memo is for those that repeat).
+_MAX_TAGS = 4096

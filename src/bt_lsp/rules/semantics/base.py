@@ -14,6 +14,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, sort_key
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 from bt_lsp.syntax.model import Model
+from bt_lsp.syntax.tokens import Token
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document
@@ -125,6 +126,13 @@ def is_compact(el: Element) -> bool:
     return el.name not in EXPLICIT_TAGS and el.name != "SubTree"
 
 
+# What a rule gave State.add: start, end, code, message, severity, data.
+Finding = tuple[int, int, str, str, Severity | None, FixData | None]
+# A node tag, its number of children and what the node checks found there (offsets from
+# the tag's start), or ``False`` when that depends on more than the tag.
+TagFindings = tuple[Token, int, tuple[Finding, ...] | Literal[False]]
+
+
 @dataclass(slots=True)
 class State:
     """One run of the checks over one document."""
@@ -160,8 +168,14 @@ class State:
     # semantics.check_elements): what they add, as given to add, and whether they read
     # only the tag and the number of children (``pure``; a rule that reads anything else
     # clears it).
-    record: list[tuple[int, int, str, str, Severity | None, FixData | None]] | None = None
+    record: list[Finding] | None = None
     pure: bool = True
+    # The findings of node tags (see semantics.check_elements), by the tag's id, for this
+    # run and, ``shared_tags``, for every run of one check (those that looked nothing up
+    # in the context: ``lookups`` counts the lookups of a run's context, when it counts).
+    tags: dict[int, TagFindings] = field(default_factory=dict)
+    shared_tags: dict[int, TagFindings] | None = None
+    lookups: list[int] | None = None
 
     def line_of(self, offset: int) -> int:
         """The 0-based document line of ``offset`` (in this run's coordinates).  Messages

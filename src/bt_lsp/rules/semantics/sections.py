@@ -29,7 +29,7 @@ from bt_lsp.rules.context import Context, ModelDecl, TreeDecl
 from bt_lsp.rules.diagnostics import Diagnostic, capped
 from bt_lsp.rules.facts import local_facts
 from bt_lsp.rules.section_diff import common_ends
-from bt_lsp.rules.semantics.base import State
+from bt_lsp.rules.semantics.base import State, TagFindings
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
@@ -46,6 +46,7 @@ V = TypeVar("V")
 # field's index and a key (``None`` stands for the whole mapping, iterated).
 _FIELDS: Final = ("models", "subtree_models", "trees", "workspace_trees")
 _KEY: Final = "semantics"
+_UNKNOWN: Final = object()  # a signature not yet computed
 # Per field, what was looked up (or what changed): keys.
 Keys = tuple[set[str | None], ...]
 # The signature of a lookup now: (field index, key) -> signature.
@@ -55,27 +56,37 @@ Current = Callable[[int, "str | None"], object]
 class _Recording(Mapping[str, V]):
     """A mapping of the context that notes which keys a rule looked up."""
 
-    __slots__ = ("_inner", "_keys")
+    __slots__ = ("_count", "_inner", "_keys")
 
-    def __init__(self, inner: Mapping[str, V], keys: set[str | None]) -> None:
+    def __init__(self, inner: Mapping[str, V], keys: set[str | None], count: list[int]) -> None:
         self._inner = inner
         self._keys = keys
+        self._count = count  # of every lookup (see State.lookups)
 
     def __getitem__(self, key: str) -> V:
         self._keys.add(key)
+        self._count[0] += 1
         return self._inner[key]
+
+    def get(self, key: str, default: V | None = None) -> V | None:  # type: ignore[override]
+        self._keys.add(key)  # (Mapping.get would raise and catch a KeyError on a miss)
+        self._count[0] += 1
+        return self._inner.get(key, default)
 
     def __contains__(self, key: object) -> bool:
         if isinstance(key, str):
             self._keys.add(key)
+        self._count[0] += 1
         return key in self._inner
 
     def __iter__(self) -> Iterator[str]:
         self._keys.add(None)
+        self._count[0] += 1
         return iter(self._inner)
 
     def __len__(self) -> int:
         self._keys.add(None)
+        self._count[0] += 1
         return len(self._inner)
 
 
@@ -172,11 +183,10 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
 
     def current(field: int, key: str | None) -> object:
         found = memo[field]
-        try:
-            return found[key]
-        except KeyError:
+        sig = found.get(key, _UNKNOWN)
+        if sig is _UNKNOWN:
             sig = found[key] = _signature(mappings[field], key, ctx.path)
-            return sig
+        return sig
 
     hist = _HISTORY.get(st.doc.history)
     if hist is None:
@@ -338,17 +348,20 @@ class _RecordingContext:
     """The context as the runs over sections see it: the same, except that its mappings
     note in ``keys`` what a run looks up (cleared before each run)."""
 
-    __slots__ = ("ctx", "keys")
+    __slots__ = ("count", "ctx", "keys", "tags")
 
     def __init__(self, ctx: Context) -> None:
         self.keys: Keys = tuple(set() for _ in _FIELDS)
+        self.count = [0]  # lookups, for State.lookups
+        self.tags: dict[int, TagFindings] = {}  # for State.shared_tags
         models, subtree_models, trees, workspace_trees = self.keys
+        c = self.count
         self.ctx = dataclasses.replace(
             ctx,
-            models=_Recording(ctx.models, models),
-            subtree_models=_Recording(ctx.subtree_models, subtree_models),
-            trees=_Recording(ctx.trees, trees),
-            workspace_trees=_Recording(ctx.workspace_trees, workspace_trees),
+            models=_Recording(ctx.models, models, c),
+            subtree_models=_Recording(ctx.subtree_models, subtree_models, c),
+            trees=_Recording(ctx.trees, trees, c),
+            workspace_trees=_Recording(ctx.workspace_trees, workspace_trees, c),
         )
 
 
@@ -365,19 +378,19 @@ def _run(
 ) -> _Entry:
     for keys in recording.keys:
         keys.clear()
-    local = Model.of_section(sec, root)
     run = State(
         st.doc,
         recording.ctx,
-        local,
+        Model.of_section(sec, root),
         st.text[origin : origin + sec.length],
         v4=st.v4,
         v3=st.v3,
         origin=origin,
         made=st.made,
+        shared_tags=recording.tags,
+        lookups=recording.count,
     )
-    elements = local.elements
-    check(run, elements[1:])  # a view of the section's elements, not a copy
+    check(run, sec.elements)  # the section's model's elements but its root
     line = lines.line_of(origin) if run.uses_lines else None
     out = capped(run.out, run.more)
     deps: list[object] = []
