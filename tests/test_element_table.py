@@ -119,3 +119,20 @@ def test_a_run_of_equal_empty_elements_is_built_like_any_other() -> None:
     ]
     assert list(els[2].children) == [3, 4, 5]
     assert list(els[0].children) == [1, 6, 7, 8]
+
+
+def test_elements_that_stand_for_enough_text_are_kept_and_tiny_ones_are_not() -> None:
+    dense = Document(
+        '<root><BehaviorTree ID="T"><Sequence>'
+        + '<SetBlackboard output_key="{key}" value="a value of some length"/>' * 50
+        + "</Sequence></BehaviorTree></root>"
+    )
+    tiny = Document(
+        '<root><BehaviorTree ID="T"><Sequence>' + "<A/>" * 50 + "</Sequence></BehaviorTree></root>"
+    )
+    (kept,) = (s.elements for s in dense.model.sections)
+    (made,) = (s.elements for s in tiny.model.sections)
+    assert kept.kept and not made.kept
+    assert next(iter(kept)) is next(iter(kept)) and kept[3] is kept[3]  # made once
+    assert next(iter(made)) is not next(iter(made))  # made when read, not kept
+    assert [_view(e) for e in kept] == [_view(kept[i]) for i in range(len(kept))]

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bt_lsp.syntax.scanner import rescan, scan
+from bt_lsp.syntax.scanner import rescan, scan, scan_token
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_DUPLICATES, MAX_TAG_PROBLEMS
 from bt_lsp.syntax.tokens import Kind, Token
 from bt_lsp.syntax.values import decode_value
@@ -231,3 +231,37 @@ def test_a_malformed_tag_reports_a_bounded_number_of_problems() -> None:
         f"(only the first {MAX_DUPLICATES} are listed)",
     ]
     assert not any(p.message.startswith("Missing whitespace") for p in tok.problems)
+
+
+def _token_by_token(text: str) -> list[tuple[int, Token]]:
+    out: list[tuple[int, Token]] = []
+    pos = 0
+    while pos < len(text):
+        tok = scan_token(text, pos)
+        out.append((pos, tok))
+        pos += tok.length
+    return out
+
+
+# Pieces that repeat, and ones that repeat only up to the character after them.
+_REPEATS = ["<A/>", "<A/", "<A>", "</A>", "  ", "\n", "x", "<A", "<!-- c -->", '<B a="1"/>']
+
+
+@settings(max_examples=300)
+@given(st.lists(st.sampled_from(_REPEATS), max_size=60).map("".join))
+def test_a_repeated_token_is_the_one_a_scan_makes_there(text: str) -> None:
+    # The full scan reuses one of the last three tokens where the text it looked at
+    # comes again: the result is the one scanning each token gives.
+    full = scan(text)
+    assert list(zip(full.starts, full.tokens, strict=True)) == _token_by_token(text)
+
+
+def test_repeats_are_found_again_after_text_that_does_not_repeat() -> None:
+    # Where fewer than half the tokens repeat, the scan stops looking for a while, then
+    # looks again: both stretches give the tokens a plain scan gives.
+    varied = "".join(f'<N{k} a="{k}"/>' for k in range(3000))
+    text = varied + "<A/>" * 5000 + varied
+    full = scan(text)
+    assert list(zip(full.starts, full.tokens, strict=True)) == _token_by_token(text)
+    runs = full.tokens[3000:8000]
+    assert all(t is runs[0] for t in runs)  # one token for the run
