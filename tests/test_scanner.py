@@ -265,3 +265,14 @@ def test_repeats_are_found_again_after_text_that_does_not_repeat() -> None:
     assert list(zip(full.starts, full.tokens, strict=True)) == _token_by_token(text)
     runs = full.tokens[3000:8000]
     assert all(t is runs[0] for t in runs)  # one token for the run
+
+
+def test_equal_attributes_stay_shared_when_the_pool_fills_midway() -> None:
+    # The pool of shared attributes is bounded; making room in it keeps what was added
+    # last, so that one document's equal attributes stay one tuple across the trim.
+    from bt_lsp.syntax import scanner
+
+    room = scanner._SHARED_MAX - len(scanner._ATTRS) - 5
+    scan("".join(f'<F z{k}="v"/>' for k in range(max(0, room))))
+    full = scan("".join(f'<F a="1" c="{k}"/>' for k in range(50)))
+    assert len({id(t.attrs[0]) for t in full.tokens}) == 1

@@ -22,6 +22,8 @@ from __future__ import annotations
 import re
 from array import array
 from dataclasses import dataclass
+from itertools import islice
+from typing import Any
 
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
 from bt_lsp.syntax.text import Offsets
@@ -83,10 +85,17 @@ def _text_token(length: int) -> Token:
     return tok
 
 
+def _trim(pool: dict[Any, Any]) -> None:
+    """Make room in a full pool: its older half goes (not all of it, so that what the
+    text being scanned shares still is shared after)."""
+    for key in list(islice(pool, _SHARED_MAX // 2)):
+        del pool[key]
+
+
 def _keep(pool: dict[str, str], s: str) -> str:
-    """Keep ``s`` in ``pool`` (emptied when full) for the next equal string to share."""
+    """Keep ``s`` in ``pool`` (bounded) for the next equal string to share."""
     if len(pool) >= _SHARED_MAX:
-        pool.clear()
+        _trim(pool)
     pool[s] = s
     return s
 
@@ -97,7 +106,7 @@ _ATTRS: dict[Attr, Attr] = {}
 
 def _keep_attr(attr: Attr) -> Attr:
     if len(_ATTRS) >= _SHARED_MAX:
-        _ATTRS.clear()
+        _trim(_ATTRS)
     _ATTRS[attr] = attr
     return attr
 
