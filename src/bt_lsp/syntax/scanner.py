@@ -22,8 +22,7 @@ from __future__ import annotations
 import re
 from array import array
 from dataclasses import dataclass
-from itertools import islice
-from typing import Any
+from typing import TypeVar
 
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
 from bt_lsp.syntax.text import Offsets
@@ -85,40 +84,38 @@ def _text_token(length: int) -> Token:
     return tok
 
 
-def _trim(pool: dict[Any, Any]) -> None:
-    """Make room in a full pool: its older half goes (not all of it, so that what the
-    text being scanned shares still is shared after)."""
-    for key in list(islice(pool, _SHARED_MAX // 2)):
-        del pool[key]
+_T = TypeVar("_T")
 
 
-def _keep(pool: dict[str, str], s: str) -> str:
-    """Keep ``s`` in ``pool`` (bounded) for the next equal string to share."""
+def _keep(pool: dict[_T, _T], older: dict[_T, _T], x: _T) -> _T:
+    """The shared object equal to ``x`` (``x`` itself if none), kept in ``pool`` for the
+    next equal one (``pool.get`` is the quick look-up).  A full pool becomes ``older``
+    and starts again empty; what is found in ``older`` comes back into the pool, so that
+    what the text being scanned shares stays shared however the pools fill."""
+    found = older.pop(x, x)
     if len(pool) >= _SHARED_MAX:
-        _trim(pool)
-    pool[s] = s
-    return s
+        older.clear()
+        older.update(pool)
+        pool.clear()
+    pool[found] = found
+    return found
 
 
 # Attributes (relative to their tag) shared by equal tags' attributes (bounded).
 _ATTRS: dict[Attr, Attr] = {}
-
-
-def _keep_attr(attr: Attr) -> Attr:
-    if len(_ATTRS) >= _SHARED_MAX:
-        _trim(_ATTRS)
-    _ATTRS[attr] = attr
-    return attr
+_OLDER_ATTRS: dict[Attr, Attr] = {}
+_OLDER_NAMES: dict[str, str] = {}
+_OLDER_VALUES: dict[str, str] = {}
 
 
 def _name(name: str) -> str:
-    return _NAMES.get(name) or _keep(_NAMES, name)
+    return _NAMES.get(name) or _keep(_NAMES, _OLDER_NAMES, name)
 
 
 def _value(raw: str) -> str:
     if len(raw) > _SHARED_VALUE_LENGTH:
         return raw
-    return _VALUES.get(raw) or _keep(_VALUES, raw)
+    return _VALUES.get(raw) or _keep(_VALUES, _OLDER_VALUES, raw)
 
 
 def _scan_text(text: str, pos: int, n: int) -> Token:
@@ -317,7 +314,7 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
             ),
         )
         # Equal attributes at the same place in their tags are one tuple, like short values.
-        attrs.append(_ATTRS.get(attr) or _keep_attr(attr))
+        attrs.append(_ATTRS.get(attr) or _keep(_ATTRS, _OLDER_ATTRS, attr))
     close = _FAST_CLOSE_RE.match(text, a_end)
     if close is None:
         return None
