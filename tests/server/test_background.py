@@ -7,6 +7,7 @@ the test asserts that order, never a time."""
 
 from __future__ import annotations
 
+import json
 import queue
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -369,6 +370,25 @@ def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:
         if made:
             text = sections[0].cache["outline-json"].text
             assert text.startswith('{"name": "Main", "detail": "BehaviorTree"')
+        assert od.folding is None  # no folding request waited
+
+
+def test_folding_ranges_asked_with_the_open_are_made_on_the_worker() -> None:
+    """Held with the open, folding ranges are made by the worker as JSON, kept for the
+    document's version, which the request then answers with."""
+    background = Background(cast("BtServer", SimpleNamespace(encoding="utf-16")))
+    doc = Document(big_document("Frobnicate"), BIG_URI, scanned=False)
+    od = OpenDocument(BIG_URI, doc, 1, "xml")
+    od.refresh_kind()
+    background._prepare_for(_Held(od, [SimpleNamespace(method="textDocument/foldingRange")]))
+    assert od.folding is not None and od.folding[0] == 1
+    folds = json.loads(od.folding[1])
+    lines = doc.text.count("\n")
+    assert folds[:2] == [
+        {"startLine": 0, "endLine": lines - 2, "kind": "region"},  # <root>
+        {"startLine": 1, "endLine": lines - 3, "kind": "region"},  # <BehaviorTree>
+    ]
+    assert doc.model._by_symbol is None  # only the folding ranges waited
 
 
 def test_a_snapshot_continues_the_caches_of_its_document(monkeypatch: pytest.MonkeyPatch) -> None:

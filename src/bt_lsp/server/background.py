@@ -39,7 +39,7 @@ from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.early_names import early_name_diagnostics
 from bt_lsp.server.cpp import is_cpp
 from bt_lsp.server.lookup import context_of
-from bt_lsp.server.navigation import outline_json
+from bt_lsp.server.navigation import folding_json, outline_json
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.text import positions_of
@@ -107,8 +107,9 @@ def target_uri(message: Any) -> str | None:
     return None
 
 
-def _is_outline(message: Any) -> bool:
-    return getattr(message, "method", None) == "textDocument/documentSymbol"
+# Requests about the whole document, made on the worker when they wait for its open.
+_OUTLINE, _FOLDING = "textDocument/documentSymbol", "textDocument/foldingRange"
+_WHOLE = frozenset({_OUTLINE, _FOLDING})
 
 
 class Background:
@@ -145,18 +146,22 @@ class Background:
         return True
 
     def _prepare_for(self, held: _Held) -> None:
-        """On the worker thread: :func:`_prepare`, and the outline when a request for it
-        waits (its sections keep their JSON, which the request then reads): made on the
-        loop while the analysis ran on the worker, the two shared the interpreter and the
-        outline of 8 MB took 6 s to come."""
+        """On the worker thread: :func:`_prepare`, and the outline (the folding ranges)
+        when a request for it waits; the request then reads what the worker kept. Made
+        on the loop while the analysis ran on the worker, the two shared the interpreter
+        and the outline of 8 MB took 6 s to come."""
         od = held.od
-        if not (od.is_bt and any(map(_is_outline, list(held.messages)))):
+        methods = {getattr(m, "method", None) for m in list(held.messages)}
+        if not (od.is_bt and methods & _WHOLE):
             _prepare(od.doc, od.is_bt, held.messages)
             return
-        _prepare(od.doc, od.is_bt)  # the name index after the outline, if another waits
-        server = self._server
-        outline_json(od.doc, context_of(server, od), server.encoding)
-        if not all(map(_is_outline, list(held.messages))):
+        _prepare(od.doc, od.is_bt)  # the name index after these, if another waits
+        if _OUTLINE in methods:
+            server = self._server
+            outline_json(od.doc, context_of(server, od), server.encoding)
+        if _FOLDING in methods:
+            folding_json(od)
+        if methods - _WHOLE:
             _ = od.doc.model.by_symbol
 
     def _kind_and_early_names(self, held: _Held, loop: asyncio.AbstractEventLoop) -> None:

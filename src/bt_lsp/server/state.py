@@ -22,6 +22,7 @@ class OpenDocument:
     cache_key: tuple[int | None, int, int] | None = None
     cached: list[Diagnostic] = field(default_factory=list)
     published: DiagnosticJson = field(default_factory=DiagnosticJson)  # reused JSON
+    folding: tuple[int | None, str] | None = None  # the folding ranges' JSON, by version
 
     def refresh_kind(self) -> None:
         self.is_bt = self.doc.is_bt
