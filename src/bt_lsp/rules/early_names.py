@@ -68,11 +68,14 @@ class _Reader:
         stack = self.stack
         if stack:
             parent, pz = stack[-1]
-            zone = zone_in(tag, pz)
+            zone = _NODE if pz is _NODE or pz is _TREE else zone_in(tag, pz)
         else:
             parent, zone = -1, Zone.ROOT
         stack.append((index, zone))
-        if zone == _NODE:
+        if zone is _NODE:
+            # Most nodes of a large document: a known type without attributes.
+            if not attrib and tag in self.good_models:
+                return
             suspect = self._node_suspect(tag, attrib)
         elif zone in (_TREE, _ENTRY):
             value = attrib.get("ID")
