@@ -151,11 +151,11 @@ class Background:
         on the loop while the analysis ran on the worker, the two shared the interpreter
         and the outline of 8 MB took 6 s to come."""
         od = held.od
-        methods = {getattr(m, "method", None) for m in list(held.messages)}
-        if not (od.is_bt and methods & _WHOLE):
-            _prepare(od.doc, od.is_bt, held.messages)
-            return
         _prepare(od.doc, od.is_bt)  # the name index after these, if another waits
+        if not od.is_bt:
+            return
+        # Read once the model is made: the requests sent with the open have come by then.
+        methods = {getattr(m, "method", None) for m in list(held.messages)}
         if _OUTLINE in methods:
             server = self._server
             outline_json(od.doc, context_of(server, od), server.encoding)
