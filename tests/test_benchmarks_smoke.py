@@ -3,10 +3,14 @@ real server, and the runner produces its table.  Correctness only, never timings
 
 from __future__ import annotations
 
+import asyncio
+import importlib.util
 import json
+import re
 import sys
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 import pytest
 from lxml import etree
@@ -202,3 +206,48 @@ def test_scale_times_the_outline_and_a_publication(
     publication = result["publication"]
     assert publication["edits"] == 4 and publication["diagnostics"] > 50
     assert publication["edit_ms"]["p50"] > 0
+
+
+def _bench_module(name: str) -> Any:
+    """A benchmark script as a module of its own name (``requests.py`` would otherwise be
+    shadowed by, or shadow, the HTTP library of that name)."""
+    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_requests_benchmark_runs_each_measurement(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bench_requests = _bench_module("requests")
+    # The same shapes as the benchmark's, small: a document past the size that is prepared
+    # on the worker thread, with one unknown node, and a script of 2,000 statements.
+    realistic = bench_generate.generate(300_000, seed=1).text.replace(
+        "</BehaviorTree>", "<Frob/></BehaviorTree>", 1
+    )
+    script = (
+        '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<Script code="'
+        + "".join(f"a{i}:=1; " for i in range(2_000))
+        + '"/><Frob/></BehaviorTree>\n</root>\n'
+    )
+    monkeypatch.setattr(
+        bench_requests, "INPUTS", {"realistic": lambda: realistic, "script": lambda: script}
+    )
+    assert bench_requests.main([]) == 0
+    printed = capsys.readouterr().out
+    assert "open → outline answered:" in printed and "RSS peak:" in printed
+    # The key a1000 is written once: its references are that one use.
+    assert re.search(r"v3 textDocument/references: \d+ ms \(1 results\)", printed), printed
+    assert re.search(r"v3 textDocument/hover: \d+ ms \(1 results\)", printed), printed
+    for name in ("outline", "folding", "hover"):
+        assert f"open → {name}:" in printed
+
+
+def test_hostile_measures_an_input() -> None:
+    bench_hostile = _bench_module("hostile")
+    text = bench_hostile._sequence("<Frob/>" * 2_000)
+    result = asyncio.run(bench_hostile.measure("small", text))
+    assert result["size"] == len(text)
+    assert result["diagnostics_s"] > 0 and result["hover_s"] > 0 and result["rss_peak_mib"] > 0
