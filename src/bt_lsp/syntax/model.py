@@ -253,7 +253,7 @@ class Model:
                     for sec, o, f, b in zip(
                         self.sections, self.origins, self.firsts, self.bases, strict=True
                     )
-                    if zone is None or sec.elements[0].zone == zone
+                    if zone is None or sec.top_zone == zone
                 ]
             return found
         els = self.elements

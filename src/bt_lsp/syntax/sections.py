@@ -25,7 +25,7 @@ from bt_lsp.syntax.elements import (
     model_symbol,
 )
 from bt_lsp.syntax.nametokens import name_refs, shared_symbol
-from bt_lsp.syntax.table import ElementTable
+from bt_lsp.syntax.table import ZONES, ElementTable
 from bt_lsp.syntax.tokens import Token
 
 _ROLE_NODE_TYPE_END = Role.NODE_TYPE_END
@@ -89,6 +89,11 @@ class Section:
     def top_name(self) -> str:
         """The name of its top element."""
         return self.elements.columns.tags[1].name
+
+    @property
+    def top_zone(self) -> Zone:
+        """The zone of its top element (read from its row, without making it)."""
+        return ZONES[self.elements.columns.zones[1]]
 
     @property
     def refs(self) -> list[NameRef]:
@@ -233,10 +238,6 @@ class Part:
             return local
         return self.elem_base + local - 1
 
-    def element(self, el: Element) -> Element:
-        """An element of the section (read from its elements) in document coordinates."""
-        return self.elements()[el.local - 1]
-
     def elements(self) -> ElementTable:
         """The section's elements in document coordinates."""
         return self.section.elements.placed(self.origin, self.tok_origin, self.elem_base)
@@ -268,7 +269,7 @@ def section_top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> E
     hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
     if hit is not None and hit[0] == origin and hit[1] == tok_origin and hit[2] == elem_base:
         return hit[3]
-    el = Part(sec, origin, tok_origin, elem_base).element(sec.elements[0])
+    el = sec.elements.placed(origin, tok_origin, elem_base)[0]
     sec.cache["top"] = (origin, tok_origin, elem_base, el)
     return el
 
