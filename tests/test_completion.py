@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 from bt_lsp.ide.completion import Completions, Item, ItemKind, complete
+from bt_lsp.ide.completion_attrs import MAX_KEY_ITEMS
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
@@ -273,6 +274,22 @@ def test_keys_include_the_ports_of_the_tree() -> None:
     found, _, _ = run(text)
     assert labels(found) == ["delay", "done", "pose"]
     assert item(found, "pose").detail == "input port of this tree"
+
+
+def test_keys_of_a_huge_script_are_capped_those_typed_first() -> None:
+    script = "".join(f"k{i}:=1; " for i in range(MAX_KEY_ITEMS + 500)) + "zeta:=2"
+    found, _, _ = run(here(f'<Script code="{script}"/><MoveBase goal="{{⟦k15‸⟧"/>'))
+    assert found.incomplete  # the client asks again as the key is typed
+    assert len(found.items) == MAX_KEY_ITEMS
+    got = labels(found)
+    assert got == sorted(got)
+    # Every key that starts as typed is listed (k15, k150..k159, k1500..k1499+500).
+    typed = {f"k{i}" for i in range(MAX_KEY_ITEMS + 500) if f"k{i}".startswith("k15")}
+    assert typed <= set(got)
+    assert item(found, "k15").detail == "used in a script of this tree"
+    assert "zeta" not in got  # past the cap, and not as typed
+    few, _, _ = run(here('<Script code="a:=1; b:=2"/><MoveBase goal="{⟦‸⟧"/>'))
+    assert not few.incomplete
 
 
 def test_no_keys_in_names_and_ids() -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 from lsprotocol import types
 
+from bt_lsp.ide.completion_attrs import MAX_KEY_ITEMS
 from tests.server.conftest import BtClient, clients
 
 pytestmark = [pytest.mark.asyncio(loop_scope="module"), clients("vscode", "emacs")]
@@ -83,3 +84,29 @@ async def test_a_key_of_a_large_script(client: BtClient) -> None:
     assert hover.contents.value.count("`Script` `code` (line 4)") == 2
     between = await client.hover(uri, client.pos(edited, in_script + 3))  # on ':='
     assert between is None or "Blackboard key" not in str(between.contents)
+
+
+async def test_key_completion_in_the_tree_of_a_large_script(client: BtClient) -> None:
+    """40,000 keys: the first MAX_KEY_ITEMS, those typed first, marked incomplete so that
+    the client asks again as the key is typed (not 40,000 items at every keystroke)."""
+    typed = '"/>\n      <SetBlackboard value="1" output_key="{a7}"/>'
+    text = TEXT.replace(typed, typed + '\n      <SetBlackboard value="2" output_key="{a399')
+    uri = client.open(text, name="script-completion")
+    await client.diags(uri, 1)
+    at = text.index("{a399") + len("{a399")
+    found = await client.text_document_completion_async(
+        types.CompletionParams(
+            text_document=types.TextDocumentIdentifier(uri=uri), position=client.pos(text, at)
+        )
+    )
+    assert isinstance(found, types.CompletionList)
+    assert found.is_incomplete
+    labels = [i.label for i in found.items]
+    assert len(labels) == MAX_KEY_ITEMS
+    assert {f"a399{d}" for d in range(10)} <= set(labels)  # every key as typed
+    assert "a7" not in labels  # past the cap, and not as typed
+    item = next(i for i in found.items if i.label == "a3990")
+    assert item.detail == "used in a script of this tree"
+    assert isinstance(item.text_edit, types.TextEdit)
+    assert item.text_edit.new_text == "a3990}"
+    assert item.text_edit.range == client.range(text, at - 4, at)

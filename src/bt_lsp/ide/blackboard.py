@@ -32,6 +32,7 @@ from bisect import bisect_right
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import lru_cache
 
 from bt_lsp.rules.builtins import BUILTINS
 from bt_lsp.rules.conversions import is_blackboard_reference
@@ -50,6 +51,7 @@ __all__ = [
     "blackboard_keys",
     "enclosing_tree",
     "key_at",
+    "key_names",
     "key_uses",
     "mentions",
     "port_value_key",
@@ -253,16 +255,33 @@ def _element_keys(
         value = a.value
         if value is None or (only is not None and only not in value and only != a.name):
             continue  # (``{=}`` is the key named like its port)
-        if a.name in CONDITION_ATTRS:
-            _script_keys(doc, el, a, idx, tree, out, at, only)
-        elif not _is_port(a.name):
-            continue  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
-        elif is_blackboard_reference(value):
-            k = _port_key(doc, el, a, idx, tree, value)
-            if k is not None and (only is None or k.key == only):
-                out.uses.append(k)
-        elif _is_script_port(el, a):
-            _script_keys(doc, el, a, idx, tree, out, at, only)
+        _element_attr_keys(doc, el, a, idx, tree, out, at, only)
+
+
+def _element_attr_keys(
+    doc: Document,
+    el: Element,
+    a: Attr,
+    idx: int,
+    tree: int,
+    out: TreeKeys,
+    at: int = -1,
+    only: str | None = None,
+) -> None:
+    """The key uses of one attribute (with a value) of node ``idx``: see :func:`_element_keys`."""
+    value = a.value
+    if value is None:
+        return
+    if a.name in CONDITION_ATTRS:
+        _script_keys(doc, el, a, idx, tree, out, at, only)
+    elif not _is_port(a.name):
+        return  # ID, name, _autoremap, and attributes BehaviorTree.CPP ignores
+    elif is_blackboard_reference(value):
+        k = _port_key(doc, el, a, idx, tree, value)
+        if k is not None and (only is None or k.key == only):
+            out.uses.append(k)
+    elif _is_script_port(el, a):
+        _script_keys(doc, el, a, idx, tree, out, at, only)
 
 
 def port_value_key(doc: Document, idx: int, a: Attr) -> KeyRef | None:
@@ -287,6 +306,54 @@ def tree_keys(doc: Document, tree: int, key: str | None = None) -> TreeKeys:
     for i in subtree_range(model, tree):
         _element_keys(doc, i, tree, out, only=key)
     return out
+
+
+def key_names(doc: Document, tree: int, skip_at: int = -1) -> dict[str, KeyForm]:
+    """The keys one tree uses, each with the form of its first use, leaving out a use whose
+    span holds ``skip_at`` (the key being typed): what a completion lists.  The names of
+    a script are read from its text alone and remembered for it, without a use per
+    identifier (a script of 200,000 statements has 200,000 uses, and a completion is
+    asked at every keystroke)."""
+    model = doc.model
+    out: dict[str, KeyForm] = {}
+    if not 0 <= tree < len(model.elements) or model.elements[tree].zone != Zone.TREE:
+        return out
+    for i in subtree_range(model, tree):
+        el = model.elements[i]
+        if el.zone != Zone.NODE:
+            continue
+        for a in el.attrs:
+            value = a.value
+            if value is None:
+                continue
+            if a.name in CONDITION_ATTRS:
+                script = True
+            elif not _is_port(a.name):
+                continue
+            elif is_blackboard_reference(value):
+                script = False
+            elif _is_script_port(el, a):
+                script = True
+            else:
+                continue
+            vs, ve = el.span_of_value(a)
+            if script and not vs <= skip_at <= ve:
+                for name in _script_names(value):  # (names are the decoded text's)
+                    out.setdefault(name, _SCRIPT)
+                continue
+            found = TreeKeys()
+            _element_attr_keys(doc, el, a, i, tree, found)
+            for k in found.uses:
+                if not k.start <= skip_at <= k.end:
+                    out.setdefault(k.key, k.form)
+    return out
+
+
+@lru_cache(maxsize=64)
+def _script_names(code: str) -> tuple[str, ...]:
+    """The distinct identifiers of a script, in order of first use."""
+    spans, _ = identifiers(code)
+    return tuple(dict.fromkeys([code[s:e] for s, e in spans]))
 
 
 def key_uses(doc: Document, tree: int) -> list[KeyRef]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_uses
+from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_names
 from bt_lsp.ide.completion_items import (
     Completions,
     Item,
@@ -221,16 +221,26 @@ def _keys(
     tree = enclosing_tree(model, idx)
     seen: dict[str, str] = {}
     if tree >= 0:
-        for k in key_uses(doc, tree):
-            if not (k.start <= offset <= k.end):
-                where = "a script of " if k.form == KeyForm.SCRIPT else ""
-                seen.setdefault(k.key, f"used in {where}this tree")
+        for key, form in key_names(doc, tree, offset).items():
+            seen[key] = f"used in {'a script of ' if form == KeyForm.SCRIPT else ''}this tree"
         tid = tree_id(model, tree)
         decl = ctx.subtree_models.get(tid) if tid else None
         for p in decl.ports if decl is not None else ():
             seen.setdefault(p.name, f"{p.direction} port of this tree")
+    keys = sorted(seen)
+    incomplete = len(keys) > MAX_KEY_ITEMS
+    if incomplete:  # those that start as typed first; the client asks again as one types
+        typed = text[start:offset].strip().casefold()
+        keys.sort(key=lambda k: not k.casefold().startswith(typed))
+        del keys[MAX_KEY_ITEMS:]
+        keys.sort()
     items = [
-        Item(k, ItemKind.KEY, why, insert=k if closed else k + "}", filter=k, sort=k)
-        for k, why in sorted(seen.items())
+        Item(k, ItemKind.KEY, seen[k], insert=k if closed else k + "}", filter=k, sort=k)
+        for k in keys
     ]
-    return Completions(start, end, "key", items)
+    return Completions(start, end, "key", items, incomplete=incomplete)
+
+
+# Keys listed at most by one completion (a tree may use 200,000): past them the list is
+# marked incomplete, so that the client asks again as the key is typed.
+MAX_KEY_ITEMS = 1000

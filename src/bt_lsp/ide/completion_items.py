@@ -54,6 +54,8 @@ class Completions:
     # in the indentation before a tag, the line break and indentation that keep the tag on
     # a line of its own.
     trail: str = ""
+    # Whether items were left out (see MAX_KEY_ITEMS): typing more may bring others.
+    incomplete: bool = False
 
 
 # --- text helpers --------------------------------------------------------------------------

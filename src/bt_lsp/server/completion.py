@@ -85,4 +85,4 @@ def register(server: BtServer) -> None:
                     insert_text_mode=types.InsertTextMode.AsIs if as_is else None,
                 )
             )
-        return types.CompletionList(is_incomplete=False, items=items)
+        return types.CompletionList(is_incomplete=found.incomplete, items=items)
