@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import queue
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import SimpleNamespace
@@ -208,6 +209,39 @@ def test_the_open_of_a_large_document_holds_only_its_own_requests(session: Sessi
     assert (tree["name"], tree["range"]["start"]["line"]) == ("Main", 1)
     assert len(tree["children"]) == big.count("<Sequence") + 1  # Frobnicate and each Sequence
     s.until(published(BIG_URI, 1, "unknown-node"))
+
+
+def test_a_large_outline_and_folding_are_made_beside_the_loop(session: Session) -> None:
+    """The outline and the folding ranges of a large document, asked while an edit of it
+    is analysed, are made on a thread of their own: a hover on another document sent after
+    them is answered first (on the loop, it waited for both), and both are of the edit."""
+    s = session
+    big = big_document("Frobnicate").replace(LINE.format(i=0), "", 1)  # room for the edit
+    s.raw.write(frame(msg("textDocument/didOpen", open_params(BIG_URI, big))))
+    s.until(published(BIG_URI, 1, "unknown-node"))
+    at = {"line": 2, "character": 0}
+    change = {
+        "textDocument": {"uri": BIG_URI, "version": 2},
+        "contentChanges": [{"range": {"start": at, "end": at}, "text": "<Sequence/>\n"}],
+    }
+    folding = frame(msg("textDocument/foldingRange", {"textDocument": {"uri": BIG_URI}}, 22))
+    s.raw.write(frame(msg("textDocument/didChange", change)) + symbols(BIG_URI, 21) + folding)
+    # Once they are under way (the first outline of 2 MB takes a few hundred ms of CPU;
+    # the slower the machine, the more so): on the loop, the hover would wait for both.
+    time.sleep(0.05)
+    s.raw.write(hover(SMALL_URI, 23))
+    hovered = s.until(answer(23))
+    outlined, folded = s.until(answer(21)), s.until(answer(22))
+    assert hovered < outlined and hovered < folded
+    (tree,) = s.log[outlined]["result"]
+    assert len(tree["children"]) == big.count("<Sequence") + 2  # the new one too
+    assert tree["children"][0]["range"]["start"]["line"] == 2
+    ranges = s.log[folded]["result"]
+    # <root> folds to the line before its end tag, one line further down after the edit.
+    assert ranges[0] == {"startLine": 0, "endLine": big.count("\n") - 1, "kind": "region"}
+    s.until(published(BIG_URI, 2, "unknown-node"))
+    s.raw.write(symbols(BIG_URI, 24))  # again, from what the first one kept
+    assert s.log[s.until(answer(24))]["result"] == s.log[outlined]["result"]
 
 
 def test_an_edit_right_after_the_open_is_not_lost(session: Session) -> None:

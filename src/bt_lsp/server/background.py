@@ -32,7 +32,7 @@ import threading
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from bt_lsp.rules.context import facts_of
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -56,6 +56,7 @@ WORKER_CHARS = 256 * 1024
 CPP_WORKER_CHARS = 32 * 1024
 
 Key = tuple[int | None, int, int]
+R = TypeVar("R")
 PUBLISH_DIAGNOSTICS = "textDocument/publishDiagnostics"
 _EARLY_WAIT = 1.0  # seconds the worker waits at most for the loop to publish the names
 
@@ -120,11 +121,22 @@ class Background:
         self._pool: ThreadPoolExecutor | None = None
         self._jobs: dict[str, _Job] = {}
         self._held: dict[str, _Held] = {}  # documents being prepared, by URI
+        self._aside: ThreadPoolExecutor | None = None
 
     def _worker(self) -> ThreadPoolExecutor:
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bt-lsp-analysis")
         return self._pool
+
+    def aside(self, func: Callable[..., R], *args: Any) -> asyncio.Future[R]:
+        """``func(*args)`` on a thread of its own (not the worker's, which may be busy with
+        an analysis for seconds): a request about the whole of a large document (its
+        outline, its folding ranges), made from a snapshot taken on the loop.  On the loop
+        it held every other request for as long (a second at 8 MB, two while an analysis
+        shared the interpreter); there, the loop answers them meanwhile."""
+        if self._aside is None:
+            self._aside = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bt-lsp-requests")
+        return asyncio.get_running_loop().run_in_executor(self._aside, func, *args)
 
     # -- preparing a large document --------------------------------------------------------
 
@@ -319,5 +331,6 @@ class Background:
         self._jobs.pop(uri, None)
 
     def shutdown(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
+        for pool in (self._pool, self._aside):
+            if pool is not None:
+                pool.shutdown(wait=False, cancel_futures=True)

@@ -380,13 +380,25 @@ def folding_json(od: OpenDocument) -> RawJson:
     kept = od.folding
     if kept is not None and kept[0] == od.version:
         return RawJson(kept[1])
+    od.folding = (od.version, folding_text(od.doc))
+    return RawJson(od.folding[1])
+
+
+def folding_text(doc: Document) -> str:
+    """The JSON text of the document's folding ranges."""
     text = ", ".join(
         f'{{"startLine": {f.start_line}, "endLine": {f.end_line}, '
         f'"kind": "{"comment" if f.comment else "region"}"}}'
-        for f in folding_ranges(od.doc)
+        for f in folding_ranges(doc)
     )
-    od.folding = (od.version, f"[{text}]")
-    return RawJson(od.folding[1])
+    return f"[{text}]"
+
+
+def _snapshot(od: OpenDocument) -> Document:
+    """A copy of the open document for another thread: its model made first (after an
+    edit, only the sections the edit touched), so that both do not make it."""
+    _ = od.doc.model
+    return od.doc.snapshot()
 
 
 # --- features -----------------------------------------------------------------------------
@@ -488,11 +500,15 @@ def register(server: BtServer) -> None:
         return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources, what)
 
     @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
-    def document_symbol(ls: BtServer, params: types.DocumentSymbolParams) -> RawJson | None:
+    async def document_symbol(ls: BtServer, params: types.DocumentSymbolParams) -> RawJson | None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
-        return outline_json(od.doc, context_of(ls, od), ls.encoding)
+        ctx = context_of(ls, od)
+        if not ls.background.wants(od):
+            return outline_json(od.doc, ctx, ls.encoding)
+        # A large document's: beside the loop, which answers the other requests meanwhile.
+        return await ls.background.aside(outline_json, _snapshot(od), ctx, ls.encoding)
 
     @server.feature(types.WORKSPACE_SYMBOL)
     def workspace_symbol(
@@ -517,11 +533,18 @@ def register(server: BtServer) -> None:
         return out
 
     @server.feature(types.TEXT_DOCUMENT_FOLDING_RANGE)
-    def folding_range(ls: BtServer, params: types.FoldingRangeParams) -> RawJson | None:
+    async def folding_range(ls: BtServer, params: types.FoldingRangeParams) -> RawJson | None:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
-        return folding_json(od)
+        kept = od.folding
+        if (kept is not None and kept[0] == od.version) or not ls.background.wants(od):
+            return folding_json(od)
+        version = od.version
+        text = await ls.background.aside(folding_text, _snapshot(od))
+        if od.version == version:  # (else an edit came meanwhile: not the current ones)
+            od.folding = (version, text)
+        return RawJson(text)
 
     @server.feature(types.TEXT_DOCUMENT_LINKED_EDITING_RANGE)
     def linked_editing_range(
