@@ -164,3 +164,55 @@ def test_each_tree_costs_the_rules_a_bounded_number_of_objects() -> None:
     # them.  A dict of lookups, a result list per section or a set of all sections would
     # add more than one each.
     assert per_tree < 13, per_tree
+
+
+def _too_many(text: str) -> str:
+    diags = analyze(Document(text))
+    assert len(diags) == 2001
+    return diags[-1].message
+
+
+def test_a_repeated_tag_past_the_cap_is_counted_exactly() -> None:
+    # Each <Frob/> is unknown-node: 5,000 findings, 2,000 kept; each of 4,500 <Fr.ob/>
+    # breaks a name rule (which the name rules count without making it).
+    assert _too_many(HEAD + "<Frob/>" * 5000 + TAIL).startswith("3000 more problems")
+    mixed = HEAD + "<Frob/><Fr.ob/>" * 1500 + "<AlwaysSuccess/>" * 10 + "<Fr.ob/>" * 3000 + TAIL
+    # 1,500 unknown-node, 4,500 model-name-forbidden-char.
+    assert _too_many(mixed).startswith(f"{1500 + 4500 - 2000} more problems")
+
+
+def test_depth_over_the_limit_is_flagged_on_a_repeated_tag_in_each_tree() -> None:
+    # Every <Inverter> has one child: from the second on, each is remembered by its tag.
+    deep = "<Inverter>" * 300 + "<AlwaysSuccess/>" + "</Inverter>" * 300
+    text = (
+        '<root BTCPP_format="4" main_tree_to_execute="A">'
+        f'<BehaviorTree ID="A">{deep}</BehaviorTree>'
+        f'<BehaviorTree ID="B">{deep}</BehaviorTree></root>'
+    )
+    a = text.index(">", text.index('ID="A"')) + 1
+    b = text.index(">", text.index('ID="B"')) + 1
+    step = len("<Inverter>")
+    # Depth: <root> 0, <BehaviorTree> 1, the first <Inverter> 2; flagged past 257.
+    expected = [a + 256 * step + 1, b + 256 * step + 1]
+    assert _codes_at(text, "nesting-depth") == expected
+
+
+def test_findings_of_repeated_tags_move_with_their_section_after_an_edit() -> None:
+    body = "<Sequence>" + "<Frob/><Fr.ob/>" * 50 + "</Sequence>"
+    text = (
+        '<root BTCPP_format="4" main_tree_to_execute="A">'
+        f'<BehaviorTree ID="A">{body}</BehaviorTree>\n'
+        f'<BehaviorTree ID="B">{body}</BehaviorTree></root>'
+    )
+    doc = Document(text)
+    before = [(d.start, d.code) for d in analyze(doc)]
+    at = text.index("<Frob/>")
+    doc.edit(at, at, "<Frob/>")
+    after = [(d.start, d.code) for d in analyze(doc)]
+    fresh = [(d.start, d.code) for d in analyze(Document(doc.text))]
+    assert after == fresh
+    b = text.index('ID="B"')
+    moved = [(s + 7, c) for s, c in before if s > b]
+    assert [x for x in after if x[0] > b + 7] == moved
+    assert len([c for _, c in moved if c == "unknown-node"]) == 50
+    assert len([c for _, c in moved if c == "model-name-forbidden-char"]) == 50

@@ -9,6 +9,7 @@ import weakref
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from itertools import chain, compress, count
+from operator import or_
 from typing import TYPE_CHECKING, Final
 
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
@@ -244,7 +245,79 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     symbols (:meth:`Section.symbols`) on the way.  Each distinct start tag is checked once
     (equal tags are one token); once ``out`` holds twice :data:`MAX_DIAGNOSTICS`, only the
     first by position are kept and later findings past them are counted, not made: the
-    count returned."""
+    count returned.
+
+    The section's rows are told apart by tag and zone in C, from its columns, and only
+    those whose tag has findings are read one by one (a document may be a million
+    ``<A/>``); but in a section with port declarations, whose names depend on their entry
+    (:func:`_element_name_diagnostics`)."""
+    els = section.elements
+    rows = els.rows
+    cols = els.columns
+    lo, n = rows.start, len(rows)
+    zones = cols.zones[lo : lo + n]
+    if _PORT_DECL in zones:
+        return _element_name_diagnostics(section, out)
+    tags = cols.tags[lo : lo + n]
+    keys = list(map(or_, map(_SHIFTED, map(id, tags)), zones))  # as _TAG_NAMES's
+    symbols: dict[Symbol, None] = {}
+    # What the tags with findings find, by key.
+    bad: dict[int, tuple[tuple[int, int, str, str, Severity, NameData], ...]] = {}
+    hits: list[tuple[int, tuple[tuple[int, int, str, str, Severity, NameData], ...]]] = []
+    root = section.root
+    if root is not None and root.zone not in _NAMELESS:  # the head's: read first
+        found = _tag_names(root, None)
+        symbols.update(dict.fromkeys(found[1]))
+        if found[0]:
+            hits.append((root.token_start, found[0]))
+    shared = _TAG_NAMES
+    nameless = _NAMELESS_ZONES
+    # Each key once, in the order of its first row (with one of its rows).
+    for key, i in dict(zip(keys, range(n), strict=True)).items():
+        if key & 15 in nameless:
+            continue
+        tag = tags[i]
+        hit = shared.get(key)
+        if hit is not None and hit[0] is tag:
+            found = hit[1]
+        else:
+            found = _tag_names(els[i], None)
+            if len(shared) >= _MAX_CACHED:
+                shared.clear()
+            shared[key] = (tag, found)
+        symbols.update(dict.fromkeys(found[1]))
+        if found[0]:
+            bad[key] = found[0]
+    more = 0
+    if bad or hits:
+        starts = cols.starts
+        at = els.origin
+        limit: tuple[int, int, str] | None = None
+        picked = compress(range(lo, lo + n), map(bad.__contains__, keys))
+        for ts, findings in chain(hits, ((starts[k] + at, bad[keys[k - lo]]) for k in picked)):
+            for rs, re_, code, message, severity, data in findings:
+                start, end = ts + rs, ts + re_
+                if limit is not None and (start, end, code) >= limit:
+                    more += 1  # past the first MAX_DIAGNOSTICS found: never kept
+                    continue
+                out.append(Diagnostic(start, end, code, message, severity, data))
+                if len(out) >= 2 * MAX_DIAGNOSTICS:
+                    out.sort(key=sort_key)  # stable: the first found first among equals
+                    more += len(out) - MAX_DIAGNOSTICS
+                    del out[MAX_DIAGNOSTICS:]
+                    limit = sort_key(out[-1])
+    if "symbols" not in section.cache:  # what Section.symbols() would make from its names
+        section.cache["symbols"] = tuple(symbols)
+    return more
+
+
+_PORT_DECL: Final = int(Zone.PORT_DECL)
+_NAMELESS_ZONES: Final = frozenset(map(int, _NAMELESS))
+_SHIFTED: Final = (4).__rlshift__  # x -> x << 4
+
+
+def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
+    """:func:`_section_name_diagnostics` element by element."""
     seen: dict[int, _TagNames] = {}  # this section's tags (alive while it runs)
     shared = _TAG_NAMES
     symbols: dict[Symbol, None] = {}

@@ -21,6 +21,7 @@ from bt_lsp.rules.decls import DocumentFacts, FactsLayout, ModelDecl, TreeDecl
 from bt_lsp.syntax.elements import Element, Zone
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
+from bt_lsp.syntax.table import ElementTable
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document, History
@@ -242,7 +243,7 @@ def _extract_into(
     entry: _OpenEntry | None = None
     # Members bound once: reading one from its enum class is slow in Python 3.11.
     node, tree_zone, entry_zone, port_zone = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
-    for el in elements:
+    for el in _declaring(elements):
         zone = el.zone
         if zone == node:
             if tree is not None and el.name == "SubTree":
@@ -289,6 +290,25 @@ def _extract_into(
     if entry is not None:
         decl = entry.close(path, origin)
         (subtree_models if decl.category == "SubTree" else models).append(decl)
+
+
+def _declaring(elements: Iterable[Element]) -> Iterable[Element]:
+    """``elements`` but the nodes other than ``<SubTree>`` (which declare nothing): of a
+    section's columns, those rows are passed over in C without being made."""
+    if not isinstance(elements, ElementTable):
+        return elements
+    rows = elements.rows
+    cols = elements.columns
+    lo, hi = rows.start, rows.stop
+    tags = cols.tags[lo:hi]
+    calls = {
+        k for k, t in dict(zip(map(id, tags), tags, strict=True)).items() if t.name == "SubTree"
+    }
+    kept = map(or_, map(_NOT_NODE, cols.zones[lo:hi]), map(calls.__contains__, map(id, tags)))
+    return map(elements.__getitem__, compress(range(hi - lo), kept))
+
+
+_NOT_NODE: Final = int(Zone.NODE).__ne__
 
 
 @dataclass(slots=True)

@@ -143,6 +143,17 @@ class ElementTable(Sequence[Element]):
         """Whether its elements are kept once made (see :func:`keeps`)."""
         return self._keep
 
+    @property
+    def rows(self) -> range:
+        """The rows of :attr:`columns` it reads (element ``i`` is row ``rows[i]``)."""
+        return range(self._lo, self._hi)
+
+    @property
+    def origin(self) -> int:
+        """What a row's start is moved by: element ``i`` starts at
+        ``columns.starts[rows[i]] + origin``."""
+        return self._place.origin
+
     def placed(self, origin: int, tok_origin: int, base: int) -> ElementTable:
         """The same rows placed elsewhere."""
         return ElementTable(

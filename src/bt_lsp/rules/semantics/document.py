@@ -74,7 +74,7 @@ NESTING_DEPTH: Final = define(
 MAX_DEPTH: Final = 256
 # Element depth in the model: <root> 0, <BehaviorTree> 1, so a node at model depth d is
 # d - 1 levels below its tree.
-_MODEL_DEPTH_LIMIT: Final = MAX_DEPTH + 1
+DEPTH_LIMIT: Final = MAX_DEPTH + 1
 
 _ID_TAGS: Final = EXPLICIT_TAGS | {"SubTree"}
 
@@ -190,7 +190,7 @@ def _check_include(st: State, el: Element) -> None:
 
 def check_depth(st: State, el: Element, tree_flagged: list[bool]) -> None:
     """Report the first element of a tree that is nested too deep."""
-    if el.depth > _MODEL_DEPTH_LIMIT and not tree_flagged[0]:
+    if el.depth > DEPTH_LIMIT and not tree_flagged[0]:
         tree_flagged[0] = True
         st.add(
             el.name_start,
