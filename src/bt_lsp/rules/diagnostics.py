@@ -6,9 +6,10 @@ workspace live in :mod:`bt_lsp.rules.semantics` and are combined in :mod:`bt_lsp
 from __future__ import annotations
 
 import weakref
+from array import array
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from itertools import chain, compress, count
+from itertools import chain, compress, count, islice
 from operator import or_
 from typing import TYPE_CHECKING, Final
 
@@ -258,8 +259,9 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     zones = cols.zones[lo : lo + n]
     if _PORT_DECL in zones:
         return _element_name_diagnostics(section, out)
-    tags = cols.tags[lo : lo + n]
-    keys = list(map(or_, map(_SHIFTED, map(id, tags)), zones))  # as _TAG_NAMES's
+    tags = cols.tags
+    # As _TAG_NAMES's, as machine integers (a list of them would cost 40 bytes a row).
+    keys = array("q", map(or_, map(_SHIFTED, map(id, islice(tags, lo, lo + n))), zones))
     symbols: dict[Symbol, None] = {}
     # What the tags with findings find, by key.
     bad: dict[int, tuple[tuple[int, int, str, str, Severity, NameData], ...]] = {}
@@ -276,7 +278,7 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     for key, i in dict(zip(keys, range(n), strict=True)).items():
         if key & 15 in nameless:
             continue
-        tag = tags[i]
+        tag = tags[lo + i]
         hit = shared.get(key)
         if hit is not None and hit[0] is tag:
             found = hit[1]

@@ -18,6 +18,7 @@ Each module's docstring lists its codes with their severity and range.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import islice
 from typing import TYPE_CHECKING, Literal
 
 from bt_lsp.rules.context import Context
@@ -119,7 +120,7 @@ def _check_rows(st: State, els: ElementTable) -> None:
         cols.child_n,
     )
     limit = document.DEPTH_LIMIT
-    deep = max(depths[rows.start : rows.stop]) > limit  # else no element is too deep
+    deep = max(islice(depths, rows.start, rows.stop)) > limit  # else no element is too deep
     scope = TreeScope(None)
     memo = st.tags.get
     shared = st.shared_tags.get if st.shared_tags is not None else None
