@@ -250,9 +250,11 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
 
     The section's rows are told apart by tag and zone in C, from its columns, and only
     those whose tag has findings are read one by one (a document may be a million
-    ``<A/>``); but in a section with port declarations, whose names depend on their entry
-    (:func:`_element_name_diagnostics`)."""
+    ``<A/>``); but in a section whose elements are kept (made once) or with port
+    declarations, whose names depend on their entry (:func:`_element_name_diagnostics`)."""
     els = section.elements
+    if els.kept:  # its elements are made once: read as they are
+        return _element_name_diagnostics(section, out)
     rows = els.rows
     cols = els.columns
     lo, n = rows.start, len(rows)

@@ -295,7 +295,7 @@ def _extract_into(
 def _declaring(elements: Iterable[Element]) -> Iterable[Element]:
     """``elements`` but the nodes other than ``<SubTree>`` (which declare nothing): of a
     section's columns, those rows are passed over in C without being made."""
-    if not isinstance(elements, ElementTable):
+    if not isinstance(elements, ElementTable) or elements.kept:  # made once: read as they are
         return elements
     rows = elements.rows
     cols = elements.columns

@@ -64,8 +64,9 @@ def check_elements(st: State, elements: Sequence[Element]) -> None:
     the run, or for every run of the check when they looked nothing up in the context
     (a built-in node): a document of a hundred thousand ``<Frob/>`` checks one, and one of
     twenty thousand trees its ``<Sequence>`` once.  A section's elements are read from its
-    columns (:func:`_check_rows`): an element is made only where a rule reads it."""
-    if isinstance(elements, ElementTable):
+    columns (:func:`_check_rows`): an element is made only where a rule reads it (but
+    where its elements are kept, made once: they are read as they are)."""
+    if isinstance(elements, ElementTable) and not elements.kept:
         _check_rows(st, elements)
         return
     scope = TreeScope(None)
