@@ -26,7 +26,7 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan
 from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
 from bt_lsp.syntax.table import ZONES as _ZONES
-from bt_lsp.syntax.table import Columns, ElementTable, keeps, offsets_code
+from bt_lsp.syntax.table import Columns, ElementTable, Growing, keeps, offsets_code
 from bt_lsp.syntax.tokens import XML_SYNTAX, Kind, Token
 from bt_lsp.syntax.values import decode_value
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
@@ -77,7 +77,7 @@ class _Builder:
         text: str,
         origin: int,
         tok_origin: int,
-        cols: Columns,
+        cols: Growing,
         stack: list[int],
         has_root: bool,
     ) -> None:
@@ -351,12 +351,14 @@ class _Builder:
         if end == CLOSED:
             at = cols.starts[0]
             root_end = (at + cols.extents[0], at + cols.names_at[0])
+        # A small section's columns cost more than its rows unless packed (see table.py).
+        done: Columns = cols.packed() if cols.packs() else cols
         return Section(
             ntokens,
             length,
-            ElementTable(cols, 0, 0, 1, keep=keeps(length, len(cols) - 1)),
-            self.problems,
-            self.lexical,
+            ElementTable(done, 0, 0, 1, keep=keeps(length, len(cols) - 1)),
+            self.problems or (),  # (an empty tuple is shared)
+            self.lexical or (),
             end,
             root_end,
             root,
@@ -364,7 +366,7 @@ class _Builder:
 
 
 def _stand_in(
-    cols: Columns, tag: Token, start: int, tindex: int, extent: int, name_at: int
+    cols: Growing, tag: Token, start: int, tindex: int, extent: int, name_at: int
 ) -> None:
     """Write row 0: the root, as a section or the tail is built with it."""
     cols.tags.append(tag)
@@ -384,7 +386,7 @@ def _section(
 ) -> tuple[Section, int, int]:
     """The section that starts at token ``i`` (a start tag with only the root open)."""
     origin = starts[i]
-    cols = Columns(code)
+    cols = Growing(code)
     _stand_in(cols, root_tag, -origin, -i, -1, -1)
     b = _Builder(text, origin, i, cols, [0], True)
     j, end = b.run(tokens, starts, i, _SECTION)
@@ -407,7 +409,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     starts: Sequence[int] = scan.starts if change is not None else scan.starts.toarray()
     n = len(tokens)
     code = offsets_code(len(text))
-    hcols = Columns(code)
+    hcols = Growing(code)
     hb = _Builder(text, 0, 0, hcols, [], False)
     i, state = hb.run(tokens, starts, 0, _HEAD)
     root_tag = hcols.tags[0] if hcols.tags else None
@@ -479,7 +481,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
             assert re_ is not None
             o = origins[-1] - root_start
             extent, name_at = re_[0] + o, re_[1] + o if re_[1] >= 0 else -1
-        tcols = Columns(code)
+        tcols = Growing(code)
         _stand_in(tcols, root_tag, root_start, root_tindex, extent, name_at)
         tb = _Builder(text, 0, 0, tcols, [0] if state != CLOSED else [], True)
         tb.run(tokens, starts, i, _TAIL)

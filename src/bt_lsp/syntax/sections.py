@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections import OrderedDict
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 from bt_lsp.syntax.elements import (
@@ -64,8 +64,8 @@ class Section:
         ntokens: int,
         length: int,
         elements: ElementTable,
-        problems: list[StructureProblem],
-        lexical: list[StructureProblem],
+        problems: Sequence[StructureProblem],
+        lexical: Sequence[StructureProblem],
         end: int,
         root_end: tuple[int, int] | None,
         root: Element | None = None,

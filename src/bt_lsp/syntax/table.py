@@ -7,15 +7,20 @@ text.  A row of the columns costs about 45 bytes: the start tag (a token shared 
 tags), machine integers for the offsets and indexes, a byte for the zone; children are one
 flat array with each element's slice of it.  An :class:`~bt_lsp.syntax.elements.Element`
 is made when read, many at a time in C when the rows are iterated, and not kept.
+
+A document may also be made of 20,000 small trees, each a section of a few rows: there
+the columns' objects cost more than their rows (nine arrays of 80 bytes or more, 14 MB
+for 2 MB of text), so a small section's columns are packed into one array once built
+(:class:`Packed`, about 270 bytes for a tree of four elements instead of 1,300).
 """
 
 from __future__ import annotations
 
 from array import array
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from itertools import chain, repeat
 from operator import itemgetter
-from typing import overload
+from typing import TypeAlias, overload
 
 from bt_lsp.syntax.elements import NO_CHILDREN, Element, Zone, of_row
 from bt_lsp.syntax.tokens import Token
@@ -28,6 +33,18 @@ _ATTRS = itemgetter(6)  # Token.attrs
 _SMALL = 2**31 - 1
 # Rows made at a time when the elements are iterated.
 _CHUNK = 512
+# Sections of at most this many rows are packed (a column read of them copies its slice).
+PACKED_ROWS = 64
+# The contents of columns without port declarations (shared).
+_NO_CONTENTS: Mapping[int, str] = {}
+
+# A row's values as :meth:`Columns.row` gives them (seven).
+_Row: TypeAlias = Sequence[int]
+# Rows ``a .. b - 1`` as :meth:`Columns.window` gives them: zones, starts, token indexes,
+# parents, depths, extents and end tags' names.
+_Window: TypeAlias = (
+    "tuple[Sequence[int], array[int], array[int], array[int], array[int], array[int], array[int]]"
+)
 
 
 def offsets_code(length: int) -> str:
@@ -36,10 +53,106 @@ def offsets_code(length: int) -> str:
 
 
 class Columns:
-    """The elements a builder made, one row each (row 0 is the root, or the stand-in for
-    it that a section is built with).  Offsets are relative to the builder's origin; an
+    """The elements of a section, one row each (row 0 is the root, or the stand-in for
+    it that a section is built with).  Offsets are relative to the section's origin; an
     element's end and its end tag's name are relative to its own start, so that they do
-    not move with it."""
+    not move with it.
+
+    Read as columns by name (``tags``, ``zones``, ``starts``, ``tindex``, ``parents``,
+    ``depths``, ``extents``, ``names_at``, ``child_at``, ``child_n``, ``flat``,
+    ``contents``) from either kind: :class:`Growing` as the builder writes them, or
+    :class:`Packed`.  Row ``k``'s children are
+    ``flat[child_at[k] : child_at[k] + child_n[k]]``.
+
+    Columns are also where the elements of their own table find their children and
+    content (a place with no shift: see :class:`_Placement`), which saves an object per
+    section."""
+
+    __slots__ = ()
+
+    # As a place: at the origin (see _Placement).
+    origin = 0
+    tok_origin = 0
+    base = 1
+
+    @property
+    def cols(self) -> Columns:
+        return self
+
+    @property
+    def tags(self) -> list[Token]:
+        raise NotImplementedError
+
+    @property
+    def zones(self) -> bytearray:
+        raise NotImplementedError
+
+    @property
+    def starts(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def tindex(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def parents(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def depths(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def extents(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def names_at(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def child_at(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def child_n(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def flat(self) -> array[int]:
+        raise NotImplementedError
+
+    @property
+    def contents(self) -> Mapping[int, str]:
+        """Port declarations' text, by row."""
+        raise NotImplementedError
+
+    def __len__(self) -> int:
+        return len(self.tags)
+
+    def row(self, k: int) -> _Row:
+        """Row ``k``: zone, start, token index, parent, depth, extent, end tag's name."""
+        raise NotImplementedError
+
+    def window(self, a: int, b: int) -> _Window:
+        """Rows ``a .. b - 1`` by column (see ``_Window``)."""
+        raise NotImplementedError
+
+    def children_of(self, local: int) -> Sequence[int]:
+        """Row ``local``'s children (rows)."""
+        raise NotImplementedError
+
+    def content_of(self, local: int) -> str | None:
+        return self.contents.get(local)
+
+    def element(self, k: int) -> Element:
+        """Row ``k`` as an element of these coordinates."""
+        return ElementTable(self, 0, 0, 1, k, k + 1)[0]
+
+
+class Growing(Columns):
+    """Columns as the builder writes them: one array (or list) each."""
 
     __slots__ = (
         "child_at",
@@ -58,25 +171,170 @@ class Columns:
 
     def __init__(self, code: str) -> None:
         self.tags: list[Token] = []
-        self.zones = bytearray()
+        self.zones: bytearray = bytearray()
         self.starts: array[int] = array(code)
         self.tindex: array[int] = array("i")
         self.parents: array[int] = array("i")
         self.depths: array[int] = array("i")
         self.extents: array[int] = array(code)
         self.names_at: array[int] = array(code)
-        # Row k's children are flat[child_at[k] : child_at[k] + child_n[k]].
         self.child_at: array[int] = array("i")
         self.child_n: array[int] = array("i")
         self.flat: array[int] = array("i")
-        self.contents: dict[int, str] = {}  # port declarations' text, by row
+        self.contents: dict[int, str] = {}
 
-    def __len__(self) -> int:
-        return len(self.tags)
+    def row(self, k: int) -> _Row:
+        return (
+            self.zones[k],
+            self.starts[k],
+            self.tindex[k],
+            self.parents[k],
+            self.depths[k],
+            self.extents[k],
+            self.names_at[k],
+        )
 
-    def element(self, k: int) -> Element:
-        """Row ``k`` as an element of these coordinates."""
-        return ElementTable(self, 0, 0, 1, k, k + 1)[0]
+    def window(self, a: int, b: int) -> _Window:
+        return (
+            self.zones[a:b],
+            self.starts[a:b],
+            self.tindex[a:b],
+            self.parents[a:b],
+            self.depths[a:b],
+            self.extents[a:b],
+            self.names_at[a:b],
+        )
+
+    def children_of(self, local: int) -> Sequence[int]:
+        n = self.child_n[local]
+        if not n:
+            return NO_CHILDREN
+        at = self.child_at[local]
+        return self.flat[at : at + n]
+
+    def packs(self) -> bool:
+        """Whether these columns are better packed: few rows, offsets of 4 bytes."""
+        return len(self.tags) <= PACKED_ROWS and self.starts.typecode == "i"
+
+    def packed(self) -> Packed:
+        """The same columns in one array (see :class:`Packed`)."""
+        return Packed(self)
+
+
+# Where each column starts in a packed array, in rows (the flat children follow them):
+# the columns of a row as Columns.row gives them first, so that a row is one slice.
+_ZONE, _STARTS, _TINDEX, _PARENTS, _DEPTHS, _EXTENTS, _NAMES_AT, _CHILD_AT, _CHILD_N = range(9)
+_ROW = 7
+_FLAT = 9
+
+
+class Packed(Columns):
+    """Columns of a few rows, finished, in one array of machine integers: column ``j``
+    is ``ints[j * n : (j + 1) * n]`` for ``n`` rows (zones too), then the flat children.
+    A column read by name is a copy of its slice (of a few rows: cheap); the table reads
+    rows and windows from the one array."""
+
+    __slots__ = ("_contents", "_ints", "_tags")
+
+    def __init__(self, cols: Growing) -> None:
+        self._tags = cols.tags[:]  # exactly as long
+        ints = array("i")
+        ints.frombytes(
+            b"".join(
+                (
+                    array("i", iter(cols.zones)),
+                    cols.starts,
+                    cols.tindex,
+                    cols.parents,
+                    cols.depths,
+                    cols.extents,
+                    cols.names_at,
+                    cols.child_at,
+                    cols.child_n,
+                    cols.flat,
+                )
+            )
+        )
+        self._ints = ints[:]  # exactly as long
+        self._contents: Mapping[int, str] = cols.contents or _NO_CONTENTS
+
+    def _column(self, j: int) -> array[int]:
+        n = len(self._tags)
+        return self._ints[j * n : (j + 1) * n]
+
+    @property
+    def tags(self) -> list[Token]:
+        return self._tags
+
+    @property
+    def zones(self) -> bytearray:
+        return bytearray(self._column(_ZONE).tolist())
+
+    @property
+    def starts(self) -> array[int]:
+        return self._column(_STARTS)
+
+    @property
+    def tindex(self) -> array[int]:
+        return self._column(_TINDEX)
+
+    @property
+    def parents(self) -> array[int]:
+        return self._column(_PARENTS)
+
+    @property
+    def depths(self) -> array[int]:
+        return self._column(_DEPTHS)
+
+    @property
+    def extents(self) -> array[int]:
+        return self._column(_EXTENTS)
+
+    @property
+    def names_at(self) -> array[int]:
+        return self._column(_NAMES_AT)
+
+    @property
+    def child_at(self) -> array[int]:
+        return self._column(_CHILD_AT)
+
+    @property
+    def child_n(self) -> array[int]:
+        return self._column(_CHILD_N)
+
+    @property
+    def flat(self) -> array[int]:
+        return self._ints[_FLAT * len(self._tags) :]
+
+    @property
+    def contents(self) -> Mapping[int, str]:
+        return self._contents
+
+    def row(self, k: int) -> _Row:
+        n = len(self._tags)
+        return self._ints[k : _ROW * n : n]
+
+    def window(self, a: int, b: int) -> _Window:
+        ints = self._ints
+        n = len(self._tags)
+        return (
+            ints[a:b],
+            ints[n + a : n + b],
+            ints[2 * n + a : 2 * n + b],
+            ints[3 * n + a : 3 * n + b],
+            ints[4 * n + a : 4 * n + b],
+            ints[5 * n + a : 5 * n + b],
+            ints[6 * n + a : 6 * n + b],
+        )
+
+    def children_of(self, local: int) -> Sequence[int]:
+        ints = self._ints
+        n = len(self._tags)
+        count = ints[_CHILD_N * n + local]
+        if not count:
+            return NO_CHILDREN
+        at = _FLAT * n + ints[_CHILD_AT * n + local]
+        return ints[at : at + count]
 
 
 class _Placement:
@@ -84,7 +342,7 @@ class _Placement:
     and ``base - 1`` elements further on (a local row ``k > 0`` is element
     ``base - 1 + k`` there; row 0, the root, stays element 0).  An element read from
     them finds its children and content here (it refers to this, not to the table that
-    may keep it: no cycle)."""
+    may keep it: no cycle).  Columns are their own placement at their origin."""
 
     __slots__ = ("base", "cols", "origin", "tok_origin")
 
@@ -95,17 +353,18 @@ class _Placement:
         self.base = base
 
     def children_of(self, local: int) -> Sequence[int]:
-        c = self.cols
-        n = c.child_n[local]
-        if not n:
-            return NO_CHILDREN
-        at = c.child_at[local]
-        kids = c.flat[at : at + n]
+        kids = self.cols.children_of(local)
         shift = self.base - 1
-        return array("i", map(shift.__add__, kids)) if shift else kids
+        return array("i", map(shift.__add__, kids)) if shift and kids else kids
 
     def content_of(self, local: int) -> str | None:
         return self.cols.contents.get(local)
+
+
+def _placement(cols: Columns, origin: int, tok_origin: int, base: int) -> _Placement | Columns:
+    if origin == 0 and tok_origin == 0 and base == 1:
+        return cols
+    return _Placement(cols, origin, tok_origin, base)
 
 
 class ElementTable(Sequence[Element]):
@@ -128,7 +387,7 @@ class ElementTable(Sequence[Element]):
         hi: int = -1,
         keep: bool = False,
     ) -> None:
-        self._place = _Placement(cols, origin, tok_origin, base)
+        self._place = _placement(cols, origin, tok_origin, base)
         self._lo = lo
         self._hi = len(cols.tags) if hi < 0 else hi
         self._keep = keep
@@ -189,16 +448,16 @@ class ElementTable(Sequence[Element]):
         k = self._lo + i
         pl = self._place
         c = pl.cols
-        p = c.parents[k]
+        z, s, t, p, d, e, na = c.row(k)
         return of_row(
             c.tags[k],
-            ZONES[c.zones[k]],
-            c.starts[k] + pl.origin,
-            c.tindex[k] + pl.tok_origin,
+            ZONES[z],
+            s + pl.origin,
+            t + pl.tok_origin,
             p + pl.base - 1 if p > 0 else p,
-            c.depths[k],
-            c.extents[k],
-            c.names_at[k],
+            d,
+            e,
+            na,
             pl,
             k,
         )
@@ -223,7 +482,8 @@ class ElementTable(Sequence[Element]):
         c = pl.cols
         origin, tok_origin, shift = pl.origin, pl.tok_origin, pl.base - 1
         tags = c.tags[a:b]
-        parents: Iterator[int] | array[int] = c.parents[a:b]
+        zones, starts, tindex, parents_, depths, extents, names_at = c.window(a, b)
+        parents: Iterator[int] | array[int] = parents_
         if shift and min(parents, default=1) <= 0:  # the root's children: not moved
             parents = (p + shift if p > 0 else p for p in parents)
         elif shift:
@@ -235,13 +495,13 @@ class ElementTable(Sequence[Element]):
                 tags,
                 map(_NAME, tags),
                 map(_ATTRS, tags),
-                map(ZONES.__getitem__, c.zones[a:b]),
-                map(origin.__add__, c.starts[a:b]) if origin else c.starts[a:b],
-                map(tok_origin.__add__, c.tindex[a:b]) if tok_origin else c.tindex[a:b],
+                map(ZONES.__getitem__, zones),
+                map(origin.__add__, starts) if origin else starts,
+                map(tok_origin.__add__, tindex) if tok_origin else tindex,
                 parents,
-                c.depths[a:b],
-                c.extents[a:b],
-                c.names_at[a:b],
+                depths,
+                extents,
+                names_at,
                 repeat(pl),
                 range(a, b),
             ),
