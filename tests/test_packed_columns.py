@@ -79,3 +79,50 @@ def test_packed_sections_read_as_the_columns_written(trees: list[str], data: st.
     doc.edit(at, at, new)
     edited = text[:at] + new + text[at:]
     assert _all(doc) == _unpacked(edited, monkeypatch)
+
+
+def _columns(cols: table.Columns) -> tuple[Any, ...]:
+    n = len(cols)
+    named = (
+        cols.tags,
+        cols.zones,
+        cols.starts,
+        cols.tindex,
+        cols.parents,
+        cols.depths,
+        cols.extents,
+        cols.names_at,
+        cols.child_at,
+        cols.child_n,
+        cols.flat,
+    )
+    return (
+        [list(c) for c in named],
+        [list(cols.row(k)) for k in range(n)],
+        [[list(c) for c in cols.window(a, n)] for a in range(n)],
+        [list(cols.window(0, b)[1]) for b in range(n + 1)],
+        [list(cols.children_of(k)) for k in range(n)],
+        dict(cols.contents),
+    )
+
+
+def test_short_and_long_packed_columns_read_as_written(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two bytes an integer where they fit: trees far (over 32 KiB) from the root's start
+    keep the root's offsets apart; a tree of a few rows over 32 KiB long keeps four."""
+    far = "<!--" + "x" * 40_000 + "-->"
+    text = _text(
+        [f"<Sequence><Frob/>{far}</Sequence>", "<Frob/>", '<SubTree ID="T1"/><Frob/>', "<Frob/>"]
+    )
+    doc = Document(text)
+    sections = [p.section for p in doc.model.parts()]
+    packed = [s.elements.columns for s in sections]
+    kinds = {c._ints.typecode for c in packed if isinstance(c, table.Packed)}
+    assert kinds == {"h", "i"}
+    with monkeypatch.context() as m:
+        m.setattr(table, "PACKED_ROWS", 0)
+        plain = [p.section.elements.columns for p in Document(text).model.parts()]
+    assert all(isinstance(c, table.Growing) for c in plain)
+    assert [_columns(c) for c in packed] == [_columns(c) for c in plain]
+    root_starts = [c.starts[0] for c in packed[1:]]
+    assert min(root_starts) < -(1 << 15)  # the root's start, kept apart, read back whole
+    assert _all(doc) == _unpacked(text, monkeypatch)

@@ -292,27 +292,46 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
         symbols.update(dict.fromkeys(found[1]))
         if found[0]:
             bad[key] = found[0]
-    more = 0
+    placer = _Placer(out)
     if bad or hits:
         starts = cols.starts
         at = els.origin
-        limit: tuple[int, int, str] | None = None
         picked = compress(range(lo, lo + n), map(bad.__contains__, keys))
         for ts, findings in chain(hits, ((starts[k] + at, bad[keys[k - lo]]) for k in picked)):
-            for rs, re_, code, message, severity, data in findings:
-                start, end = ts + rs, ts + re_
-                if limit is not None and (start, end, code) >= limit:
-                    more += 1  # past the first MAX_DIAGNOSTICS found: never kept
-                    continue
-                out.append(Diagnostic(start, end, code, message, severity, data))
-                if len(out) >= 2 * MAX_DIAGNOSTICS:
-                    out.sort(key=sort_key)  # stable: the first found first among equals
-                    more += len(out) - MAX_DIAGNOSTICS
-                    del out[MAX_DIAGNOSTICS:]
-                    limit = sort_key(out[-1])
+            placer.place(ts, findings)
     if "symbols" not in section.cache:  # what Section.symbols() would make from its names
         section.cache["symbols"] = tuple(symbols)
-    return more
+    return placer.more
+
+
+class _Placer:
+    """Places a tag's findings (:data:`_TagNames`) at its start into ``out``, keeping the
+    first :data:`MAX_DIAGNOSTICS` by position: once ``out`` holds twice as many, the rest
+    are cut, and later findings past the last kept are counted (``more``), not made."""
+
+    __slots__ = ("limit", "more", "out")
+
+    def __init__(self, out: list[Diagnostic]) -> None:
+        self.out = out
+        self.more = 0
+        self.limit: tuple[int, int, str] | None = None
+
+    def place(
+        self, ts: int, findings: tuple[tuple[int, int, str, str, Severity, NameData], ...]
+    ) -> None:
+        out = self.out
+        for rs, re_, code, message, severity, data in findings:
+            start, end = ts + rs, ts + re_
+            limit = self.limit
+            if limit is not None and (start, end, code) >= limit:
+                self.more += 1  # past the first MAX_DIAGNOSTICS found: never kept
+                continue
+            out.append(Diagnostic(start, end, code, message, severity, data))
+            if len(out) >= 2 * MAX_DIAGNOSTICS:
+                out.sort(key=sort_key)  # stable: the first found first among equals
+                self.more += len(out) - MAX_DIAGNOSTICS
+                del out[MAX_DIAGNOSTICS:]
+                self.limit = sort_key(out[-1])
 
 
 _PORT_DECL: Final = int(Zone.PORT_DECL)
@@ -325,8 +344,7 @@ def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     seen: dict[int, _TagNames] = {}  # this section's tags (alive while it runs)
     shared = _TAG_NAMES
     symbols: dict[Symbol, None] = {}
-    more = 0
-    limit: tuple[int, int, str] | None = None
+    placer = _Placer(out)
     els = section.elements
     root = section.root
     nameless = _NAMELESS
@@ -354,23 +372,11 @@ def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
                 seen[key] = found
             for symbol in found[1]:
                 symbols[symbol] = None
-        if not found[0]:
-            continue
-        ts = el.token_start
-        for rs, re_, code, message, severity, data in found[0]:
-            start, end = ts + rs, ts + re_
-            if limit is not None and (start, end, code) >= limit:
-                more += 1  # past the first MAX_DIAGNOSTICS found: never kept
-                continue
-            out.append(Diagnostic(start, end, code, message, severity, data))
-            if len(out) >= 2 * MAX_DIAGNOSTICS:
-                out.sort(key=sort_key)  # stable: the first found first among equals
-                more += len(out) - MAX_DIAGNOSTICS
-                del out[MAX_DIAGNOSTICS:]
-                limit = sort_key(out[-1])
+        if found[0]:
+            placer.place(el.token_start, found[0])
     if "symbols" not in section.cache:  # what Section.symbols() would make from its names
         section.cache["symbols"] = tuple(symbols)
-    return more
+    return placer.more
 
 
 def compute(doc: Document) -> Capped:

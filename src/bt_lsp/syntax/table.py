@@ -80,7 +80,7 @@ class Columns:
         return self
 
     @property
-    def tags(self) -> list[Token]:
+    def tags(self) -> Sequence[Token]:
         raise NotImplementedError
 
     @property
@@ -226,18 +226,25 @@ class Growing(Columns):
 _ZONE, _STARTS, _TINDEX, _PARENTS, _DEPTHS, _EXTENTS, _NAMES_AT, _CHILD_AT, _CHILD_N = range(9)
 _ROW = 7
 _FLAT = 9
+_SHORT = 1 << 15  # what an array("h") holds: -_SHORT to _SHORT - 1
+
+
+def _low(v: int) -> int:
+    """The low 16 bits of ``v`` as a signed short (``v >> 16`` is the high ones)."""
+    return ((v & 0xFFFF) ^ 0x8000) - 0x8000
 
 
 class Packed(Columns):
-    """Columns of a few rows, finished, in one array of machine integers: column ``j``
-    is ``ints[j * n : (j + 1) * n]`` for ``n`` rows (zones too), then the flat children.
+    """Columns of a few rows, finished, in one array of machine integers (of two bytes
+    each where they fit, four otherwise): column ``j`` is ``ints[j * n : (j + 1) * n]``
+    for ``n`` rows (zones too), then the flat children.
     A column read by name is a copy of its slice (of a few rows: cheap); the table reads
     rows and windows from the one array."""
 
     __slots__ = ("_contents", "_ints", "_tags")
 
     def __init__(self, cols: Growing) -> None:
-        self._tags = cols.tags[:]  # exactly as long
+        self._tags = tuple(cols.tags)  # exactly as long (a list's items are one more block)
         ints = array("i")
         ints.frombytes(
             b"".join(
@@ -255,15 +262,43 @@ class Packed(Columns):
                 )
             )
         )
-        self._ints = ints[:]  # exactly as long
+        # Two bytes an integer where every one fits (a section of under 32 KiB): a small
+        # section's columns are then half as large.  The root's start and token index
+        # (row 0: where the document's root is, before the section) grow with the
+        # document: they follow the rest, two halves each (see _root).
+        n = len(self._tags)
+        root = (ints[_STARTS * n], ints[_TINDEX * n]) if n else (0, 0)
+        if n:
+            ints[_STARTS * n] = ints[_TINDEX * n] = 0
+        if n and min(ints) >= -_SHORT and max(ints) < _SHORT:
+            ints.extend(half for v in root for half in (_low(v), v >> 16))
+            self._ints = array("h", ints.tolist())  # exactly as long
+        else:
+            if n:
+                ints[_STARTS * n], ints[_TINDEX * n] = root
+            self._ints = ints[:]  # exactly as long
         self._contents: Mapping[int, str] = cols.contents or _NO_CONTENTS
+
+    def _root(self) -> tuple[int, int] | None:
+        """The root row's start and token index when kept apart (a short array)."""
+        ints = self._ints
+        if ints.typecode != "h":
+            return None
+        s_lo, s_hi, t_lo, t_hi = ints[-4:]
+        return (s_hi << 16) + (s_lo & 0xFFFF), (t_hi << 16) + (t_lo & 0xFFFF)
 
     def _column(self, j: int) -> array[int]:
         n = len(self._tags)
-        return self._ints[j * n : (j + 1) * n]
+        col = self._ints[j * n : (j + 1) * n]
+        if j in (_STARTS, _TINDEX):
+            root = self._root()
+            if root is not None:
+                col = array("i", col)
+                col[0] = root[j - _STARTS]
+        return col
 
     @property
-    def tags(self) -> list[Token]:
+    def tags(self) -> Sequence[Token]:
         return self._tags
 
     @property
@@ -304,7 +339,8 @@ class Packed(Columns):
 
     @property
     def flat(self) -> array[int]:
-        return self._ints[_FLAT * len(self._tags) :]
+        ints = self._ints
+        return ints[_FLAT * len(self._tags) : len(ints) - 4 if ints.typecode == "h" else None]
 
     @property
     def contents(self) -> Mapping[int, str]:
@@ -312,15 +348,27 @@ class Packed(Columns):
 
     def row(self, k: int) -> _Row:
         n = len(self._tags)
-        return self._ints[k : _ROW * n : n]
+        found = self._ints[k : _ROW * n : n]
+        root = None if k else self._root()
+        if root is None:
+            return found
+        row = array("i", found)
+        row[_STARTS], row[_TINDEX] = root
+        return row
 
     def window(self, a: int, b: int) -> _Window:
         ints = self._ints
         n = len(self._tags)
+        starts = ints[n + a : n + b]
+        tindex = ints[2 * n + a : 2 * n + b]
+        root = self._root() if a == 0 and b > 0 else None
+        if root is not None:
+            starts, tindex = array("i", starts), array("i", tindex)
+            starts[0], tindex[0] = root
         return (
             ints[a:b],
-            ints[n + a : n + b],
-            ints[2 * n + a : 2 * n + b],
+            starts,
+            tindex,
             ints[3 * n + a : 3 * n + b],
             ints[4 * n + a : 4 * n + b],
             ints[5 * n + a : 5 * n + b],
