@@ -418,9 +418,9 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     model.head_ntokens = i
     root: Element | None = None
     sections: list[Section] = []
-    origins: list[int] = []
-    firsts: list[int] = []
-    bases: list[int] = []
+    origins: array[int] = array("q")
+    firsts: array[int] = array("q")
+    bases: array[int] = array("q")
     names: list[str] = []
     if state == OPEN and root_tag is not None:
         base = 1

@@ -11,6 +11,7 @@ coordinates, made when first asked for; the elements are read from the sections'
 
 from __future__ import annotations
 
+from array import array
 from bisect import bisect_right
 from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from itertools import accumulate, compress, count
@@ -148,9 +149,10 @@ class Model:
         self.head: Section | None = None  # None for a model that is not made of sections
         self.head_ntokens = 0
         self.sections: list[Section] = []
-        self.origins: list[int] = []
-        self.firsts: list[int] = []
-        self.bases: list[int] = []
+        # Machine integers: a list's cost 40 bytes each, and there may be 20,000 sections.
+        self.origins: array[int] = array("q")
+        self.firsts: array[int] = array("q")
+        self.bases: array[int] = array("q")
         self.top_names: list[str] = []  # the name of each section's top element
         self.sections_end = 0
         self.tail: Section | None = None
