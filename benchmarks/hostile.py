@@ -2,8 +2,10 @@
 
 For each input a fresh ``bt-lsp serve`` opens a small document, then the input; right
 after the input's ``didOpen`` it asks for a hover on the small document. Printed per
-input: its size, the time from the open to its complete diagnostics (those holding
-``unknown-node``, which only the complete analysis reports), the hover's round trip
+input: its size, the time from the open to its first diagnostics (from 256 KiB on, the
+name diagnostics published first) and to its complete diagnostics (those holding
+``unknown-node``, which only the complete analysis reports; above ``maxDocumentBytes``,
+those holding ``document-too-large``, as only the XML and name checks run), the hover's round trip
 while the input is analysed, and the server's peak RSS (VmHWM) above its RSS before the
 open, as a multiple of the input's size.
 
@@ -32,8 +34,8 @@ END = "</BehaviorTree>\n</root>\n"
 SMALL = TREE + "<AlwaysSuccess/>\n" + END
 
 
-def _realistic() -> str:
-    text = generate(8 * MIB - 4096, seed=1).text
+def _realistic(size: int = 8 * MIB - 4096) -> str:
+    text = generate(size, seed=1).text
     return text.replace("</BehaviorTree>", "<Frob/></BehaviorTree>", 1)
 
 
@@ -50,6 +52,9 @@ INPUTS: dict[str, Callable[[], str]] = {
     "elements": lambda: _sequence("<Frob/>" * 100_000),
     "attributed": lambda: _sequence(
         "".join(f'<Frob a="1" b="x" c="{k}"/>' for k in range(100_000))
+    ),
+    "attributed-8mib": lambda: _sequence(
+        "".join(f'<Frob a="1" b="x" c="{k}"/>' for k in range(280_000))
     ),
     "pairs": lambda: _sequence("<Sequence><Frob/></Sequence>" * 50_000),
     "texts": lambda: _sequence("<Frob/>text<!-- note -->" * 100_000),
@@ -85,7 +90,13 @@ INPUTS: dict[str, Callable[[], str]] = {
     ),
     "deep": lambda: TREE + "<Sequence>" * 10_000 + "<Frob/>" + "</Sequence>" * 10_000 + END,
     "single_line": lambda: _realistic().replace("\n", " "),
+    # Above the default maxDocumentBytes (8 MiB): the too-large path, capped like the others.
+    "over_limit": lambda: _realistic(10 * MIB).replace("\n", " "),
 }
+
+#: The code that marks a complete publication: only the full analysis reports
+#: ``unknown-node``; above ``maxDocumentBytes`` the publication says the document is too large.
+LIMIT = 8 * MIB
 
 
 async def measure(name: str, text: str) -> dict[str, float]:
@@ -102,22 +113,24 @@ async def measure(name: str, text: str) -> dict[str, float]:
         before = rss_kib(client.pid)
         uri = f"untitled:{name}.xml"
         item = {"uri": uri, "languageId": "xml", "version": 1, "text": text}
+        done = "document-too-large" if len(text.encode("utf-8")) > LIMIT else "unknown-node"
+        first = client.expect_diagnostics(uri, 1)
         opened = time.perf_counter()
         client.notify("textDocument/didOpen", {"textDocument": item})
         _, hover_seconds = await client.request_timed("textDocument/hover", hover, 600)
         while True:  # the complete set, not the early names published first
             fut = client.expect_diagnostics(uri, 1)
             latest = client.latest(uri)
-            if latest is not None and any(
-                d.get("code") == "unknown-node" for d in latest.diagnostics
-            ):
+            if latest is not None and any(d.get("code") == done for d in latest.diagnostics):
                 published = latest
                 break
             await asyncio.wait_for(fut, 600)
         size = len(text.encode("utf-8"))
+        first_at = (await asyncio.wait_for(first, 1)).at
         peak = rss_kib(client.pid, "VmHWM")
         return {
             "size": size,
+            "first_s": first_at - opened,
             "diagnostics_s": published.at - opened,
             "hover_s": hover_seconds,
             "rss_peak_mib": peak / 1024,
@@ -134,12 +147,16 @@ def main(argv: list[str] | None = None) -> int:
     unknown = set(args.inputs) - set(INPUTS)
     if unknown:
         parser.error(f"unknown inputs: {', '.join(sorted(unknown))}")
-    print("| input | size | open → diagnostics | hover meanwhile | peak RSS | peak / size |")
-    print("|---|---|---|---|---|---|")
+    print(
+        "| input | size | open → first diagnostics | open → complete diagnostics "
+        "| hover meanwhile | peak RSS | peak / size |"
+    )
+    print("|---|---|---|---|---|---|---|")
     for name in args.inputs or list(INPUTS):
         r = asyncio.run(measure(name, INPUTS[name]()))
         print(
-            f"| {name} | {r['size'] / MIB:.1f} MiB | {r['diagnostics_s']:.1f} s "
+            f"| {name} | {r['size'] / MIB:.1f} MiB | {r['first_s']:.1f} s "
+            f"| {r['diagnostics_s']:.1f} s "
             f"| {r['hover_s']:.2f} s | {r['rss_peak_mib']:.0f} MiB | {r['ratio']:.1f}× |",
             flush=True,
         )
