@@ -186,6 +186,17 @@ def test_broken_headers_then_serving_on(server: RawServer, header: bytes) -> Non
     assert server.proc.poll() is None
 
 
+def test_a_length_without_a_body_leaves_the_next_message_whole(fresh: RawServer) -> None:
+    """A repeated Content-Length whose body never came: the bytes it counts are the next
+    message's header, which is read as such, so the message after is answered too."""
+    server = fresh
+    nxt = frame(msg("bt-lsp/noSuchRequest", {}, 102), b"content-LENGTH: %d\r\n\r\n")
+    server.write(b"Content-Length: 5\r\nContent-Length: 7\r\n\r\n" + nxt)
+    assert server.answer(102)["error"]["code"] == -32601
+    assert any("but no body" in m for m in server.logs())
+    assert not any(m.get("id", 0) is None for m in server.seen)  # no parse error answered
+
+
 def test_a_message_without_content_length_is_still_read(server: RawServer) -> None:
     before = len(server.logs())
     server.write(b"Content-Type: x\r\n\r\n" + body_of(msg("bt-lsp/noSuchRequest", {}, 98)))
@@ -265,6 +276,8 @@ def test_before_initialize() -> None:
         )
         assert s.answer_to(msg("textDocument/hover", hover, 1))["error"]["code"] == -32002
         assert s.answer_to(msg("shutdown", None, 2))["error"]["code"] == -32002
+        # Whatever its params: the lifecycle answers before their shape is checked.
+        assert s.answer_to(msg("textDocument/hover", {}, 6))["error"]["code"] == -32002
         s.initialize()
         # The didOpen before initialize was dropped: the document is unknown, no diagnostics.
         answer = s.answer_to(msg("textDocument/hover", hover, 3))
@@ -272,6 +285,7 @@ def test_before_initialize() -> None:
         assert not any(m.get("method") == "textDocument/publishDiagnostics" for m in s.seen)
         second = s.answer_to(msg("initialize", INIT_PARAMS, 4))
         assert second["error"]["code"] == -32600
+        assert s.answer_to(msg("initialize", {}, 7))["error"]["code"] == -32600
         s.still_serving(5)
     finally:
         s.close()

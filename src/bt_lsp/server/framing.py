@@ -62,6 +62,10 @@ class Stream:
     def buffered(self) -> bytes:
         return bytes(self._buf)
 
+    def peek(self, n: int) -> bytes:
+        """The next ``n`` bytes read but not taken (fewer if fewer are)."""
+        return bytes(self._buf[:n])
+
     def drop(self, n: int) -> None:
         del self._buf[:n]
 
@@ -172,7 +176,9 @@ class Framer:
             raw = await self.stream.exactly(n)
             if raw is None:
                 return None
-            return await self._decode(raw, n)
+            body = await self._decode(raw, n, seen)
+            if body is not None:
+                return body
 
     async def _headers(self) -> tuple[dict[bytes, bytes], bytes] | None:
         fields: dict[bytes, bytes] = {}
@@ -215,11 +221,19 @@ class Framer:
         self.stream.drop(lead + len(text[:end].encode("utf-8")))
         return Body(value)
 
-    async def _decode(self, raw: bytes, n: int) -> Body:
+    async def _decode(self, raw: bytes, n: int, seen: bytes) -> Body | None:
+        """The message whose body is ``raw``, as far as it can be told from the bytes
+        around it; ``None`` if there is no body (the caller reads the next message)."""
         try:
             return Body(json.loads(raw))
         except (ValueError, UnicodeDecodeError):
             pass
+        if MARKER.match((raw[:64] + self.stream.peek(32)).lstrip()):
+            # No body at all: the length ran into the next message's header (after a
+            # repeated Content-Length, say), which is read as the next message.
+            self._framing_error(f"Content-Length {n} but no body", seen)
+            self.stream.unread(raw)
+            return None
         text = raw.decode("utf-8", "replace")
         stripped = text.lstrip()
         try:

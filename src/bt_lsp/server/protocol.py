@@ -23,7 +23,6 @@ from pygls.exceptions import (
     JsonRpcException,
     JsonRpcInternalError,
     JsonRpcInvalidParams,
-    JsonRpcInvalidRequest,
 )
 from pygls.protocol import LanguageServerProtocol, lsp_method
 
@@ -148,11 +147,16 @@ class BtProtocol(LanguageServerProtocol):
 
     def structure_message(self, data: dict[str, Any]) -> Any:
         """A request whose params do not have its method's shape is answered with an
-        InvalidParams error; pygls only logs it, and the client would wait forever."""
+        InvalidParams error; pygls only logs it, and the client would wait forever.  One
+        that the lifecycle refuses (:meth:`_refusal`) gets that error whatever its params."""
         try:
             return super().structure_message(data)
         except JsonRpcException as exc:
             if isinstance(data, dict) and "id" in data and "method" in data:
+                refusal = self._refusal(data["method"])
+                if refusal is not None:
+                    self._send_error(data["id"], *refusal)
+                    raise
                 cause = exc.__cause__
                 detail = (
                     "; ".join(transform_error(cause))
@@ -217,28 +221,14 @@ class BtProtocol(LanguageServerProtocol):
         ``shutdown``, requests get InvalidRequest as LSP asks (pygls drops them silently,
         which leaves a client waiting); notifications other than ``exit`` are ignored."""
         method = getattr(message, "method", None)
-        msg_id = getattr(message, "id", None)
-        is_request = method is not None and hasattr(message, "id")
-        if method == types.INITIALIZE and is_request:
-            if self._initialize_seen:
-                self._send_error(msg_id, jsonrpc.INVALID_REQUEST, "initialize was already received")
+        if method is not None and hasattr(message, "id"):  # a request
+            refusal = self._refusal(method)
+            if refusal is not None:
+                self._send_error(message.id, *refusal)
                 return
-            self._initialize_seen = True
+            if method == types.INITIALIZE:
+                self._initialize_seen = True
         elif not self._initialize_seen and method is not None and method != types.EXIT:
-            if is_request:
-                self._send_error(
-                    msg_id, jsonrpc.SERVER_NOT_INITIALIZED, f"{method} before initialize"
-                )
-            return
-        if (
-            self._shutdown
-            and getattr(message, "method", types.EXIT) != types.EXIT
-            and getattr(message, "id", None) is not None
-        ):
-            self._send_response(
-                message.id,
-                error=JsonRpcInvalidRequest("the server is shut down").to_response_error(),
-            )
             return
         background = getattr(self._server, "background", None)
         if background is not None and background.holds(message):
@@ -251,6 +241,18 @@ class BtProtocol(LanguageServerProtocol):
             self._send_error(message.params.id, REQUEST_CANCELLED, "the request was cancelled")
             return
         super().handle_message(message)
+
+    def _refusal(self, method: str) -> tuple[int, str] | None:
+        """The error a request for ``method`` gets from the lifecycle, whatever its params:
+        before ``initialize`` ServerNotInitialized, a second ``initialize`` or any request
+        after ``shutdown`` InvalidRequest (LSP); ``None`` if it is served."""
+        if method == types.INITIALIZE and self._initialize_seen:
+            return jsonrpc.INVALID_REQUEST, "initialize was already received"
+        if not self._initialize_seen and method not in (types.INITIALIZE, types.EXIT):
+            return jsonrpc.SERVER_NOT_INITIALIZED, f"{method} before initialize"
+        if self._shutdown and method != types.EXIT:
+            return jsonrpc.INVALID_REQUEST, "the server is shut down"
+        return None
 
     def _forward(self, method: str, params: Any) -> Generator[Any, Any, None]:
         handler = self.fm.features.get(method)
