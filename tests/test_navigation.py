@@ -14,7 +14,7 @@ from bt_lsp.ide.catalog import BUILTIN_CATALOG, builtin_catalog
 from bt_lsp.ide.definition import definition
 from bt_lsp.ide.folding import Fold, folding_ranges, linked_editing_ranges
 from bt_lsp.ide.places import Place
-from bt_lsp.ide.references import highlights, references
+from bt_lsp.ide.references import MAX_HIGHLIGHTS, highlights, references
 from bt_lsp.ide.rename import RenameRefused, prepare_rename, rename
 from bt_lsp.ide.symbols import DocSymbol, SymbolKind, document_symbols, workspace_symbols
 from bt_lsp.project.index import ProjectIndex, links, normalize
@@ -227,6 +227,31 @@ def test_highlights_mark_declarations_as_writes() -> None:
     found = highlights(doc, off)
     assert [(h.start, h.end) for h in found] == spans
     assert [h.write for h in found] == [False, True, True]
+
+
+@pytest.mark.parametrize("where", [0.0, 0.5, 1.0])
+def test_highlights_are_those_nearest_the_cursor(where: float) -> None:
+    """A name used more than MAX_HIGHLIGHTS times gets that many highlights, the nearest
+    to the cursor in document order (the cursor's own among them)."""
+    n = MAX_HIGHLIGHTS * 3
+    text = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
+        + '<Frob a="1"/>' * n
+        + '</Sequence></BehaviorTree><BehaviorTree ID="U"><Frob/></BehaviorTree></root>'
+    )
+    doc = Document(text)
+    uses = [i + 1 for i in range(len(text)) if text.startswith("<Frob", i)]
+    at = uses[min(int(where * len(uses)), len(uses) - 1)] + 2
+    found = highlights(doc, at)
+    assert len(found) == MAX_HIGHLIGHTS
+    starts = [h.start for h in found]
+    assert starts == sorted(starts)
+    k = uses.index(starts[0])
+    assert starts == uses[k : k + MAX_HIGHLIGHTS]  # a run of neighbours, none skipped
+    assert any(h.start <= at <= h.end for h in found)
+    # Centred on the cursor's use, shifted where the document begins or ends.
+    c = next(i for i, u in enumerate(uses) if u <= at <= u + 4)
+    assert k == max(0, min(c - MAX_HIGHLIGHTS // 2, len(uses) - MAX_HIGHLIGHTS))
 
 
 def test_highlights_of_a_compact_node_include_end_tags() -> None:

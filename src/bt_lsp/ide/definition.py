@@ -21,14 +21,15 @@ from bt_lsp.syntax.elements import PortSymbol, Role, Symbol, model_symbol, tree_
 def _declarations(
     doc: Document, others: Mapping[str, Document], symbol: Symbol, role: Role
 ) -> list[Place]:
-    """Occurrences of ``symbol`` in the ``role`` that declares it: this document's first."""
-    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(symbol) if r.role == role]
+    """Occurrences of ``symbol`` in the ``role`` that declares it: this document's first
+    (read from the declaring elements only, not from every use of the name)."""
+    own = [Place(None, r.start, r.end) for r in doc.model.declarations_of(symbol) if r.role == role]
     if own:
         return own
     return [
         Place(path, r.start, r.end)
         for path, d in others.items()
-        for r in d.model.refs_to(symbol)
+        for r in d.model.declarations_of(symbol)
         if r.role == role
     ]
 
@@ -41,7 +42,11 @@ def _tree_definition(
     doc: Document, others: Mapping[str, Document], ctx: Context | None, tree_id: str
 ) -> list[Place]:
     sym = tree_symbol(tree_id)
-    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.TREE_DEF]
+    own = [
+        Place(None, r.start, r.end)
+        for r in doc.model.declarations_of(sym)
+        if r.role == Role.TREE_DEF
+    ]
     if own:
         return own
     if ctx is not None:
@@ -56,7 +61,11 @@ def _model_definition(
     doc: Document, others: Mapping[str, Document], ctx: Context | None, model_id: str
 ) -> list[Place]:
     sym = model_symbol(model_id)
-    own = [Place(None, r.start, r.end) for r in doc.model.refs_to(sym) if r.role == Role.MODEL_DEF]
+    own = [
+        Place(None, r.start, r.end)
+        for r in doc.model.declarations_of(sym)
+        if r.role == Role.MODEL_DEF
+    ]
     if own:
         return own
     if ctx is not None:

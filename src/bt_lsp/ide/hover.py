@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, tree_keys
-from bt_lsp.ide.name_edits import elsewhere, occurrences
+from bt_lsp.ide.name_edits import elsewhere
 from bt_lsp.ide.name_fixes import preferred_renaming
 from bt_lsp.ide.ports import builtins_in, ports_of
 from bt_lsp.rules.builtins import PortModel
@@ -327,7 +327,11 @@ def hover_at(
         _bad_name(w, doc, ref, others, ctx)
     else:
         w.title(_what(w, ref))
-        decl = [r for r in occurrences(model, ref) if r.role in DECLARING_ROLES]
+        decl = (
+            model.declarations_of(ref.symbol)
+            if ref.symbol is not None
+            else [ref] * (ref.role in DECLARING_ROLES)
+        )
         if decl:
             line = doc.lines.position(decl[0].start, "utf-32")[0] + 1
             w.para(f"Declared at line {line} ({decl[0].role}).")

@@ -17,7 +17,14 @@ from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from itertools import accumulate, compress, count
 from typing import Any, overload
 
-from bt_lsp.syntax.elements import Element, NameRef, StructureProblem, Symbol, Zone
+from bt_lsp.syntax.elements import (
+    DECLARING_ROLES,
+    Element,
+    NameRef,
+    StructureProblem,
+    Symbol,
+    Zone,
+)
 from bt_lsp.syntax.gcpause import gc_paused
 from bt_lsp.syntax.sections import Part, Section, section_top
 from bt_lsp.syntax.table import ElementTable, Prefixed
@@ -221,6 +228,21 @@ class Model:
 
     def refs_to(self, symbol: Symbol) -> list[NameRef]:
         return self.by_symbol.get(symbol, [])
+
+    def declarations_of(self, symbol: Symbol) -> list[NameRef]:
+        """The names that declare ``symbol`` (:data:`DECLARING_ROLES`), in document order:
+        those of :meth:`refs_to` that declare, read from the declaring elements of each
+        section only (:meth:`Section.declaring_refs`), not from every use."""
+        if self.head is None:
+            return [r for r in self.refs_to(symbol) if r.role in DECLARING_ROLES]
+        out: list[NameRef] = []
+        for part in self.parts():
+            sec = part.section
+            known: tuple[Symbol, ...] | None = sec.cache.get("symbols")
+            if known is not None and symbol not in known:
+                continue
+            out.extend(part.ref(r) for r in sec.declaring_refs() if r.symbol == symbol)
+        return out
 
     @property
     def by_symbol(self) -> Mapping[Symbol, list[NameRef]]:

@@ -15,6 +15,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any, Final
 
 from bt_lsp.syntax.elements import (
+    DECLARING_ROLES,
     EXPLICIT_TAGS,
     Element,
     NameRef,
@@ -31,6 +32,8 @@ from bt_lsp.syntax.tokens import Token
 _ROLE_NODE_TYPE_END = Role.NODE_TYPE_END
 _ZONE_NODE = Zone.NODE
 _ZONE_PORT_DECL = Zone.PORT_DECL
+# The zones of the elements whose names may declare (see nametokens.name_refs).
+_DECLARING_ZONES: Final = (Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL)
 
 _new = tuple.__new__
 
@@ -236,12 +239,98 @@ class Section(SectionMemo):
                 refs.clear()
 
     def ref_at(self, offset: int) -> NameRef | None:
-        """The name token containing local ``offset`` (see :meth:`Model.ref_at`)."""
+        """The name token containing local ``offset`` (see :meth:`Model.ref_at`).  In a
+        large section whose names are not made yet, read from the one tag that holds it:
+        making them all to find one took seconds in a tree of a million elements, at the
+        first hover after each edit."""
+        if len(self.elements.rows) > _FEW and self not in _RECENT_REFS:
+            found = self.ref_in_tag(offset)
+            if not isinstance(found, _Unsure):
+                return found
         refs = self.refs
         i = bisect_right([r.start for r in refs], offset) - 1
         if i >= 0 and refs[i].start <= offset <= refs[i].end:
             return refs[i]
         return None
+
+    def ref_in_tag(self, offset: int) -> NameRef | _Unsure | None:
+        """The name token at local ``offset``, as :meth:`ref_at` finds it among all the
+        section's names, read from the tag that holds ``offset``; :data:`UNSURE` where that
+        tag alone cannot tell (a tag's first character, which an unterminated name
+        before it may end at; a name-less end tag or text that one may end at).
+
+        Names lie inside their tags and tags do not overlap, so the names of the start
+        tag holding ``offset`` (found by its start, in C) or of the end tag holding it
+        (that of the innermost element around it, found up its ancestors) are the only
+        candidates."""
+        els = self.elements
+        root = self.root
+        if root is not None and root.token_start <= offset <= root.token_start + root.length:
+            return self._in_start_tag(root, 0, None, offset)
+        rows = els.rows
+        r = bisect_right(els.columns.starts, offset - els.origin, rows.start, rows.stop) - 1
+        if r < rows.start:
+            return UNSURE
+        k = r - rows.start
+        el = els[k]
+        if offset <= el.token_start + el.length:
+            p = el.parent
+            parent = els[p - 1] if p > 0 and el.zone == _ZONE_PORT_DECL else None
+            return self._in_start_tag(el, k + 1, parent, offset)
+        # Up from the last element started before ``offset``: its end tag, or an
+        # ancestor's, is the one that can hold ``offset``.
+        i = k + 1
+        while True:
+            ens = el.end_name_start
+            if ens >= 0 and ens <= offset <= ens + len(el.name):
+                if el.zone != _ZONE_NODE:
+                    return UNSURE
+                return _end_ref(el.name, ens, i)
+            end = el.end  # (-1: never closed, so an ancestor's end tag may hold it)
+            if end > offset or el.parent <= 0:
+                return UNSURE if end == offset else None
+            i = el.parent
+            el = els[i - 1]
+
+    @staticmethod
+    def _in_start_tag(
+        el: Element, i: int, parent: Element | None, offset: int
+    ) -> NameRef | _Unsure | None:
+        if offset == el.token_start:
+            return UNSURE
+        refs: list[NameRef] = []
+        name_refs(el, i, parent, refs)
+        best: NameRef | None = None
+        for r in refs:  # the last to start at or before ``offset``, as ref_at's bisect
+            if r.start <= offset and (best is None or r.start >= best.start):
+                best = r
+        return best if best is not None and offset <= best.end else None
+
+    def declaring_refs(self) -> list[NameRef]:
+        """The section's names that declare (tree IDs, model entries, port declarations:
+        :data:`DECLARING_ROLES`), in order, made from the elements of the zones that hold
+        them only (found in its zones column, in C): a tree of a million node uses
+        declares nothing, and a hover asks what declares a name."""
+        refs = _RECENT_REFS.get(self)
+        if refs is not None:
+            return [r for r in refs if r.role in DECLARING_ROLES]
+        els = self.elements
+        rows = els.rows
+        zones = els.columns.zones
+        found: list[int] = []
+        for zone in _DECLARING_ZONES:
+            at = zones.find(zone, rows.start, rows.stop)
+            while at >= 0:
+                found.append(at)
+                at = zones.find(zone, at + 1, rows.stop)
+        out: list[NameRef] = []
+        for r in sorted(found):
+            k = r - rows.start
+            el = els[k]
+            p = el.parent
+            name_refs(el, k + 1, els[p - 1] if p > 0 and el.zone == _ZONE_PORT_DECL else None, out)
+        out.sort(key=_start)
+        return [r for r in out if r.role in DECLARING_ROLES]
 
     def symbols(self) -> tuple[Symbol, ...]:
         """The symbols the section's names refer to (found when its names are first made,
@@ -258,6 +347,17 @@ class Section(SectionMemo):
 
 
 _RECENT_REFS: OrderedDict[Section, list[NameRef]] = OrderedDict()
+# A section of more elements finds the name at an offset from its tag (Section.ref_at).
+_FEW: Final = 256
+
+
+class _Unsure:
+    """What :meth:`Section.ref_in_tag` answers where one tag cannot tell."""
+
+    __slots__ = ()
+
+
+UNSURE: Final = _Unsure()
 
 
 class Part:
