@@ -2,12 +2,13 @@
 
 For each input a fresh ``bt-lsp serve`` opens a small document, then the input; right
 after the input's ``didOpen`` it asks for a hover on the small document. Printed per
-input: its size, the time from the open to its first diagnostics (from 256 KiB on, the
+input: its size; the time from the open to its first diagnostics (from 256 KiB on, the
 name diagnostics published first) and to its complete diagnostics (those holding
 ``unknown-node``, which only the complete analysis reports; above ``maxDocumentBytes``,
-those holding ``document-too-large``, as only the XML and name checks run), the hover's round trip
-while the input is analysed, and the server's peak RSS (VmHWM) above its RSS before the
-open, as a multiple of the input's size.
+those holding ``document-too-large``, as only the XML and name checks run); the hover's
+round trip while the input is analysed; a hover on the input's first ``<Frob>`` once it
+is; and the server's peak RSS (VmHWM) above its RSS before the open, as a multiple of the
+input's size.
 
     python benchmarks/hostile.py                 # every input
     python benchmarks/hostile.py duplicates      # some of them
@@ -128,11 +129,21 @@ async def measure(name: str, text: str) -> dict[str, float]:
         size = len(text.encode("utf-8"))
         first_at = (await asyncio.wait_for(first, 1)).at
         peak = rss_kib(client.pid, "VmHWM")
+        # Then a hover on the input itself, on its first <Frob> (the first after the
+        # analysis: what it gathers is made once per version).
+        at = text.index("<Frob") + 2
+        line = text.count("\n", 0, at)
+        here = {
+            "textDocument": {"uri": uri},
+            "position": {"line": line, "character": at - (text.rfind("\n", 0, at) + 1)},
+        }
+        _, own_hover_seconds = await client.request_timed("textDocument/hover", here, 600)
         return {
             "size": size,
             "first_s": first_at - opened,
             "diagnostics_s": published.at - opened,
             "hover_s": hover_seconds,
+            "own_hover_s": own_hover_seconds,
             "rss_peak_mib": peak / 1024,
             "ratio": (peak - before) * 1024 / size,
         }
@@ -149,15 +160,16 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown inputs: {', '.join(sorted(unknown))}")
     print(
         "| input | size | open → first diagnostics | open → complete diagnostics "
-        "| hover meanwhile | peak RSS | peak / size |"
+        "| hover meanwhile | hover on it then | peak RSS | peak / size |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for name in args.inputs or list(INPUTS):
         r = asyncio.run(measure(name, INPUTS[name]()))
         print(
             f"| {name} | {r['size'] / MIB:.1f} MiB | {r['first_s']:.1f} s "
             f"| {r['diagnostics_s']:.1f} s "
-            f"| {r['hover_s']:.2f} s | {r['rss_peak_mib']:.0f} MiB | {r['ratio']:.1f}× |",
+            f"| {r['hover_s']:.2f} s | {r['own_hover_s']:.2f} s "
+            f"| {r['rss_peak_mib']:.0f} MiB | {r['ratio']:.1f}× |",
             flush=True,
         )
     return 0
