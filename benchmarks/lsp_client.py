@@ -210,6 +210,16 @@ class LspClient:
     def latest(self, uri: str) -> Published | None:
         return self._published.get(uri)
 
+    async def complete(self, uri: str, code: str = "unknown-node") -> Published:
+        """The first diagnostics of ``uri`` that hold ``code``: only the complete analysis
+        reports ``unknown-node``, not the names published first."""
+        while True:
+            fut = self.expect_diagnostics(uri, 1)
+            latest = self.latest(uri)
+            if latest is not None and any(d.get("code") == code for d in latest.diagnostics):
+                return latest
+            await asyncio.wait_for(fut, 600)
+
     async def published_count(self, uri: str, count: int, timeout: float = 600.0) -> Published:
         """The latest diagnostics of ``uri`` once ``count`` publications of it arrived (a
         large document's name diagnostics come first, then the complete set); their

@@ -36,12 +36,7 @@ MIB = 1024 * 1024
 
 async def _complete(client: LspClient, uri: str) -> None:
     """Wait for the complete diagnostics of ``uri`` (those holding ``unknown-node``)."""
-    while True:
-        fut = client.expect_diagnostics(uri, 1)
-        latest = client.latest(uri)
-        if latest is not None and any(d.get("code") == "unknown-node" for d in latest.diagnostics):
-            return
-        await asyncio.wait_for(fut, 600)
+    await client.complete(uri)
 
 
 async def outline() -> None:

@@ -19,7 +19,7 @@ from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for_name
 from bt_lsp.project.index import normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
-from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edit, workspace_edit
+from bt_lsp.server.convert import to_diagnostic, to_offsets, to_text_edits, workspace_edit
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit
@@ -49,7 +49,7 @@ def _workspace_edit(
     their own line index; versioned when they are open in the editor)."""
     enc = ls.encoding
     per_uri: list[tuple[str, int | None, list[types.TextEdit]]] = [
-        (od.uri, od.version, [to_text_edit(od.doc.lines, e, enc) for e in edits])
+        (od.uri, od.version, to_text_edits(od.doc.lines, edits, enc))
     ]
     for path, file_edits in (other_edits or {}).items():
         doc = ls.project.document(normalize(path))
@@ -58,7 +58,7 @@ def _workspace_edit(
         uri = from_fs_path(path) or path
         open_doc = ls.get(uri)
         version = open_doc.version if open_doc is not None else None
-        per_uri.append((uri, version, [to_text_edit(doc.lines, e, enc) for e in file_edits]))
+        per_uri.append((uri, version, to_text_edits(doc.lines, file_edits, enc)))
     return workspace_edit(per_uri, ls.versioned_edits, ls.annotated_edits, what)
 
 

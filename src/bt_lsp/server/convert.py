@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Iterable, Sequence
+from itertools import chain
 from urllib.parse import unquote
 
 from lsprotocol import types
@@ -22,6 +24,18 @@ def to_range(lines: LineIndex, start: int, end: int, enc: Encoding) -> types.Ran
     sl, sc = lines.position(start, enc)
     el, ec = lines.position(end, enc)
     return types.Range(types.Position(sl, sc), types.Position(el, ec))
+
+
+def to_ranges(
+    lines: LineIndex, spans: Iterable[tuple[int, int]], enc: Encoding
+) -> list[types.Range]:
+    """:func:`to_range` of each of ``spans``, their positions found in one pass
+    (:meth:`LineIndex.positions`): one at a time, each position counts its line from its
+    start, and a name used a million times on one 8 MB line took minutes to convert."""
+    spans = list(spans)
+    at = lines.positions(chain.from_iterable(spans), enc)
+    P, R = types.Position, types.Range
+    return [R(P(*at[s]), P(*at[e])) for s, e in spans]
 
 
 def to_offsets(lines: LineIndex, rng: types.Range, enc: Encoding) -> tuple[int, int]:
@@ -52,8 +66,14 @@ def diagnostic_at(rng: types.Range, d: Diagnostic, described: bool = True) -> ty
     )
 
 
-def to_text_edit(lines: LineIndex, e: TextEdit, enc: Encoding) -> types.TextEdit:
-    return types.TextEdit(range=to_range(lines, e.start, e.end, enc), new_text=e.new_text)
+def to_text_edits(
+    lines: LineIndex, edits: Sequence[TextEdit], enc: Encoding
+) -> list[types.TextEdit]:
+    """Each of ``edits`` as an LSP text edit (positions as :func:`to_ranges` finds them)."""
+    ranges = to_ranges(lines, ((e.start, e.end) for e in edits), enc)
+    return [
+        types.TextEdit(range=r, new_text=e.new_text) for r, e in zip(ranges, edits, strict=True)
+    ]
 
 
 # The change annotations of the edits a fix or rename makes in files other than the one the
