@@ -183,6 +183,11 @@ class LspClient:
         """Send a notification; returns the time just before it was written."""
         return self._send({"jsonrpc": "2.0", "method": method, "params": params})
 
+    def open(self, uri: str, text: str) -> float:
+        """Open ``uri`` as an XML document of ``text`` (version 1); see :meth:`notify`."""
+        item = {"uri": uri, "languageId": "xml", "version": 1, "text": text}
+        return self.notify("textDocument/didOpen", {"textDocument": item})
+
     async def request_timed(
         self, method: str, params: Any, timeout: float = 120.0
     ) -> tuple[Any, float]:

@@ -55,12 +55,9 @@ async def measure(methods: list[str]) -> None:
     client = await LspClient.start(SERVER)
     try:
         await client.initialize(None, {"debounceMs": 0})
-        small = "untitled:small.xml"
-        item = {"uri": small, "languageId": "xml", "version": 1, "text": SMALL}
-        client.notify("textDocument/didOpen", {"textDocument": item})
-        uri = "untitled:many.xml"
-        item = {"uri": uri, "languageId": "xml", "version": 1, "text": text}
-        client.notify("textDocument/didOpen", {"textDocument": item})
+        small, uri = "untitled:small.xml", "untitled:many.xml"
+        client.open(small, SMALL)
+        client.open(uri, text)
         await client.complete(uri)
         at = text.index("<Frob") + 2
         pos = {"line": text.count("\n", 0, at), "character": at - (text.rfind("\n", 0, at) + 1)}

@@ -34,11 +34,6 @@ from run import SERVER
 MIB = 1024 * 1024
 
 
-async def _complete(client: LspClient, uri: str) -> None:
-    """Wait for the complete diagnostics of ``uri`` (those holding ``unknown-node``)."""
-    await client.complete(uri)
-
-
 async def outline() -> None:
     text = INPUTS["realistic"]()
     size = len(text.encode("utf-8"))
@@ -53,7 +48,7 @@ async def outline() -> None:
         params = {"textDocument": {"uri": uri}}
         symbols, _ = await client.request_timed("textDocument/documentSymbol", params, 600)
         first = time.perf_counter() - opened
-        await _complete(client, uri)
+        await client.complete(uri)
         done = time.perf_counter() - opened
         after_diags = rss_kib(client.pid)
         _, again = await client.request_timed("textDocument/documentSymbol", params, 600)
@@ -81,9 +76,8 @@ async def hover_key() -> None:
     try:
         await client.initialize(None, {"debounceMs": 0})
         uri = "untitled:script.xml"
-        item = {"uri": uri, "languageId": "xml", "version": 1, "text": text}
-        client.notify("textDocument/didOpen", {"textDocument": item})
-        await _complete(client, uri)
+        client.open(uri, text)
+        await client.complete(uri)
         line = text.split("\n")[2]
         col = line.index("a1000:=")
         at = {"textDocument": {"uri": uri}, "position": {"line": 2, "character": col + 1}}
