@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.rules.names import NameKind
 from bt_lsp.syntax.document import Document
@@ -156,5 +157,27 @@ def test_invalid_xml_name_characters_not_covered_by_the_name_rules() -> None:
 
 
 def test_text_outside_root() -> None:
-    errs = xml_errors("<root/>\ntrailing")
-    assert errs == [("trailing", "Text outside the root element")]
+    doc = Document("<root/>\ntrailing")
+    found = [(doc.text[d.start : d.end], d.code, d.severity) for d in own_diagnostics(doc)]
+    assert found == [("trailing", "xml-lenient", Severity.WARNING)]
+
+
+def test_what_tinyxml2_accepts_is_a_warning_not_an_error() -> None:
+    """tinyxml2 (BehaviorTree.CPP's parser) reads text before the root, attributes without
+    white space between them and elements after the root; at a stray end tag after the root
+    it stops reading. None of it fails the load, so none of it is an error."""
+    text = (
+        'preamble\n<root BTCPP_format="4"><BehaviorTree ID="T"><A a="1"b="2"/></BehaviorTree>'
+        "</root>\n<Extra/>\n</Sequence>"
+    )
+    doc = Document(text)
+    found = [(doc.text[d.start : d.end], d.code) for d in own_diagnostics(doc)]
+    assert found == [
+        ("preamble\n", "xml-lenient"),
+        ("b", "xml-lenient"),
+        ("Extra", "xml-extra-root"),
+        ("Sequence", "xml-extra-root"),
+    ]
+    assert all(d.severity == Severity.WARNING for d in own_diagnostics(doc))
+    # A mismatched end tag inside the root is still an error: tinyxml2 fails there.
+    assert xml_errors('<root><BehaviorTree ID="T"></Sequence></BehaviorTree></root>')

@@ -29,6 +29,19 @@ if TYPE_CHECKING:
 
 # The codes of these rules (see bt_lsp.rules.registry).
 XML_SYNTAX: Final = define("xml-syntax", Severity.ERROR, "the document is not well-formed XML", XML)
+XML_EXTRA_ROOT: Final = define(
+    "xml-extra-root",
+    Severity.WARNING,
+    "an element after the root element (tinyxml2 accepts it; BehaviorTree.CPP ignores it)",
+    XML,
+)
+XML_LENIENT: Final = define(
+    "xml-lenient",
+    Severity.WARNING,
+    "not well-formed XML that tinyxml2, BehaviorTree.CPP's parser, accepts (text outside "
+    "the root, attributes without white space between them)",
+    XML,
+)
 XML_UNESCAPED_CHAR: Final = define(
     "xml-unescaped-char",
     Severity.WARNING,

@@ -27,7 +27,7 @@ from bt_lsp.syntax.scanner import Rescan, Scan
 from bt_lsp.syntax.sections import CLOSED, EOF, OPEN, Section
 from bt_lsp.syntax.table import ZONES as _ZONES
 from bt_lsp.syntax.table import Columns, ElementTable, Growing, keeps, offsets_code
-from bt_lsp.syntax.tokens import XML_SYNTAX, Kind, Token
+from bt_lsp.syntax.tokens import EXTRA_ROOT, LENIENT, XML_SYNTAX, Kind, Token
 from bt_lsp.syntax.values import decode_value
 from bt_lsp.syntax.xmlnames import cached_xml_name_problem
 
@@ -157,8 +157,10 @@ class _Builder:
                             StructureProblem(
                                 tstart + 1,
                                 tstart + 1 + len(tok.name),
-                                XML_SYNTAX,
-                                f"Extra top-level element '<{tok.name}>'; a document has one root",
+                                EXTRA_ROOT,
+                                f"Extra top-level element '<{tok.name}>' after the root: "
+                                "tinyxml2 accepts it, and BehaviorTree.CPP reads the first "
+                                "element only, so this one is ignored",
                             )
                         )
                     else:
@@ -221,10 +223,13 @@ class _Builder:
                             StructureProblem(
                                 at,
                                 tstart + tok.length,
-                                XML_SYNTAX,
-                                "Text outside the root element"
-                                if self.has_root
-                                else "Text before the root element",
+                                LENIENT,
+                                (
+                                    "Text outside the root element"
+                                    if self.has_root
+                                    else "Text before the root element"
+                                )
+                                + " (tinyxml2 skips it; other XML tools reject the file)",
                             )
                         )
             elif kind == end_kind:
@@ -305,12 +310,16 @@ class _Builder:
                 break
         if match == -1:
             expected = f"; expected '</{tags[stack[-1]].name}>'" if stack else ""
+            after_root = not stack and self.has_root
             self.problems.append(
                 StructureProblem(
                     name_s if tok.name else tstart,
                     name_e if tok.name else tstart + 2,
-                    XML_SYNTAX,
-                    f"Unexpected end tag '</{tok.name}>'{expected}",
+                    EXTRA_ROOT if after_root else XML_SYNTAX,
+                    f"Unexpected end tag '</{tok.name}>' after the root: tinyxml2 stops "
+                    "reading here, and BehaviorTree.CPP ignores the rest of the file"
+                    if after_root
+                    else f"Unexpected end tag '</{tok.name}>'{expected}",
                 )
             )
             return -1

@@ -26,7 +26,7 @@ from typing import TypeVar
 
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
 from bt_lsp.syntax.text import Offsets
-from bt_lsp.syntax.tokens import DOCTYPE_CODE, XML_SYNTAX, Attr, Kind, Problem, Token
+from bt_lsp.syntax.tokens import DOCTYPE_CODE, LENIENT, XML_SYNTAX, Attr, Kind, Problem, Token
 from bt_lsp.syntax.values import decode_value
 
 # Read for every start tag: a module global is quicker than a member read from its enum
@@ -412,7 +412,13 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
         ns, ne = am.start() - pos, am.end() - pos
         if not had_ws and attrs:
             problems.append(
-                Problem(ns, ne, XML_SYNTAX, f"Missing whitespace before attribute '{aname}'")
+                Problem(
+                    ns,
+                    ne,
+                    LENIENT,
+                    f"Missing whitespace before attribute '{aname}' (tinyxml2 reads it; "
+                    "other XML tools reject the file)",
+                )
             )
         # An attribute beyond the limits is read (its value skipped) but not kept.
         keep = attrs if limits.keeps(aname in seen, len(attrs), ns, ne) else []

@@ -20,6 +20,8 @@ class Kind(IntEnum):
 
 
 XML_SYNTAX = "xml-syntax"
+EXTRA_ROOT = "xml-extra-root"
+LENIENT = "xml-lenient"
 UNESCAPED = "xml-unescaped-char"
 DOCTYPE_CODE = "xml-doctype"
 
