@@ -258,10 +258,12 @@ def compare(
 
 
 def _norm_type(t: str | None) -> str | None:
+    """Spelling only: no whitespace, no leading ``::``; an untyped port is ``None``."""
     if t is None:
         return None
     t = re.sub(r"\s+", "", t)
-    return t[2:] if t.startswith("::") else t
+    t = t[2:] if t.startswith("::") else t
+    return None if t in ("AnyTypeAllowed", "BT::AnyTypeAllowed") else t
 
 
 def _norm_default(value: str) -> str | float:

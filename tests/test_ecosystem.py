@@ -137,12 +137,14 @@ def test_catalog_node_comparison() -> None:
             {"name": "x", "direction": "input", "type": "double", "default": "1.0"},
             {"name": "g", "direction": "output", "type": "Goal", "type_resolved": "ns::Goal"},
             {"name": "e", "direction": "input", "type": "int", "default": "K", "default_expr": 1},
+            {"name": "u", "direction": "input", "type": None},
         ],
     }
     ports: list[dict[str, object]] = [
         {"name": "x", "direction": "input", "type": " double", "default": "1"},
         {"name": "g", "direction": "output", "type": "::ns::Goal", "default": None},
         {"name": "e", "direction": "input", "type": "int", "default": "5"},
+        {"name": "u", "direction": "input", "type": "AnyTypeAllowed", "default": None},
     ]
     actual = {"kind": "Action", "ports": ports}
     assert eco.compare_node(expected, actual) == []
