@@ -25,8 +25,9 @@
   nothing; ``createTreeFromText``/``createTreeFromFile`` on it fails ("Can't find a tree").
   A warning, not an error: an application may load it next to the files that hold its
   trees and create those.  Range: ``root``.
-* ``nesting-depth`` (error): an element more than 256 levels below its ``<BehaviorTree>``
-  ("Maximum XML nesting depth exceeded (limit: 256)").  Range: the first such element's
+* ``nesting-depth`` (warning): an element more than 256 levels below its ``<BehaviorTree>``
+  ("Maximum XML nesting depth exceeded (limit: 256)", BehaviorTree.CPP releases from
+  February 2026 on, pull request 1091; earlier ones recurse without a limit).  Range: the first such element's
   name in each tree.
 """
 
@@ -69,7 +70,11 @@ NO_TREE: Final = define(
     BT,
 )
 NESTING_DEPTH: Final = define(
-    "nesting-depth", Severity.ERROR, "a tree nested deeper than 256 levels", BT
+    "nesting-depth",
+    Severity.WARNING,
+    "a tree nested deeper than 256 levels (rejected by BehaviorTree.CPP 4 releases from "
+    "February 2026 on)",
+    BT,
 )
 
 
@@ -198,7 +203,8 @@ def check_depth(st: State, el: Element, tree_flagged: list[bool]) -> None:
             el.name_end,
             "nesting-depth",
             f"<{el.name}> is nested {el.depth - 1} levels below its <BehaviorTree>; "
-            f"BehaviorTree.CPP rejects trees deeper than {MAX_DEPTH} levels",
+            f"BehaviorTree.CPP releases from February 2026 on (pull request 1091) reject "
+            f"trees deeper than {MAX_DEPTH} levels (earlier ones recurse without a limit)",
         )
 
 
