@@ -27,8 +27,8 @@
   trees and create those.  Range: ``root``.
 * ``nesting-depth`` (warning): an element more than 256 levels below its ``<BehaviorTree>``
   ("Maximum XML nesting depth exceeded (limit: 256)", BehaviorTree.CPP releases from
-  February 2026 on, pull request 1091; earlier ones recurse without a limit).  Range: the first such element's
-  name in each tree.
+  February 2026 on, pull request 1091; earlier ones recurse without a limit).  Range: the
+  first such element's name in each tree.
 """
 
 from __future__ import annotations
