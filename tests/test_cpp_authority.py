@@ -60,7 +60,7 @@ def test_complete_registrations_make_unknown_nodes_errors(
     assert "did you mean 'Charge'?" in found[6][2]
     assert 7 not in found  # <Charge until_percent="80"/>, registered by robot_lib
     # <Scan range="5"/>: Scan's port list is built by code: advisory.
-    assert found[8][:2] == ("warning", "undeclared-port")
+    assert found[8][:2] == ("hint", "undeclared-port")
     assert "ports read: none" in found[8][2]
     # Only the tree file's own <TreeNodesModel> declares Ghost: not registered.
     assert found[9][:2] == ("error", "unknown-node")

@@ -299,6 +299,16 @@ class ProjectIndex:
         found = self.packages.btcpp_of(path.parent)
         if found.version is not None:
             return found
+        # A package that does not name BehaviorTree.CPP builds against the version of the
+        # packages it depends on (a tutorial package over its library package).
+        for folder in self.package_folders(path)[1:]:
+            m = self.packages.manifest(folder / "package.xml")
+            if m is not None and m.btcpp is not None:
+                return Detected(
+                    m.btcpp,
+                    f"{m.folder / 'package.xml'} (of the dependency {m.name}) names "
+                    f"BehaviorTree.CPP {m.btcpp}",
+                )
         doc = doc if doc is not None else self.document(path)
         root = doc.model.root if doc is not None else None
         if root is not None and root.name == "root":
@@ -472,10 +482,14 @@ class ProjectIndex:
         # Another workspace package's catalogs are not this document's unless it depends
         # on that package.
         skip.update(self.unrelated_catalogs(path))
+        mine = set(self.package_folders(path))
+        foreign: set[str] = set()
         for p, d in self.bt_documents():
             if p == path or p in in_closure or p in skip:
                 continue
             others.append((str(p), d, False))
+            if mine and self._unrelated(p, mine):
+                foreign.add(str(p))
             if any(inc.target == path for inc in self.includes(p, d)):
                 included_by.append(str(p))
         ctx = Context.combine(
@@ -487,6 +501,7 @@ class ProjectIndex:
             ros_models=ros_models,
             included_by=included_by,
             btcpp_version=self.btcpp_for(path, doc).version,
+            foreign=foreign,
         )
         if self.cpp is not None:
             ctx = self.cpp.context_with_models(
@@ -573,6 +588,15 @@ class ProjectIndex:
             if folder not in mine:
                 out.update(normalize(p) for p in self.ros.catalogs(folder))
         return out
+
+    def _unrelated(self, p: Path, mine: set[Path]) -> bool:
+        """Whether the BT file ``p`` (its ``<TreeNodesModel>``, a Groot2 palette) belongs
+        to a package outside ``mine`` (a package and its dependencies): its models then
+        describe another package's nodes.  A file outside any package sees every model
+        (as it sees every catalog), and a file in a package also sees those of files
+        outside any package (a repository's shared palette)."""
+        pkg = self.packages.package_of(p.parent)
+        return pkg is not None and pkg.folder not in mine
 
     # -- ROS packages --------------------------------------------------------------------------
 

@@ -143,6 +143,7 @@ class Context:
         included_by: Iterable[str] = (),
         workspace_has_custom_models: bool | None = None,
         btcpp_version: str | None = None,
+        foreign: Collection[str] = (),
     ) -> Context:
         """The context of ``own`` among ``others``: ``(path, document, included)`` triples.
 
@@ -153,7 +154,10 @@ class Context:
         ``model_files`` are the node catalogs named in the settings (``models``,
         ``modelFiles``, ``--models``): authoritative, but for a Groot2 ``.btproj``, which
         is a palette.  ``ros_models`` are the catalogs shipped by the ROS packages ``own``
-        depends on: authoritative for their nodes.
+        depends on: authoritative for their nodes.  The models of a document whose path
+        is in ``foreign`` (another package's, that ``own``'s package does not depend on)
+        do not count: an author's model of a node describes that package's node, which
+        may differ from a node of the same ID elsewhere; its trees still do.
 
         A model from an authoritative source wins over any advisory one (a
         ``<TreeNodesModel>`` of a tree file); among equals the first wins, this
@@ -181,6 +185,10 @@ class Context:
             else:
                 workspace_files += 1
             f = facts_of(other, other_path)
+            if not in_closure and other_path in foreign:
+                sources.append((f, in_closure, "foreign"))
+                workspace_trees.append(f.trees)
+                continue
             sources.append((f, in_closure))
             if other_path is not None and other_path.endswith(".btproj"):
                 advisory.append(_tagged(f, "palette"))

@@ -34,7 +34,8 @@ _DIRECTIONS: Final[Mapping[str, Direction]] = MappingProxyType(
 )
 # Attributes of a model entry that are not ports in the pre-3.x attribute form
 # (``<Action ID="Say" message=""/>``).
-_ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "description"})
+# Groot2 writes `editable` on the entries whose ports its editor may change: not a port.
+_ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "description", "editable"})
 
 # Model -> facts, keyed by document; a cached entry is valid while the document's model is
 # the same object (a document builds a new model after every edit).

@@ -337,6 +337,9 @@ class BlackboardUse:
     exact: bool  # from a built-in model
     port: str
     node: str
+    # Whether the type names only what cannot be an alias (see port_types.is_closed), or
+    # comes from a catalog BehaviorTree.CPP exported (demangled: aliases resolved).
+    closed: bool = True
 
 
 @dataclass(slots=True)

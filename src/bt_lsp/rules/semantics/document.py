@@ -3,9 +3,11 @@
 * ``root-element`` (error): the top element is not ``<root>``; BehaviorTree.CPP: "The XML
   must have a root node called <root>".  Range: the top element's name (an empty range at
   the start when the document has no element).
-* ``missing-format`` (warning): ``<root>`` without ``BTCPP_format``; BehaviorTree.CPP only
-  prints a warning.  Range: ``root``.  Fix: add ``BTCPP_format="4"``.  Not reported when
-  the project builds against BehaviorTree.CPP 3 (``Context.btcpp_version``).
+* ``missing-format`` (warning): ``<root>`` without ``BTCPP_format``; BehaviorTree.CPP 4
+  loads the file and prints "Warnings: The first tag of the XML (<root>) should contain
+  the attribute [BTCPP_format="4"]".  Range: ``root``.  Fix: add ``BTCPP_format="4"``.
+  Not reported when the project builds against BehaviorTree.CPP 3, which has no such
+  attribute (``Context.btcpp_version``); with no version detected the message says so.
 * ``duplicate-model-section`` (error): every ``<TreeNodesModel>`` after the first.
 * ``missing-id`` (error) for ``<Action|Condition|Control|Decorator|SubTree>`` written
   directly under ``<root>`` without ``ID`` while a ``<TreeNodesModel>`` exists (a check
@@ -23,9 +25,10 @@
   nothing; ``createTreeFromText``/``createTreeFromFile`` on it fails ("Can't find a tree").
   A warning, not an error: an application may load it next to the files that hold its
   trees and create those.  Range: ``root``.
-* ``nesting-depth`` (error): an element more than 256 levels below its ``<BehaviorTree>``
-  ("Maximum XML nesting depth exceeded (limit: 256)").  Range: the first such element's
-  name in each tree.
+* ``nesting-depth`` (warning): an element more than 256 levels below its ``<BehaviorTree>``
+  ("Maximum XML nesting depth exceeded (limit: 256)", BehaviorTree.CPP releases from
+  February 2026 on, pull request 1091; earlier ones recurse without a limit).  Range: the
+  first such element's name in each tree.
 """
 
 from __future__ import annotations
@@ -67,7 +70,11 @@ NO_TREE: Final = define(
     BT,
 )
 NESTING_DEPTH: Final = define(
-    "nesting-depth", Severity.ERROR, "a tree nested deeper than 256 levels", BT
+    "nesting-depth",
+    Severity.WARNING,
+    "a tree nested deeper than 256 levels (rejected by BehaviorTree.CPP 4 releases from "
+    "February 2026 on)",
+    BT,
 )
 
 
@@ -104,8 +111,7 @@ def check_root(st: State) -> None:
                 root.name_start,
                 root.name_end,
                 "missing-format",
-                '<root> has no BTCPP_format attribute; add BTCPP_format="4" if the file is '
-                "written for BehaviorTree.CPP 4 (BehaviorTree.CPP warns about it)",
+                _missing_format_message(version),
             )
     # Only the children that a rule looks at closely are made (a large document has
     # thousands of trees).
@@ -197,5 +203,19 @@ def check_depth(st: State, el: Element, tree_flagged: list[bool]) -> None:
             el.name_end,
             "nesting-depth",
             f"<{el.name}> is nested {el.depth - 1} levels below its <BehaviorTree>; "
-            f"BehaviorTree.CPP rejects trees deeper than {MAX_DEPTH} levels",
+            f"BehaviorTree.CPP releases from February 2026 on (pull request 1091) reject "
+            f"trees deeper than {MAX_DEPTH} levels (earlier ones recurse without a limit)",
         )
+
+
+def _missing_format_message(version: str | None) -> str:
+    """What BehaviorTree.CPP 4 does with a ``<root>`` without ``BTCPP_format``, for the
+    project's version (4, or not detected)."""
+    said = 'BehaviorTree.CPP 4 loads the file and prints a warning asking for BTCPP_format="4"'
+    if version == "4":
+        return f'<root> has no BTCPP_format attribute; {said}: add BTCPP_format="4"'
+    return (
+        f"<root> has no BTCPP_format attribute; {said}; BehaviorTree.CPP 3 has no such "
+        "attribute, and the project's version was not detected (set btcpp to 3 or 4): add "
+        'BTCPP_format="4" if the file is written for version 4'
+    )

@@ -10,9 +10,12 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
 
 * ``undeclared-port``: a port attribute the node's model does not declare.  An error for
   an exact model (BehaviorTree.CPP 4 throws at tree creation: "a port with name … is found
-  in the XML but not in the providedPorts()"), a warning for an advisory one and for a
-  ``<SubTree>`` call whose tree has a ``<SubTree>`` model (BehaviorTree.CPP passes any
-  attribute on as a remapping, so an undeclared one is only suspicious).  Nothing is
+  in the XML but not in the providedPorts()"); a hint for an advisory one (a
+  ``<TreeNodesModel>`` entry, a palette, a C++ port list not all read: BehaviorTree.CPP
+  reads the C++ registration, which bt-lsp did not see whole); a warning for a
+  ``<SubTree>`` call whose tree has a ``<SubTree>`` model listing ports (BehaviorTree.CPP
+  passes any attribute on as a remapping, so an undeclared one is only suspicious), a
+  hint when that model lists none.  Nothing is
   reported when the model is unknown, or for a ``<SubTree>`` call without a model.
   Range: the attribute name.
 * ``missing-required-port``: a port without a default that is not given.  Built-ins:
@@ -29,7 +32,11 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   bool literal.  Range: the value.
 * ``blackboard-type-mismatch``: within one tree, a ``{key}`` used by ports of two
   different strong types (the first use fixes the entry's type; a ``std::string`` entry
-  accepts anything).  An error when both models are exact, else a warning.  Shared
+  accepts anything).  Types are compared as C++ types (:mod:`bt_lsp.rules.port_types`:
+  spellings of one built-in type, ``std::`` forms, top-level ``const`` and references are
+  one), and only when every name in both is known not to be an alias (built-in, standard
+  library, ROS interface types): any other name may be a ``using`` from a header bt-lsp
+  did not read, so it proves nothing.  An error when both models are exact, else a warning.  Shared
   pointers of two classes read by an input port are a hint: BehaviorTree.CPP accepts the
   connection when the application registers a polymorphic cast between them (input ports
   only; an inout or output port must match exactly).  Range: the later value.
@@ -52,6 +59,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Final
 
+from bt_lsp.rules import port_types
 from bt_lsp.rules.builtins import PortModel
 from bt_lsp.rules.codes import BT, FixData, Severity, define
 from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
@@ -148,19 +156,6 @@ V3_ATTRIBUTES: Final[dict[str, str]] = {
 _BOOL_WORDS: Final = frozenset({"1", "0", "true", "false", "True", "False", "TRUE", "FALSE"})
 _TRUE_WORDS: Final = frozenset({"1", "true", "True", "TRUE"})
 
-_STRING_TYPES: Final = frozenset(
-    {
-        "std::string",
-        "string",
-        "std::__cxx11::basic_string<char, std::char_traits<char>, std::allocator<char> >",
-        "std::basic_string<char, std::char_traits<char>, std::allocator<char> >",
-    }
-)
-_WEAK_TYPES: Final = frozenset(
-    {"", "any", "Any", "BT::Any", "AnyTypeAllowed", "BT::AnyTypeAllowed"}
-)
-
-
 _allowed = lru_cache(maxsize=4096)(is_allowed_port_name)
 
 
@@ -171,12 +166,7 @@ def _convert(value: str, type_: str) -> str | None:
 
 def canonical_type(type_: str) -> str | None:
     """A port type for comparison, or ``None`` when it is not strongly typed."""
-    t = " ".join(type_.split())
-    if t in _WEAK_TYPES:
-        return None
-    if t in _STRING_TYPES:
-        return "std::string"
-    return t
+    return port_types.canonical(type_)
 
 
 _SHARED_POINTER: Final = re.compile(
@@ -309,19 +299,27 @@ def _check_port(
     if is_blackboard_reference(value):
         _blackboard_use(st, el, a, value, port, res, scope)
         return
-    if not port.type:
+    if not port.type or (st.v3 and not value):
+        # BehaviorTree.CPP 3.8 reads an empty value as not given (the default applies).
         return
     problem = _convert(value, port.type)
     if problem is not None:
         s, e = el.span_of_value(a)
-        st.add(
-            s,
-            e,
-            "invalid-port-value",
+        message = (
             f"The value of port {quoted(a.name)} cannot be converted to {port.type}: {problem}"
-            + (f" (a port of {quoted(res.id)}, registered in {res.where})" if res.where else ""),
-            None if res.exact else Severity.WARNING,
+            + (f" (a port of {quoted(res.id)}, registered in {res.where})" if res.where else "")
         )
+        severity: Severity | None = None if res.exact else Severity.WARNING
+        if st.v3:
+            # 3.8 converts a literal only when the node reads the port: a built-in then
+            # throws, a custom node's getInput returns an error its code may handle.
+            message += "; BehaviorTree.CPP 3 converts it only when the node reads the port " + (
+                "(the node then fails)" if res.origin == "builtin" else "(getInput fails)"
+            )
+            severity = Severity.WARNING if res.origin == "builtin" else Severity.HINT
+        else:
+            message += "; BehaviorTree.CPP 4 converts it when it creates the tree"
+        st.add(s, e, "invalid-port-value", message, severity)
 
 
 def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
@@ -335,7 +333,9 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
             f"{_owner(res)} declares no port {quoted(a.name)} (ports: {declared}){hint}; "
             "BehaviorTree.CPP passes it on as a remapping anyway"
         )
-        st.add(s, e, "undeclared-port", message, Severity.WARNING)
+        # A model without any port (an editor's bare <SubTree ID="X"/>) says nothing of
+        # the tree's ports: only a model that lists some makes another one suspicious.
+        st.add(s, e, "undeclared-port", message, Severity.WARNING if names else Severity.HINT)
         return
     if res.where:
         message = (
@@ -351,13 +351,16 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         )
         st.add(s, e, "undeclared-port", message)
     else:
+        # BehaviorTree.CPP reads the C++ registration, never an author's model: what the
+        # node really declares is not known, so this is a hint.
         message += (
             "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
             "could not all be read statically)"
             if res.where
-            else "; BehaviorTree.CPP rejects it unless the C++ node declares it"
+            else "; BehaviorTree.CPP rejects it only if the C++ node does not declare it "
+            "(BehaviorTree.CPP reads the C++ registration, not this model)"
         )
-        st.add(s, e, "undeclared-port", message, Severity.WARNING)
+        st.add(s, e, "undeclared-port", message, Severity.HINT)
 
 
 def _is_switch(type_id: str) -> bool:
@@ -415,6 +418,15 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
     )
 
 
+def _closed(canon: str, res: Resolved) -> bool:
+    """Whether a port type proves what it names: a built-in's, one a BehaviorTree.CPP
+    catalog wrote (``writeTreeNodesModelXML`` demangles the C++ type, so aliases are
+    resolved), or one whose every name is known not to be an alias."""
+    if res.origin == "builtin" or (res.authoritative and not res.where):
+        return True
+    return port_types.is_closed(canon)
+
+
 def _blackboard_use(
     st: State,
     el: Element,
@@ -432,9 +444,15 @@ def _blackboard_use(
     key = a.name if key in ("=", "{=}") else key[1:-1].strip(" ")
     first = scope.keys.get(key)
     if first is None:
-        scope.keys[key] = BlackboardUse(canon, port.type, res.exact, a.name, res.id)
+        scope.keys[key] = BlackboardUse(
+            canon, port.type, res.exact, a.name, res.id, _closed(canon, res)
+        )
         return
     if first.type == canon or first.type == "std::string":
+        return
+    if not (first.closed and _closed(canon, res)):
+        # A name bt-lsp cannot resolve may be an alias of the other type (``TaskPtr`` of
+        # ``std::shared_ptr<Task>``, from a header outside the project): nothing proven.
         return
     s, e = el.span_of_value(a)
     held, wanted = pointee(first.type), pointee(canon)

@@ -19,8 +19,11 @@
   document, its includes (named), the other BT files of the workspace (counted).  A
   ``<SubTree ID>`` that breaks a name rule and names no tree is left to the name rules:
   one problem, one diagnostic.  Range: the value.
-* ``duplicate-subtree-name`` (error): a second ``<SubTree>`` with the same ``name`` in one
-  tree ("Duplicate SubTree path detected").  Range: the second ``name`` value.
+* ``duplicate-subtree-name`` (warning): a second ``<SubTree>`` with the same ``name`` in one
+  tree.  BehaviorTree.CPP 4 releases from January 2026 on (pull request 1053) reject it
+  ("Duplicate SubTree path detected"); earlier releases and 3.8 create the tree, so it is
+  a warning for version 4 and an unknown version, and not reported for version 3.
+  Range: the second ``name`` value.
 * ``subtree-recursion`` (error): trees calling each other in a cycle ("Recursive behavior
   tree cycle detected").  The cycle is found by a depth-first walk that starts at the main
   tree, then this document's trees in order; the call that closes a cycle is reported
@@ -42,6 +45,7 @@ from bt_lsp.rules.context import TreeDecl
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import State, TreeScope, quoted
 from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.tokens import Attr
 
 if TYPE_CHECKING:
     from bt_lsp.syntax.document import History
@@ -73,8 +77,9 @@ SUBTREE_RECURSION: Final = define(
 )
 DUPLICATE_SUBTREE_NAME: Final = define(
     "duplicate-subtree-name",
-    Severity.ERROR,
-    "two `<SubTree>` calls with the same `name` in one tree",
+    Severity.WARNING,
+    "two `<SubTree>` calls with the same `name` in one tree (rejected by BehaviorTree.CPP "
+    "4 releases from January 2026 on)",
     BT,
 )
 
@@ -205,16 +210,28 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
         if first is None:
             scope.subtree_names[name.value] = el
         else:
-            s, e = el.span_of_value(name)
-            line = st.line_of(first.name_start) + 1
-            st.add(
-                s,
-                e,
-                "duplicate-subtree-name",
-                f"Another <SubTree> in this tree (line {line}) "
-                f"has the name {quoted(name.value)}; BehaviorTree.CPP rejects the duplicate "
-                "SubTree path (use unique names or omit 'name')",
-            )
+            _duplicate_name(st, el, name, first)
+
+
+def _duplicate_name(st: State, el: Element, name: Attr, first: Element) -> None:
+    """Only BehaviorTree.CPP releases from January 2026 on (pull request 1053) reject a
+    duplicate SubTree path; earlier 4.x releases (ROS 2 Humble to Jazzy) and 3.8 create the
+    tree, with two subtrees of one path (loggers and Groot2 confuse them).  bt-lsp knows
+    the major version only, so version 4 and an unknown version get a warning; version 3
+    never rejects it."""
+    if st.v3 or name.value is None:
+        return
+    s, e = el.span_of_value(name)
+    line = st.line_of(first.name_start) + 1
+    st.add(
+        s,
+        e,
+        "duplicate-subtree-name",
+        f"Another <SubTree> in this tree (line {line}) has the name {quoted(name.value)}; "
+        "BehaviorTree.CPP releases from January 2026 on (4.x after pull request 1053) "
+        "reject the duplicate SubTree path, earlier ones create the tree with two "
+        "subtrees of one path (use unique names or omit 'name')",
+    )
 
 
 def _unknown_tree(st: State, tree_id: str, start: int, end: int, code: str, what: str) -> None:
