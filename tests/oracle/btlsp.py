@@ -49,8 +49,9 @@ def catalog(actions: Sequence[str], conditions: Sequence[str]) -> str:
 def check_files(
     files: Sequence[tuple[str, str]], actions: Sequence[str], conditions: Sequence[str]
 ) -> list[dict[str, Any]]:
-    """bt-lsp's diagnostics of the first file of ``files`` in a workspace of them all, with
-    the custom nodes as the authoritative catalog."""
+    """bt-lsp's diagnostics of ``files`` (the first includes the others) checked as one
+    workspace, with the custom nodes as the authoritative catalog; each with its file's
+    name as ``file``."""
     with tempfile.TemporaryDirectory(prefix="bt-lsp-oracle-") as tmp:
         folder = os.path.join(tmp, "ws")
         for name, text in files:
@@ -63,5 +64,6 @@ def check_files(
             fh.write(catalog(actions, conditions))
         found = check_folder(folder, models)
         assert not isinstance(found, str), found
-        main = os.path.join(folder, files[0][0])
-        return [d for d in found if os.path.samefile(d["path"], main)] if found else []
+        for d in found:
+            d["file"] = os.path.relpath(d["path"], folder)
+        return found
