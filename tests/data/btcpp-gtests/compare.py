@@ -40,6 +40,7 @@ import shlex
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -49,13 +50,30 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 EMPTY_CATALOG = '<root BTCPP_format="4">\n  <TreeNodesModel/>\n</root>\n'
 
 
+# What runs bt-lsp on one case folder: (folder, catalog or None) -> its JSON diagnostics, or
+# a string saying why there are none.
+Runner = Callable[[str, "str | None"], "list[dict[str, Any]] | str"]
+
+
 def run_case(exe: str, folder: str, models: str | None = None) -> list[dict[str, Any]] | str:
     """bt-lsp's diagnostics for one case folder, or a string saying why there are none.
     ``models`` is the catalog to give a case that has no models.xml."""
-    argv = [*shlex.split(exe), "check", folder, "--format", "json", "--no-progress"]
+    return run_command(exe, folder, catalog_of(folder, models))
+
+
+def catalog_of(folder: str, models: str | None) -> str | None:
+    """The catalog to give a case: its models.xml, else ``models`` (with ``--models``)."""
     catalog = os.path.join(folder, "models.xml")
-    if models is not None:
-        argv += ["--models", catalog if os.path.isfile(catalog) else models]
+    if models is None:
+        return None
+    return catalog if os.path.isfile(catalog) else models
+
+
+def run_command(exe: str, folder: str, catalog: str | None) -> list[dict[str, Any]] | str:
+    """``bt-lsp check folder --format json [--models catalog]`` in a process of its own."""
+    argv = [*shlex.split(exe), "check", folder, "--format", "json", "--no-progress"]
+    if catalog is not None:
+        argv += ["--models", catalog]
     try:
         proc = subprocess.run(
             argv,
@@ -82,7 +100,9 @@ def describe(d: dict[str, Any], folder: str) -> str:
     return f"{d.get('severity')} {d.get('code')} {rel}:{d.get('line')}: {msg}"
 
 
-def main(argv: list[str]) -> int:
+def main(argv: list[str], runner: Runner | None = None) -> int:
+    """``runner`` (for a caller that runs bt-lsp in its own process) replaces the
+    command named by ``argv[1]``, which is then not run."""
     if len(argv) < 2 or argv[1] in ("-h", "--help"):
         print(__doc__.strip())
         return 2
@@ -106,8 +126,11 @@ def main(argv: list[str]) -> int:
             empty = os.path.join(tmp, "empty_models.xml")
             with open(empty, "w", encoding="utf-8") as fh:
                 fh.write(EMPTY_CATALOG)
-        with ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1))) as pool:
-            results = list(pool.map(lambda f: run_case(exe, f, empty), folders))
+        if runner is not None:
+            results = [runner(f, catalog_of(f, empty)) for f in folders]
+        else:
+            with ThreadPoolExecutor(max_workers=max(1, min(4, os.cpu_count() or 1))) as pool:
+                results = list(pool.map(lambda f: run_case(exe, f, empty), folders))
 
     mismatches = 0
     load_total = load_caught = 0
