@@ -60,7 +60,7 @@ def test_complete_registrations_make_unknown_nodes_errors(
     assert "did you mean 'Charge'?" in found[6][2]
     assert 7 not in found  # <Charge until_percent="80"/>, registered by robot_lib
     # <Scan range="5"/>: Scan's port list is built by code: advisory.
-    assert found[8][:2] == ("warning", "undeclared-port")
+    assert found[8][:2] == ("hint", "undeclared-port")
     assert "ports read: none" in found[8][2]
     # Only the tree file's own <TreeNodesModel> declares Ghost: not registered.
     assert found[9][:2] == ("error", "unknown-node")
@@ -120,13 +120,14 @@ def test_what_makes_the_registrations_all_known(tmp_path: Path) -> None:
     loads = 'void g() { f.registerFromPlugin("x.so"); }'
     dynamic = _completeness(_ws(tmp_path / "3", FACTORY + loads))
     assert not dynamic.complete and "loads node plugins chosen at run time" in dynamic.why
-    helper = _completeness(
-        _ws(
-            tmp_path / "4",
-            FACTORY + "template <class T> void reg(BT::BehaviorTreeFactory& f, const char* name)"
-            " { f.registerNodeType<T>(name); }",
-        )
+    reg = (
+        "template <class T> void reg(BT::BehaviorTreeFactory& f, const char* name)"
+        " { f.registerNodeType<T>(name); }\n"
     )
+    # A helper of the project registers for its callers: each call names its node.
+    called = _completeness(_ws(tmp_path / "4", FACTORY + reg + 'void g() { reg<A>(f, "B"); }'))
+    assert called.complete
+    helper = _completeness(_ws(tmp_path / "5", FACTORY + reg + "void g() { reg<A>(f, name); }"))
     assert not helper.complete and "is not known statically" in helper.why
 
 
@@ -182,9 +183,11 @@ def test_a_registering_macro_not_read_leaves_the_registrations_unknown(tmp_path:
     read = "#define REG(T) f.registerNodeType<T>(#T);\n"
     assert _completeness(_ws(tmp_path / "1", read + FACTORY)).complete
     composed = "#define REG_NS(ns, Name) \\\n  f.registerNodeType<ns::Name>(#Name);\n"
-    found = _completeness(_ws(tmp_path / "2", composed + FACTORY))
+    assert _completeness(_ws(tmp_path / "2", composed + FACTORY)).complete
+    pasted = "#define REG_P(Name) \\\n  f.registerNodeType<Name##Node>(#Name);\n"
+    found = _completeness(_ws(tmp_path / "3", pasted + FACTORY))
     assert not found.complete
-    assert found.why == "macro REG_NS of src/app/src/main.cpp registers nodes in a form not read"
+    assert found.why == "macro REG_P of src/app/src/main.cpp registers nodes in a form not read"
 
 
 _SLEEP_CPP = """#include <behaviortree_cpp_v3/bt_factory.h>

@@ -351,12 +351,16 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         )
         st.add(s, e, "undeclared-port", message)
     else:
-        message += (
-            "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
-            "could not all be read statically)"
-            if res.where
-            else "; BehaviorTree.CPP rejects it unless the C++ node declares it"
-        )
+        if res.where:
+            # A port list learned from C++ that was not all read (a definition, base or
+            # helper out of sight): what is missing may be just this port.
+            message += (
+                "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
+                "could not all be read statically: the hover on the node says what was not)"
+            )
+            st.add(s, e, "undeclared-port", message, Severity.HINT)
+            return
+        message += "; BehaviorTree.CPP rejects it unless the C++ node declares it"
         st.add(s, e, "undeclared-port", message, Severity.WARNING)
 
 

@@ -41,6 +41,13 @@ public:
   static BT::PortsList providedPorts() { return {}; }
 };
 
+// Another class under the same ID: which one a program registers is not known.
+class OtherTwin : public BT::SyncActionNode
+{
+public:
+  static BT::PortsList providedPorts() { return {}; }
+};
+
 template <class T>
 void registerLater(BT::BehaviorTreeFactory& factory, const std::string& name)
 {
@@ -54,6 +61,7 @@ BT_REGISTER_NODES(factory)
   factory.registerNodeType<Built>("Built");
   factory.registerNodeType<Spin>("Spin");
   factory.registerNodeType<Twin>("Twin");
-  factory.registerNodeType<Twin>("Twin");
+  factory.registerNodeType<OtherTwin>("Twin");
   factory.registerNodeType<Missing>("Missing");
+  registerLater<Wait>(factory, computed_name);
 }
