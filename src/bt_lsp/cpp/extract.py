@@ -739,9 +739,34 @@ class _Reader:
                 if last == "providedBasicPorts" and len(args) <= 1:
                     inner = self.ports_expr(args[0], local) if args else ()
                     return (Op("basic", ref=scope, ops=inner),)
+                # A helper not followed (``appendPorts(Base::providedPorts(), {…})``): its
+                # result is unknown, the port lists given to it are kept.
+                given = [
+                    op
+                    for a in args
+                    if self._is_port_list(a, local)
+                    for op in self.ports_expr(a, local)
+                ]
+                if given:
+                    return (Op("unknown", ref=squash(self.text(n))[:80]), *given)
         if t == "parenthesized_expression" and n.named_children:
             return self.ports_expr(n.named_children[0], local)
         return (Op("unknown", ref=squash(self.text(n))[:80]),)
+
+    def _is_port_list(self, n: Node, local: dict[str, list[Op]]) -> bool:
+        """Whether ``n`` is plainly a port list: ``{InputPort…}``, a local port list,
+        ``X::providedPorts()``."""
+        if n.type == "initializer_list":
+            return any(self._is_port_call(c) for c in n.named_children)
+        if n.type == "identifier":
+            return self.text(n) in local
+        if n.type == "call_expression":
+            fn = n.child_by_field_name("function")
+            return fn is not None and last_name(strip_args(self.text(fn))) in (
+                "providedPorts",
+                "providedBasicPorts",
+            )
+        return False
 
     def _port_direction(self, call: Node) -> str | None:
         fn = call.child_by_field_name("function")

@@ -22,8 +22,16 @@ public:
   }
 };
 
+// A base of a BehaviorTree.ROS2 fork: an action, its basic ports are the fork's.
+class PubTwist : public BT::RosTopicPubStatefulActionNode<Twist>
+{
+public:
+  static BT::PortsList providedPorts() { return providedBasicPorts({ BT::InputPort<double>("v") }); }
+};
+
 BT_REGISTER_NODES(factory)
 {
+  factory.registerNodeType<PubTwist>("PubTwist");
   factory.registerNodeType<Grip>("Grip");
   factory.registerNodeType<Fib>("Fib");
 }

@@ -65,3 +65,19 @@ BT_REGISTER_NODES(factory)
   factory.registerNodeType<Missing>("Missing");
   registerLater<Wait>(factory, computed_name);
 }
+
+// A helper that merges port lists with a loop: its result is not read, the lists given
+// to it are kept (the list stays incomplete).
+class Merged : public BT::SyncActionNode
+{
+public:
+  static BT::PortsList providedPorts()
+  {
+    return appendPorts(Wait::providedPorts(), { BT::InputPort<int>("goal_x") });
+  }
+};
+
+void registerMore(BT::BehaviorTreeFactory& factory)
+{
+  factory.registerNodeType<Merged>("Merged");
+}
