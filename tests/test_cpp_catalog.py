@@ -56,6 +56,7 @@ def test_every_form_has_a_fixture() -> None:
         "basic_ports",
         "literal_defaults",
         "macro_composed",
+        "registrar",
     }
 
 

@@ -31,7 +31,7 @@ from bt_lsp.cpp.facts import (
     Registration,
     Span,
 )
-from bt_lsp.cpp.names import last_name, squash, strip_args, unescape
+from bt_lsp.cpp.names import last_name, split_top, squash, strip_args, unescape
 from bt_lsp.cpp.tree_walk import declared_name, enclosing_call, template_args, up, up_to
 
 Node = tree_sitter.Node
@@ -108,10 +108,22 @@ _MACRO_BODY: Final = re.compile(
 )
 
 
+# A macro whose body calls a function template or makes an object of a class template
+# with a parameter as its class and a stringified parameter (or a literal) as the ID:
+# ``#define REG(T) static Registrar<T> reg_##T(#T);``, ``#define REG(T) reg<T>(f, #T)``.
+# It registers when the function or class is a registering helper of the project.
+_MACRO_HELPER: Final = re.compile(
+    r"\b([A-Za-z_]\w*)\s*<\s*((?:::)?[A-Za-z_]\w*(?:\s*::\s*[A-Za-z_]\w*)*)\s*>\s*"
+    r"(?:[A-Za-z_][\w#]*\s*)?[({]\s*(?:[^(){};\"]*?,\s*)?"
+    r"(?:#\s*([A-Za-z_]\w*)|\"((?:[^\"\\]|\\.)*)\")"
+)
 # Calls that may be of a project's registering helper: a function template called with
 # template arguments (``reg<MyNode>(factory, "MyNode")``), or a function whose name says
 # it registers.  Only those with a string literal among their arguments are kept.
 _HELPER_CALL: Final = re.compile(rb"\b([A-Za-z_]\w*)[ \t]*(?:<[^;{}()]*?>[ \t\r\n]*\(|\()")
+_REGISTRAR_OBJECT: Final = re.compile(
+    rb"\b([A-Za-z_]\w*)[ \t]*<[^;{}()]*?>[ \t\r\n]*[A-Za-z_]\w*[ \t]*[({][ \t\r\n]*\""
+)
 _HELPER_NAME: Final = re.compile(r"[Rr]egist|^[Rr]eg(?:[A-Z_]|$)|^add[A-Z]")
 _NOT_HELPERS: Final = frozenset(
     {
@@ -505,8 +517,12 @@ class _Reader:
             nm = declared_name(d) if d is not None else None
             params.append(self.text(nm) if nm is not None else "")
         tparams: tuple[str, ...] = ()
-        if fn.parent is not None and fn.parent.type == "template_declaration":
-            tl = fn.parent.child_by_field_name("parameters")
+        holder = fn.parent
+        if holder is not None and holder.type == "field_declaration_list":
+            # A member (a registrar's constructor): the class template's parameters.
+            holder = holder.parent.parent if holder.parent is not None else None
+        if holder is not None and holder.type == "template_declaration":
+            tl = holder.child_by_field_name("parameters")
             if tl is not None:
                 tparams = tuple(p for p in map(self._template_param, tl.named_children) if p)
         id_text = self.text(id_node).strip()
@@ -531,6 +547,7 @@ class _Reader:
         return True
 
     def _helper_calls(self, root: Node) -> Iterator[HelperCall]:
+        yield from self._registrar_objects(root)
         for m in _HELPER_CALL.finditer(self.src):
             name = m.group(1).decode()
             templated = m.group(0).rstrip(b"( \t\r\n").endswith(b">")
@@ -559,6 +576,38 @@ class _Reader:
                 tuple(self.span(a) for a in args),
                 self.span(call),
             )
+
+    def _registrar_objects(self, root: Node) -> Iterator[HelperCall]:
+        """Objects of a class template made with a string argument, which may be of a
+        registrar: ``static Registrar<MyNode> reg("MyNode");``."""
+        for m in _REGISTRAR_OBJECT.finditer(self.src):
+            ident = root.descendant_for_byte_range(m.start(1), m.end(1))
+            if ident is None or ident.type != "type_identifier":
+                continue
+            decl = up_to(ident, ("declaration",), 4)
+            tt = ident.parent
+            if decl is None or tt is None or tt.type != "template_type":
+                continue
+            for d in decl.children_by_field_name("declarator"):
+                if d.type != "init_declarator":
+                    continue
+                value = d.child_by_field_name("value")
+                if value is None or value.type not in ("argument_list", "initializer_list"):
+                    continue
+                args = [a for a in value.named_children if a.type != "comment"]
+                values = tuple(self.string(a) for a in args)
+                if all(v is None for v in values):
+                    continue
+                targs = tt.child_by_field_name("arguments")
+                inner = self.text(targs)[1:-1] if targs is not None else ""
+                yield HelperCall(
+                    self.text(ident),
+                    tuple(squash(a) for a in split_top(inner)),
+                    tuple(squash(self.text(a)) for a in args),
+                    values,
+                    tuple(self.span(a) for a in args),
+                    self.span(d),
+                )
 
     def _ports_fn(self, ident: Node, name: str) -> None:
         decl = ident.parent
@@ -837,10 +886,14 @@ class _Reader:
             return
         body = re.sub(r"\\\r?\n", " ", self.text(value))  # continuation lines joined
         m = _MACRO_BODY.search(body)
-        if m is None:
-            return
+        if m is not None:
+            form, cls_text, str_p, id_p, lit = m.groups()
+        else:
+            h = _MACRO_HELPER.search(body)
+            if h is None or h.group(1) in _NOT_HELPERS:
+                return
+            (form, cls_text, str_p, lit), id_p = h.groups(), None
         plist = tuple(self.text(p) for p in params.named_children)
-        form, cls_text, str_p, id_p, lit = m.groups()
         cls_text = re.sub(r"\s+", "", cls_text)
         # The class is a parameter, or a name made of parameters (``ns::name``).
         cls_p = next((p for p in cls_text.split("::") if p in plist), None)
