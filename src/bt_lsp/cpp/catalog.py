@@ -324,9 +324,8 @@ class _Linker:
             m = self.macros.get(call.name)  # a change of it changes the registration
             if m is None or len(call.args) != len(m.params) or m.cls_param >= len(call.args):
                 continue
-            if m.form not in ("registerNodeType", "registerBuilder"):
-                if m.form not in self.helpers:
-                    continue  # the function or class it calls registers nothing
+            if m.form not in ("registerNodeType", "registerBuilder", *self.helpers):
+                continue  # the function or class it calls registers nothing
             cls = call.args[m.cls_param]
             if m.cls_text:
                 args = dict(zip(m.params, call.args, strict=False))
