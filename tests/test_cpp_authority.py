@@ -129,6 +129,9 @@ def test_what_makes_the_registrations_all_known(tmp_path: Path) -> None:
     assert called.complete
     helper = _completeness(_ws(tmp_path / "5", FACTORY + reg + "void g() { reg<A>(f, name); }"))
     assert not helper.complete and "is not known statically" in helper.why
+    # No call read: it registers from code bt-lsp does not see.
+    uncalled = _completeness(_ws(tmp_path / "6", FACTORY + reg))
+    assert not uncalled.complete and "is not known statically" in uncalled.why
 
 
 def test_dependencies_outside_the_workspace(tmp_path: Path) -> None:

@@ -238,6 +238,7 @@ class _Linker:
         self.constants: dict[str, str] = {}
         self.macros: dict[str, MacroTemplate] = {}
         self.helpers: dict[str, list[Helper]] = {}
+        self._called: set[str] = set()  # helpers whose calls were read
         # Class and constant names looked up and not found: the project layer reads the
         # files that may define them (lazily: most files declare no node) and links again.
         self.missing: set[str] = set()
@@ -289,6 +290,12 @@ class _Linker:
                 else:
                     by_id[id_] = node
                 nodes.append(node)
+        # A helper that takes the ID from its callers, with no call read: it registers
+        # from code not read (or a call not recognised), under IDs not known.
+        for path, f in self.files:
+            for h in f.helpers:
+                if h.id_param >= 0 and h.name not in self._called:
+                    unresolved.append(Unresolved(path, h.span, h.form, f"{h.name}(…)"))
         if self.memo is not None:
             self.memo.facts = dict(self.files)
             self.memo.nodes = made
@@ -326,6 +333,7 @@ class _Linker:
                 continue
             if m.form not in ("registerNodeType", "registerBuilder", *self.helpers):
                 continue  # the function or class it calls registers nothing
+            self._called.add(m.form)
             cls = call.args[m.cls_param]
             if m.cls_text:
                 args = dict(zip(m.params, call.args, strict=False))
@@ -346,6 +354,7 @@ class _Linker:
             for h in self.helpers.get(hc.name, ()):
                 if h.cls_tparam >= len(hc.targs) or h.id_param >= len(hc.args):
                     continue  # another overload
+                self._called.add(h.name)
                 hcls = hc.targs[h.cls_tparam] if h.cls_tparam >= 0 else h.cls
                 if h.id_param >= 0:
                     id_, ref = hc.values[h.id_param], None
