@@ -241,3 +241,31 @@ def test_a_v3_projects_own_sleep_is_its_c_plus_plus_node(
     severity, code, message = found[3]
     assert (severity, code) == ("error", "undeclared-port")
     assert "'Sleep' declares no port 'msec' (registered in src/napper/src/main.cpp:" in message
+
+
+def test_a_catalogs_port_types_win_over_the_spelling_of_the_cpp(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Nav2 writes ``uint16`` in its catalog and ``ActionResult::_error_code_type`` in its
+    C++: with the C++ read, the two spellings of one type must not make a mismatch."""
+    nodes = (
+        "struct Plan : BT::SyncActionNode { static BT::PortsList providedPorts() {\n"
+        '  return { BT::OutputPort<ActionResult::_error_code_type>("error_code_id") }; } };\n'
+        "struct Help : BT::ConditionNode { static BT::PortsList providedPorts() {\n"
+        '  return { BT::InputPort<uint16_t>("error_code") }; } };\n'
+        'int main() { BT::BehaviorTreeFactory f; f.registerNodeType<Plan>("Plan");\n'
+        'f.registerNodeType<Help>("Help"); }\n'
+    )
+    tree = _ws(tmp_path, nodes)
+    (tree.parent / "tree_nodes.xml").write_text(
+        '<root BTCPP_format="4"><TreeNodesModel>'
+        '<Action ID="Plan"><output_port name="error_code_id" type="uint16_t"/></Action>'
+        "</TreeNodesModel></root>\n"
+    )
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Plan error_code_id="{code}"/>\n<Help error_code="{code}"/>\n'
+        "</Sequence></BehaviorTree></root>\n"
+    )
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert not [f for f in found.values() if f[1] == "blackboard-type-mismatch"]

@@ -337,8 +337,10 @@ class CppModels:
         decls = self.decls(cat, ctx.btcpp_version)
         merged = dict(ctx.models)
         for id_, d in decls.items():
-            if id_ not in merged or cat.by_id[id_].authoritative:
+            if id_ not in merged:
                 merged[id_] = d
+            elif cat.by_id[id_].authoritative:
+                merged[id_] = _with_catalog_types(d, merged[id_])
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
@@ -510,6 +512,23 @@ def cpp_diagnostics(text: str, scanner: Scanner | None = None) -> list[Diagnosti
     data = text.encode("utf-8", "surrogatepass")
     facts = scanner.facts("<document>", data) if scanner is not None else extract(data)
     return cpp_name_diagnostics(facts, text)
+
+
+def _with_catalog_types(cpp: ModelDecl, other: ModelDecl) -> ModelDecl:
+    """The C++ model, with the port types of an authoritative catalog of the same node.
+
+    The C++ says which ports there are (a catalog may be older than the code); a catalog
+    spells their types as BehaviorTree.CPP exports them, where the C++ spells them as
+    written (``ActionResult::_error_code_type``, ``PoseStamped`` under a ``using``), so
+    types compared across nodes of both sources agree.
+    """
+    if not other.authoritative:
+        return cpp
+    types = {p.name: p.type for p in other.ports if p.type}
+    if not any(p.name in types and types[p.name] != p.type for p in cpp.ports):
+        return cpp
+    ports = tuple(replace(p, type=types.get(p.name, p.type)) for p in cpp.ports)
+    return cpp._replace(ports=ports)
 
 
 def _category(kind: str | None) -> Category:
