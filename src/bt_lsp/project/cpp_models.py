@@ -3,9 +3,10 @@
 A file inside a ROS package (the nearest ``package.xml``) sees the C++ of that package and
 of the packages it depends on that are in the same workspace (colcon ``src/``), not every
 node of the workspace; a file outside any package sees the C++ under the workspace
-folders.  A package's C++ is its ``src/`` and ``include/`` (the whole package when it has
-neither), or what the ``sources`` globs of the configuration name; build, install and
-log folders and the ``exclude`` globs are skipped.
+folders.  A package's C++ is every C++ file of the package, wherever it keeps it
+(:func:`~bt_lsp.project.cpp_scan.cpp_sources`, the rule ``bt-lsp models`` follows too), or
+what the ``sources`` globs of the configuration name; build, install and log folders,
+test folders (but for the one holding the tree) and the ``exclude`` globs are skipped.
 
 Files are read once and again only after :meth:`CppModels.file_changed` (or when their
 modification time or size changed, for the command line); their facts come from the
@@ -33,7 +34,7 @@ from typing import Final, NamedTuple
 from bt_lsp.cpp.catalog import Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
-from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, cpp_sources, find_cpp_files, scan
 from bt_lsp.project.packages import BTCPP_PACKAGES, Manifest, Packages, is_file
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.builtins import Category, Direction, PortModel
@@ -210,9 +211,7 @@ class CppModels:
         else:
             found = []
             for folder in folders:
-                parts = [folder / "src", folder / "include"]
-                present = [p for p in parts if p.is_dir()] if pkgs is not None else []
-                found.extend(find_cpp_files(present or [folder]))
+                found.extend(cpp_sources(folder, path))
         if exclude:
             found = [f for f in found if not any(f.match(g) for g in exclude)]
         return tuple(sorted(dict.fromkeys(found))[:MAX_CPP_FILES])
@@ -338,8 +337,10 @@ class CppModels:
         decls = self.decls(cat, ctx.btcpp_version)
         merged = dict(ctx.models)
         for id_, d in decls.items():
-            if id_ not in merged or cat.by_id[id_].authoritative:
+            if id_ not in merged:
                 merged[id_] = d
+            elif cat.by_id[id_].authoritative:
+                merged[id_] = _with_catalog_types(d, merged[id_])
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
@@ -511,6 +512,23 @@ def cpp_diagnostics(text: str, scanner: Scanner | None = None) -> list[Diagnosti
     data = text.encode("utf-8", "surrogatepass")
     facts = scanner.facts("<document>", data) if scanner is not None else extract(data)
     return cpp_name_diagnostics(facts, text)
+
+
+def _with_catalog_types(cpp: ModelDecl, other: ModelDecl) -> ModelDecl:
+    """The C++ model, with the port types of an authoritative catalog of the same node.
+
+    The C++ says which ports there are (a catalog may be older than the code); a catalog
+    spells their types as BehaviorTree.CPP exports them, where the C++ spells them as
+    written (``ActionResult::_error_code_type``, ``PoseStamped`` under a ``using``), so
+    types compared across nodes of both sources agree.
+    """
+    if not other.authoritative:
+        return cpp
+    types = {p.name: p.type for p in other.ports if p.type}
+    if not any(p.name in types and types[p.name] != p.type for p in cpp.ports):
+        return cpp
+    ports = tuple(replace(p, type=types.get(p.name, p.type)) for p in cpp.ports)
+    return cpp._replace(ports=ports)
 
 
 def _category(kind: str | None) -> Category:

@@ -355,7 +355,7 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         # node really declares is not known, so this is a hint.
         message += (
             "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
-            "could not all be read statically)"
+            "could not all be read statically: the hover on the node says what was not)"
             if res.where
             else "; BehaviorTree.CPP rejects it only if the C++ node does not declare it "
             "(BehaviorTree.CPP reads the C++ registration, not this model)"
