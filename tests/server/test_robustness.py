@@ -342,3 +342,28 @@ async def test_a_nul_character_in_an_include_path(client: BtClient) -> None:
     errors = [m.message for m in client.log_messages[seen:] if m.type == types.MessageType.Error]
     assert errors == []
     await _still_serving(client)
+
+
+# The states of typing ``<!--`` (or a DOCTYPE, a processing instruction) before ``<root>``:
+# the document has no element, and its outline was an internal error.
+HALF_DECLARATIONS = [
+    "<!<root>",
+    "<!-<root>",
+    "<!DOCTYPE<root>",
+    "<?<BehaviorTree ",
+    '<!<root BTCPP_format="4"><BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>',
+    '<!-<root BTCPP_format="4"><BehaviorTree ID="A"/></root>',
+    "<?x<root><BehaviorTree ID='A'/></root>",
+    "<![CDATA[<root>",
+]
+
+
+@clients("vscode", "nvim-0.11")
+async def test_outline_while_typing_a_declaration_before_root(client: BtClient) -> None:
+    for text in HALF_DECLARATIONS:
+        uri = client.open(text)
+        for method in (types.TEXT_DOCUMENT_DOCUMENT_SYMBOL, types.TEXT_DOCUMENT_FOLDING_RANGE):
+            answer = await raw_request(client, method, {"textDocument": {"uri": uri}})
+            assert answer is None or isinstance(answer, list), (text, method, answer)
+        client.close(uri)
+    await _still_serving(client)
