@@ -33,7 +33,8 @@ def _texts() -> list[str]:
 @pytest.mark.parametrize("text", _texts())
 def test_every_feature_on_a_half_typed_declaration(text: str) -> None:
     doc = Document(text)
-    assert len(doc.model.head.elements) >= 0
+    head = doc.model.head
+    assert head is not None and len(head.elements) >= 0
     outline_json(doc, Context(), "utf-16")
     document_symbols(doc)
     folding_ranges(doc)
@@ -47,7 +48,9 @@ def test_every_feature_on_a_half_typed_declaration(text: str) -> None:
 
 def test_an_empty_element_table_has_no_rows() -> None:
     for text in ["", "text", "<!", "<!<root>"]:
-        elements = Document(text).model.head.elements
+        head = Document(text).model.head
+        assert head is not None
+        elements = head.elements
         assert len(elements) == 0
         assert list(elements) == []
         assert list(elements[0:5]) == []
