@@ -167,6 +167,36 @@ async def test_reversed_and_overlapping_changes(client: BtClient) -> None:
         (types.TEXT_DOCUMENT_DIAGNOSTIC, {"textDocument": "file:///x.xml"}),
         (types.CODE_ACTION_RESOLVE, {"kind": "quickfix", "edit": "no"}),
         (types.CODE_ACTION_RESOLVE, [1, 2, 3]),
+        # cattrs made these a URI "5" and a line 0 (answered null or as line 0).
+        (
+            types.TEXT_DOCUMENT_HOVER,
+            {"textDocument": {"uri": 5}, "position": {"line": 0, "character": 0}},
+        ),
+        (
+            types.TEXT_DOCUMENT_HOVER,
+            {"textDocument": {"uri": "file:///x.xml"}, "position": {"line": "0", "character": 0}},
+        ),
+        (
+            types.TEXT_DOCUMENT_DEFINITION,
+            {"textDocument": {"uri": "file:///x.xml"}, "position": {"line": 0, "character": True}},
+        ),
+        (
+            types.TEXT_DOCUMENT_REFERENCES,
+            {
+                "textDocument": {"uri": "file:///x.xml"},
+                "position": {"line": 0, "character": 0},
+                "context": {"includeDeclaration": "yes"},
+            },
+        ),
+        (types.TEXT_DOCUMENT_DOCUMENT_SYMBOL, {"textDocument": {"uri": ["file:///x.xml"]}}),
+        (
+            types.TEXT_DOCUMENT_COMPLETION,
+            {
+                "textDocument": {"uri": "file:///x.xml"},
+                "position": {"line": 0, "character": 0},
+                "context": {"triggerKind": 9},
+            },
+        ),
     ],
 )
 @each_client
