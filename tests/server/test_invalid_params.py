@@ -102,6 +102,22 @@ def test_a_version_outside_the_integer_range_refuses_the_change(server: Server) 
     assert "AlwaysFailure" in _hover(s, 4)["result"]["contents"]["value"]
 
 
+def test_deeply_nested_params_are_refused_not_fatal(server: Server) -> None:
+    """Values nested as deep as the decoder reads, where a string or a number is due."""
+    s = server
+    deep: Any = 1
+    for _ in range(800):
+        deep = [deep]
+    params = {"textDocument": {"uri": deep}, "position": {"line": 0, "character": 0}}
+    answer = s.answer_to(msg("textDocument/hover", params, 20))
+    assert answer["error"]["code"] == -32602
+    changes = [{"uri": deep, "type": 1}, {"uri": "file:///nowhere/a.xml", "type": deep}]
+    s.write(frame(msg("workspace/didChangeWatchedFiles", {"changes": changes})))
+    s.write(frame(msg("$/cancelRequest", {"id": deep})))
+    s.write(frame(msg("workspace/didChangeConfiguration", {"settings": {"btLsp": deep}})))
+    assert "result" in _hover(s, 21)
+
+
 def test_nothing_was_written_to_stderr(server: Server) -> None:
     """(Runs last.) None of the bad messages above printed a traceback."""
     s = server

@@ -13,6 +13,7 @@ import contextlib
 import inspect
 import json
 import os
+import reprlib
 import sys
 from collections.abc import Generator
 from typing import Any, cast
@@ -54,21 +55,26 @@ def _json_type(value: object) -> str:
     return "an array" if isinstance(value, list) else "an object"
 
 
+def _short(value: object) -> str:
+    """A short quotation of a value from a message (deep or long ones elided)."""
+    return reprlib.repr(value)
+
+
 def _structure_str(value: object, kind: type[str]) -> str:
     if not isinstance(value, str):
-        raise TypeError(f"a string was expected, not {_json_type(value)}: {value!r}"[:200])
+        raise TypeError(f"a string was expected, not {_json_type(value)}: {_short(value)}")
     return value if kind is str else kind(value)  # a string enumeration checks its values
 
 
 def _structure_int(value: object, kind: type[int]) -> int:
     if not isinstance(value, int) or isinstance(value, bool):
-        raise TypeError(f"an integer was expected, not {_json_type(value)}: {value!r}"[:200])
+        raise TypeError(f"an integer was expected, not {_json_type(value)}: {_short(value)}")
     return value if kind is int else kind(value)  # an IntEnum (FileChangeType) checks its values
 
 
 def _structure_bool(value: object, _: object) -> bool:
     if not isinstance(value, bool):
-        raise TypeError(f"a boolean was expected, not {_json_type(value)}: {value!r}"[:200])
+        raise TypeError(f"a boolean was expected, not {_json_type(value)}: {_short(value)}")
     return value
 
 
@@ -109,6 +115,12 @@ class BtProtocol(LanguageServerProtocol):
     def receive(self, body: Body) -> None:
         """One message body from the framing: answered with the JSON-RPC error it
         deserves, or structured and handled.  Nothing here may end the read loop."""
+        try:
+            self._receive(body)
+        except Exception as exc:  # (a value nested deep enough to fail a repr, a bug)
+            self.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    def _receive(self, body: Body) -> None:
         if body.error is not None:
             self.log(f"bt-lsp: parse error: {body.error}")
             self._send_error(None, jsonrpc.PARSE_ERROR, f"Parse error: {body.error}")
@@ -160,7 +172,7 @@ class BtProtocol(LanguageServerProtocol):
             try:
                 self._converter.structure(event, types.FileEvent)
             except Exception as exc:
-                bad.append(f"event {k} ({json.dumps(event)[:120]}): {_why(exc)}")
+                bad.append(f"event {k} ({_short(event)}): {_why(exc)}")
             else:
                 kept.append(event)
         if bad:
