@@ -482,11 +482,14 @@ def create_server() -> BtServer:
     @server.feature(types.WORKSPACE_DID_CHANGE_WATCHED_FILES)
     def did_change_watched_files(ls: BtServer, params: types.DidChangeWatchedFilesParams) -> None:
         project_files = False
-        for change in params.changes:
-            path = to_fs_path(change.uri)
-            if path:
-                ls.project.file_changed(path)
-                project_files = project_files or is_project_file(Path(path))
+        for change in params.changes:  # each alone: one that fails leaves the others
+            try:
+                path = to_fs_path(change.uri)
+                if path:
+                    ls.project.file_changed(path)
+                    project_files = project_files or is_project_file(Path(path))
+            except Exception:
+                ls.log_error(f"reading the change of {change.uri}")
         ls.refresh_all()
         if project_files:
             sync_config_diagnostics(ls)
