@@ -41,7 +41,8 @@ DOC = (
     "    </Sequence>\n"
     "  </BehaviorTree>\n"
     "  <TreeNodesModel>\n"
-    '    <Action ID="Go"><input_port name="goal"/><input_port name="name"/></Action>\n'
+    '    <Action ID="Go"><input_port name="goal"/></Action>\n'
+    '    <SubTree ID="T"><input_port name="name" default="x"/></SubTree>\n'
     '    <Action ID="Bad.Id"/>\n'
     "  </TreeNodesModel>\n"
     "</root>\n"

@@ -133,8 +133,8 @@ def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTIC
     return Capped(diags, more)
 
 
-# The violations of each name text, per role (a role decides the kind and whether the
-# name is declared): model and port names repeat (every use of a node type or port), and
+# The violations of each name text, per role (a role decides the kind): model and port
+# names repeat (every use of a node type or port), and
 # a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
 # names rarely repeat and their rule is quick: they are not kept (they would cost memory
 # in proportion to the documents).  Bounded.
@@ -143,11 +143,14 @@ _MAX_CACHED = 4096
 
 
 def violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
-    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role)."""
+    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role), as
+    the document alone tells: a reserved name of a declared port is reported by the
+    semantic checks, which know the model entry and the BehaviorTree.CPP version
+    (:func:`bt_lsp.rules.names.reserved_port_declaration`)."""
     cache = _VIOLATIONS[role]
     found = cache.get(text)
     if found is None:
-        found = check_name(text, kind, declaration=role is Role.PORT_DECL)
+        found = check_name(text, kind)
         if kind is not NameKind.INSTANCE:
             if len(cache) >= _MAX_CACHED:
                 cache.clear()

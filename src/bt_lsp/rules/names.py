@@ -16,7 +16,7 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Final
 
-from bt_lsp.rules.codes import NAMES, FixData, Severity, define
+from bt_lsp.rules.codes import BT, NAMES, FixData, Severity, define
 from bt_lsp.syntax.elements import Role
 from bt_lsp.syntax.vocabulary import (
     BTCPP_RESERVED_ATTRIBUTES,
@@ -80,10 +80,36 @@ PORT_NAME_LEADING_DIGIT: Final = define(
 PORT_NAME_RESERVED: Final = define(
     "port-name-reserved",
     Severity.ERROR,
-    "a port declared in `<TreeNodesModel>` uses a reserved attribute name",
+    "a port of a `<SubTree>` model is named after an attribute BehaviorTree.CPP reserves "
+    "(`ID`, `name`, `_autoremap`, the pre/post conditions); 4.8.4 and later throw when "
+    "they load the model",
     NAMES,
     fixes=NAME_FIX_TITLES,
 )
+PORT_NAME_RESERVED_GROOT2: Final = define(
+    "port-name-reserved-groot2",
+    Severity.WARNING,
+    "a port declared in `<TreeNodesModel>` has a name the name rules (Groot2) reserve, "
+    "where BehaviorTree.CPP accepts it (`__shared_blackboard`, `_description`, or an entry "
+    "BehaviorTree.CPP does not read)",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+)
+# Not a name-rule code: the name is right for Groot 1 and BehaviorTree.CPP 3, so no fix
+# renames it (the name fixes and ``check --fix`` act on every code of the NAMES family).
+PORT_NAME_GROOT1: Final = define(
+    "port-name-groot1",
+    Severity.HINT,
+    "`__shared_blackboard` declared as a port of a `<SubTree>` model, Groot 1's way of "
+    "writing BehaviorTree.CPP 3's shared blackboard, in a file not checked as version 4",
+    BT,
+)
+
+#: The name codes that depend on the project's BehaviorTree.CPP version and on the model
+#: entry a port is declared in: reported by the semantic checks
+#: (:func:`reserved_port_declaration`), never by a document's own name rules nor the early
+#: name pass.
+PROJECT_NAME_CODES: Final = frozenset({"port-name-reserved", "port-name-reserved-groot2"})
 PORT_NAME_FORBIDDEN_CHAR: Final = define(
     "port-name-forbidden-char",
     Severity.ERROR,
@@ -105,6 +131,7 @@ __all__ = [
     "FORBIDDEN",
     "POSTCONDITIONS",
     "PRECONDITIONS",
+    "PROJECT_NAME_CODES",
     "RESERVED_MODEL_NAMES",
     "RESERVED_PORT_NAMES",
     "RULES",
@@ -114,6 +141,7 @@ __all__ = [
     "check_name",
     "is_allowed_port_name",
     "may_hold_bad_instance_name",
+    "reserved_port_declaration",
 ]
 
 
@@ -251,7 +279,18 @@ _RULE_PORT_LEADING_DIGIT: Final = "A port name cannot start with a digit (0-9)."
 _RULE_PORT_RESERVED: Final = (
     "A port declared in <TreeNodesModel> cannot use a reserved attribute name: "
     + ", ".join(_RESERVED_PORT_ORDER)
-    + "."
+    + " (the name rules, as Groot2 applies them to every model entry)."
+)
+_RULE_PORT_RESERVED_BTCPP: Final = (
+    "A port of a <SubTree> model cannot be named after an attribute BehaviorTree.CPP "
+    "reserves: "
+    + ", ".join(n for n in _RESERVED_PORT_ORDER if n in BTCPP_RESERVED_ATTRIBUTES)
+    + " (BehaviorTree.CPP 4.8.4 and later throw when they load such a model)."
+)
+_RULE_PORT_GROOT1: Final = (
+    "Groot 1 declares __shared_blackboard, BehaviorTree.CPP 3's attribute of a <SubTree> "
+    "call, as a port of <SubTree> models; BehaviorTree.CPP 3 does not read them, Groot2 "
+    "reserves the name and BehaviorTree.CPP 4 shares a blackboard with _autoremap instead."
 )
 _RULE_PORT_FORBIDDEN: Final = f"A port name cannot contain {_FORBIDDEN_LIST}."
 _RULE_INSTANCE_CONTROL: Final = (
@@ -266,7 +305,8 @@ RULES: Final[dict[str, str]] = {
     "model-name-forbidden-char": _RULE_MODEL_FORBIDDEN,
     "port-name-empty": _RULE_PORT_EMPTY,
     "port-name-leading-digit": _RULE_PORT_LEADING_DIGIT,
-    "port-name-reserved": _RULE_PORT_RESERVED,
+    "port-name-reserved": _RULE_PORT_RESERVED_BTCPP,
+    "port-name-reserved-groot2": _RULE_PORT_RESERVED,
     "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
     "instance-name-control-char": _RULE_INSTANCE_CONTROL,
     # Where names are born (bt_lsp.rules.cpp_names).
@@ -287,9 +327,12 @@ RULES: Final[dict[str, str]] = {
 def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple[Violation, ...]:
     """Every rule ``name`` breaks as a ``kind`` of name; ``()`` when it is valid.
 
-    ``declaration`` is true for a port declared in ``<TreeNodesModel>``: only there is a
-    reserved attribute name (:data:`RESERVED_PORT_NAMES`) an error. Port violations come
-    in the order empty, leading digit, reserved, forbidden character.
+    ``declaration`` is true for a port declared in ``<TreeNodesModel>``: only there does a
+    reserved attribute name (:data:`RESERVED_PORT_NAMES`) break a rule, ``port-name-reserved``
+    for one BehaviorTree.CPP reserves, ``port-name-reserved-groot2`` for the two only the
+    name rules reserve. What a document reports for such a declaration depends on the
+    entry and the BehaviorTree.CPP version (:func:`reserved_port_declaration`). Port
+    violations come in the order empty, leading digit, reserved, forbidden character.
     """
     if kind is NameKind.MODEL:
         if not name:
@@ -329,7 +372,14 @@ def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple
                 f"Port name {_quote(name)} is a reserved attribute name and cannot be "
                 "declared as a port"
             )
-            found.append(Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED))
+            if name in BTCPP_RESERVED_ATTRIBUTES:
+                found.append(
+                    Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED_BTCPP)
+                )
+            else:
+                found.append(
+                    Violation("port-name-reserved-groot2", message, (), _RULE_PORT_RESERVED)
+                )
         if _FORBIDDEN_RE.search(name) is not None:
             found.append(
                 _char_violation(
@@ -391,6 +441,87 @@ def is_allowed_port_name(name: str) -> bool:
         and _FORBIDDEN_RE.search(name) is None
         and name not in BTCPP_RESERVED_ATTRIBUTES
     )
+
+
+# What each attribute BehaviorTree.CPP reserves is, for the messages.
+_RESERVED_MEANING: Final[dict[str, str]] = {
+    "ID": "`ID` names the tree a <SubTree> calls",
+    "name": "`name` is the instance name of every node",
+    "_autoremap": "`_autoremap` is an attribute of the <SubTree> call itself, not a port",
+    **{n: f"`{n}` is a precondition script of every node" for n in PRECONDITIONS},
+    **{n: f"`{n}` is a postcondition script of every node" for n in POSTCONDITIONS},
+}
+_BTCPP4_RESERVES = "it reserves only ID, name, _autoremap and the pre/post conditions"
+
+
+def reserved_port_declaration(name: str, entry: str, btcpp: str | None) -> Violation | None:
+    """What a document reports for a port declared as ``name`` in a ``<TreeNodesModel>``
+    entry ``<entry>`` when the name is reserved (:data:`RESERVED_PORT_NAMES`), else ``None``.
+
+    ``btcpp`` is the BehaviorTree.CPP major version the file is checked against: ``"3"``,
+    ``"4"``, or ``None`` when it is checked as 4 without a build or ``BTCPP_format``
+    saying so. BehaviorTree.CPP 3 reads no ``<TreeNodesModel>``; 4 reads only its
+    ``<SubTree>`` entries, and since 4.8.4 throws for a port named after an attribute it
+    reserves (``validatePortName``). So that is the one error (``port-name-reserved``);
+    ``__shared_blackboard`` in a ``<SubTree>`` model of a file not known to be for
+    version 4 is Groot 1's convention for version 3 (a hint, ``port-name-groot1``); every
+    other reserved name only the name rules (Groot2) reject (``port-name-reserved-groot2``).
+    """
+    if name not in RESERVED_PORT_NAMES:
+        return None
+    q = _quote(name)
+    subtree = entry == "SubTree"
+    if subtree and name == "__shared_blackboard" and btcpp != "4":
+        why = (
+            "this project builds against BehaviorTree.CPP 3"
+            if btcpp == "3"
+            else "no BTCPP_format or build says this file is for BehaviorTree.CPP 4"
+        )
+        message = (
+            f"Port {q} of a <SubTree> model is how Groot 1 writes BehaviorTree.CPP 3's "
+            f"__shared_blackboard attribute of a <SubTree> call ({why}); BehaviorTree.CPP 3 "
+            "does not read <TreeNodesModel>. Groot2's name rules reserve the name, and "
+            "BehaviorTree.CPP 4 ignores that attribute: it shares a blackboard with "
+            '_autoremap="true"'
+        )
+        return Violation("port-name-groot1", message, (), _RULE_PORT_GROOT1)
+    if subtree and btcpp != "3" and name in BTCPP_RESERVED_ATTRIBUTES:
+        message = (
+            f"Port name {q} is reserved by BehaviorTree.CPP: {_RESERVED_MEANING[name]}. "
+            "BehaviorTree.CPP 4.8.4 and later throw when they load this <SubTree> model "
+            f'("Port name {q} is a reserved attribute name"); 4.0 to 4.8.3 accepted it'
+        )
+        return Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED_BTCPP)
+    start = f"Port name {q} is reserved by the name rules (Groot2 rejects it)"
+    if btcpp == "3":
+        message = (
+            f"{start}; BehaviorTree.CPP 3, which this project builds against, does not "
+            "read <TreeNodesModel>"
+        )
+        if subtree and name in BTCPP_RESERVED_ATTRIBUTES:
+            message += ", and BehaviorTree.CPP 4.8.4 and later throw when they load it"
+    elif not subtree:
+        message = (
+            f"{start}; BehaviorTree.CPP reads only the <SubTree> entries of "
+            "<TreeNodesModel>, but no C++ node can declare a port of that name "
+            "(BehaviorTree.CPP 4's CreatePort throws for it), so this entry describes a port "
+            "its node cannot have"
+        )
+    elif name == "__shared_blackboard":
+        message = (
+            f"{start}; BehaviorTree.CPP 4 accepts it in a <SubTree> model "
+            f"({_BTCPP4_RESERVES}) but ignores a __shared_blackboard attribute of a "
+            "<SubTree> call, BehaviorTree.CPP 3's way of sharing the blackboard: version 4 "
+            'shares it with _autoremap="true"'
+        )
+    else:
+        message = (
+            f"{start}; BehaviorTree.CPP 4 accepts it in a <SubTree> model "
+            f"({_BTCPP4_RESERVES}) but never passes a <SubTree> attribute of that name on "
+            "as a remapping (it does not start with a letter), so the port only takes its "
+            "default"
+        )
+    return Violation("port-name-reserved-groot2", message, (), _RULE_PORT_RESERVED)
 
 
 # --- helpers ------------------------------------------------------------------------------
