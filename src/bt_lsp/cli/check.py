@@ -44,7 +44,9 @@ from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.project import (
     BUILD_FOLDER,
+    NOT_BT,
     config_errors,
+    included_back,
     project_index,
     skip_reason,
     version_lines,
@@ -298,14 +300,24 @@ def run(
     if options.cpp:
         project.cpp = CppModels(project.roots, project.packages)
     skipped: Counter[str] = Counter()
+    not_bt: set[str] = set()  # kept by the walk until the includes are known
 
     def skip(path: str, is_dir: bool) -> bool:
         why = skip_reason(project, path, is_dir)
+        if why == NOT_BT:
+            not_bt.add(path)
+            return False
         if why is not None:
             skipped[why] += 1
         return why is not None
 
     files, walk_errors = collect_files(paths, skip)
+    named = {os.path.realpath(p) for p in paths if not os.path.isdir(p)}  # checked as given
+    not_bt = {p for p in not_bt if os.path.realpath(p) not in named}
+    not_bt -= included_back(project, files, not_bt)
+    if not_bt:
+        skipped[NOT_BT] += len(not_bt)
+        files = [f for f in files if f not in not_bt]
     if options.cpp:
         files += [str(f) for p in paths if os.path.isdir(p) for f in find_cpp_files([p])]
     progress = Progress(err, len(files), options.progress and len(files) > 1 and _isatty(err))

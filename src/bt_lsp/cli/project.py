@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping, Sequence, Set
 from typing import Final, Protocol
 
 from bt_lsp.project.config import ConfigError, Configs, Layer, excluded
@@ -18,6 +18,7 @@ __all__ = [
     "NOT_BT",
     "WALK_SKIP_DIRS",
     "config_errors",
+    "included_back",
     "project_index",
     "skip_reason",
     "version_lines",
@@ -89,8 +90,9 @@ def version_lines(workspace: ProjectIndex, files: Sequence[str]) -> list[str]:
 
 def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     """Why a walk over a folder leaves ``path`` out (``None``: it is checked): a build or
-    VCS folder, an ``exclude`` glob of its configuration, or a file whose top element is
-    not ``<root>`` (``package.xml``, launch files, URDF, pluginlib descriptions)."""
+    VCS folder, an ``exclude`` glob of its configuration, or a file whose content is not
+    BehaviorTree.CPP XML (``package.xml``, launch files, URDF, other tools' XML; see
+    :func:`bt_lsp.syntax.kind.looks_like_bt`)."""
     p = normalize(path)
     if is_dir:
         if p.name in WALK_SKIP_DIRS:
@@ -99,3 +101,21 @@ def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     if excluded(p, workspace.settings_for(p).exclude):
         return EXCLUDED
     return None if is_bt_file(p) else NOT_BT
+
+
+def included_back(workspace: ProjectIndex, files: Sequence[str], not_bt: Set[str]) -> set[str]:
+    """The files of ``not_bt`` (skipped for their content) that one of the other
+    ``files`` includes, directly or through others: BehaviorTree.CPP loads them as BT
+    XML, so they are checked as such."""
+    if not not_bt:
+        return set()
+    by_path = {normalize(f): f for f in not_bt}
+    out: set[str] = set()
+    for f in files:
+        if f in not_bt or not f.endswith(".xml"):
+            continue
+        for p in workspace.include_closure(normalize(f)):
+            hit = by_path.get(p)
+            if hit is not None:
+                out.add(hit)
+    return out
