@@ -50,6 +50,7 @@ from bt_lsp.cli.project import (
     project_index,
     skip_reason,
     version_lines,
+    workspace_lines,
 )
 from bt_lsp.cli.results import FileResult, exit_code, file_diagnostics, findings_of, plural, summary
 from bt_lsp.project.cpp_models import CppModels
@@ -349,6 +350,8 @@ def run(
         for why, n in sorted(skipped.items()):
             what = "folder" if why == BUILD_FOLDER else "file"
             say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
+        for line in workspace_lines(paths):
+            say(err, line + "\n")
         for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]

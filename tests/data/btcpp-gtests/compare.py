@@ -52,7 +52,14 @@ EMPTY_CATALOG = '<root BTCPP_format="4">\n  <TreeNodesModel/>\n</root>\n'
 def run_case(exe: str, folder: str, models: str | None = None) -> list[dict[str, Any]] | str:
     """bt-lsp's diagnostics for one case folder, or a string saying why there are none.
     ``models`` is the catalog to give a case that has no models.xml."""
-    argv = [*shlex.split(exe), "check", folder, "--format", "json", "--no-progress"]
+    # Each file is named too: the test feeds it to BehaviorTree.CPP, which loads it as BT
+    # XML whatever it looks like (a walk of the folder would skip an empty file).
+    fed = sorted(
+        os.path.join(folder, f)
+        for f in os.listdir(folder)
+        if f.endswith(".xml") and f != "models.xml"
+    )
+    argv = [*shlex.split(exe), "check", folder, *fed, "--format", "json", "--no-progress"]
     catalog = os.path.join(folder, "models.xml")
     if models is not None:
         argv += ["--models", catalog if os.path.isfile(catalog) else models]
