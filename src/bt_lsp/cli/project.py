@@ -47,6 +47,8 @@ class ProjectOptions(Protocol):
     def severities(self) -> Mapping[str, Severity | None]: ...
     @property
     def max_bytes(self) -> int: ...
+    @property
+    def min_severity(self) -> Severity | None: ...
 
 
 def workspace_of(path: str | os.PathLike[str]) -> tuple[Path, str]:
@@ -138,6 +140,7 @@ def project_index(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex
         models=tuple(normalize(m) for m in options.models) or None,
         btcpp=options.btcpp,
         severity=dict(options.severities) or None,
+        min_severity=options.min_severity,
     )
     found = list(workspaces(paths))
     roots = [r for r in found if not any(o != r and _under(r, o) for o in found)]
