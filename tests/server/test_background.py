@@ -321,9 +321,9 @@ def test_a_held_request_that_is_cancelled_is_answered_at_once(session: Session) 
 
 
 def test_a_large_document_that_is_not_bt_is_told_apart_on_the_worker(session: Session) -> None:
-    """Whether a large text is BT XML (a search of all of it when it is not) is found
-    while it is prepared: a launch file gets no diagnostics, and an edit that makes it
-    BT XML (found around the edit, not by another search) gets them."""
+    """Whether a large text is BT XML (a search of its head) is found while it is
+    prepared: a launch file gets no diagnostics, and an edit that makes it BT XML gets
+    them."""
     s = session
     uri = "untitled:launch.xml"
     body = "".join(f'  <node pkg="p{i}" exec="e" name="n{i}"/>\n' for i in range(8_000))
@@ -340,7 +340,9 @@ def test_a_large_document_that_is_not_bt_is_told_apart_on_the_worker(session: Se
     end = {"line": 1, "character": 0}
     change = {
         "textDocument": {"uri": uri, "version": 2},
-        "contentChanges": [{"range": {"start": end, "end": end}, "text": "<root>\n"}],
+        "contentChanges": [
+            {"range": {"start": end, "end": end}, "text": '<root BTCPP_format="4">\n'}
+        ],
     }
     s.raw.write(frame(msg("textDocument/didChange", change)))
     assert s.log[s.until(published(uri, 2))]["params"]["diagnostics"] != []
@@ -359,7 +361,7 @@ def test_what_is_analysed_on_the_worker() -> None:
     assert background.wants(od(cpp, "cpp")) and background.wants(od(cpp, "plaintext", "/a.hpp"))
     assert not background.wants(od(cpp[: CPP_WORKER_CHARS - 10], "cpp"))
     assert not background.wants(od(cpp, "plaintext"))  # neither BT nor C++
-    bt = "<root>" + " " * WORKER_CHARS + "</root>"
+    bt = '<root BTCPP_format="4">' + " " * WORKER_CHARS + "</root>"
     assert background.wants(od(bt, "xml")) and not background.wants(od(bt[:-2000], "xml"))
 
 

@@ -25,6 +25,9 @@ SEVERITY = {"port-name-reserved": "warning", "instance-name-control-char": "off"
 PROFILES["init-options"] = Profile(
     "visual-studio-code", init_options={"debounceMs": 0, "severity": SEVERITY}
 )
+PROFILES["min-severity"] = Profile(
+    "visual-studio-code", init_options={"debounceMs": 0, "minSeverity": "error"}
+)
 # debounceMs from initializationOptions, severities from workspace/configuration.
 PROFILES["configuration"] = Profile(
     "visual-studio-code", init_options={"debounceMs": 0}, configuration={"severity": SEVERITY}
@@ -110,6 +113,25 @@ async def test_initialization_options(client: BtClient) -> None:
     uri = client.open(DOC)
     assert _levels(await client.pushed(uri, 1)) == OVERRIDDEN
     await _no_debounce(client, uri, DOC, 1)
+
+
+@clients("min-severity")
+async def test_min_severity_publishes_the_errors_only(client: BtClient) -> None:
+    """The hint of Go's port without a default is not published, the errors are."""
+    uri = client.open(DOC)
+    published = await client.pushed(uri, 1)
+    assert {str(d.code) for d in published} == {c for c, _ in DEFAULTS}
+    assert {d.severity for d in published} == {Sev.Error}
+    _configure(client, {"minSeverity": "hint"})
+    await client.wait_until(
+        lambda: (
+            True
+            if (last := client.latest(uri)) is not None
+            and "missing-port-without-default" in {str(d.code) for d in last.diagnostics}
+            else None
+        ),
+        "the hint published with minSeverity hint",
+    )
 
 
 @clients("configuration", "configuration-pull")

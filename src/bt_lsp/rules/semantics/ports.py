@@ -18,13 +18,17 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   hint when that model lists none.  Nothing is
   reported when the model is unknown, or for a ``<SubTree>`` call without a model.
   Range: the attribute name.
-* ``missing-required-port``: a port without a default that is not given.  Built-ins:
-  input and inout ports, an error (the node fails when it reads it).  Custom models: a
-  hint at most, since BehaviorTree.CPP never checks ports when it loads or creates a tree
-  and a node's code often reads a port without a default as optional (``getInput``
-  returning an error).  ``<SubTree>`` models: every port whose ``default`` is absent or
-  empty, an error unless ``_autoremap`` is true ("is defining a mandatory port … but you
-  are not remapping it").  Range: the element name.
+* ``missing-required-port`` (error): a port without a default that is not given, where
+  BehaviorTree.CPP fails for it.  Built-ins: input and inout ports (the node fails when it
+  reads it); the ``SwitchN`` ports are a warning (it reads them as optional).
+  ``<SubTree>`` models: every port whose ``default`` is absent or empty, unless
+  ``_autoremap`` is true ("is defining a mandatory port … but you are not remapping it").
+  Range: the element name.
+* ``missing-port-without-default`` (hint): a port of a custom node's model without a
+  default that is not given.  BehaviorTree.CPP never checks ports when it loads or
+  creates a tree, and a node's code often reads a port without a default as optional
+  (``getInput`` returning an error, Nav2's fallbacks to parameters).  Range: the element
+  name.
 * ``invalid-port-value``: a literal that does not convert to the declared type (values in
   ``{…}`` are blackboard references and never checked); an error for an exact model
   (BehaviorTree.CPP converts the literal at tree creation for a strongly typed port with
@@ -86,7 +90,8 @@ from bt_lsp.syntax.tokens import Attr
 
 @dataclass(frozen=True, slots=True)
 class MissingPorts(FixData):
-    """The ports ``missing-required-port`` found missing, in their declared order."""
+    """The ports ``missing-required-port`` or ``missing-port-without-default`` found
+    missing, in their declared order."""
 
     ports: tuple[str, ...]
 
@@ -113,8 +118,15 @@ UNDECLARED_PORT: Final = define(
 MISSING_REQUIRED_PORT: Final = define(
     "missing-required-port",
     Severity.ERROR,
-    "a port without a default that is not given (a hint for custom nodes: "
-    "BehaviorTree.CPP does not check it)",
+    "a built-in's or a `<SubTree>` model's port without a default that is not given "
+    "(BehaviorTree.CPP fails)",
+    BT,
+)
+MISSING_PORT_WITHOUT_DEFAULT: Final = define(
+    "missing-port-without-default",
+    Severity.HINT,
+    "a custom node's port without a default that is not given (BehaviorTree.CPP does not "
+    "check it; the node's code may read it as optional)",
     BT,
 )
 INVALID_PORT_VALUE: Final = define(
@@ -407,7 +419,15 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
             "check ports when it loads or creates the tree, and a port without a default may "
             "be optional in the node's code"
         )
-        severity = Severity.HINT
+        st.add(
+            el.name_start,
+            el.name_end,
+            "missing-port-without-default",
+            message,
+            None,
+            MissingPorts(tuple(missing)),
+        )
+        return
     st.add(
         el.name_start,
         el.name_end,
