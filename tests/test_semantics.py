@@ -427,6 +427,15 @@ CASES: list[tuple[str, str, Expected]] = [
         T('<Sleep msec="10" ⟦timeout⟧="1"/>'),
         [("undeclared-port", E)],
     ),
+    (
+        "Groot 1's shared blackboard port in a file not checked as version 4",
+        '<⟦root⟧ main_tree_to_execute="Main"><BehaviorTree ID="Main">'
+        '<SubTree ID="Sub" ⟦__shared_blackboard⟧="true"/></BehaviorTree>'
+        '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree><TreeNodesModel>'
+        '<SubTree ID="Sub"><input_port name="⟦__shared_blackboard⟧" default="true"/>'
+        "</SubTree></TreeNodesModel></root>",
+        [("missing-format", W), ("unknown-attribute", W), ("port-name-groot1", H)],
+    ),
     ("hyphenated undeclared port", T('<Sleep msec="10" ⟦foo-bar⟧="1"/>'), [("undeclared-port", E)]),
     (
         "undeclared port of a declared node",
