@@ -27,7 +27,7 @@ from tests.server.conftest import (
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
-README = "https://github.com/bt-lsp/bt-lsp/blob/main/README.md"
+DOCS = "https://bt-lsp.github.io/bt-lsp/"
 
 TREE = marked(
     '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\n'
@@ -87,7 +87,7 @@ async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
     every = await client.diags(uri, 1)
     diags = names_only(every)
     assert summary(diags) == expected(client, TREE, TREE_CODES)
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    pages = Path(__file__).resolve().parents[2] / "docs" / "rules"
     td = client.profile.capabilities().text_document
     described = bool(
         td
@@ -102,9 +102,9 @@ async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
             assert d.code_description is None
             continue
         assert d.code_description is not None
-        # The link goes to the code's row in the README's table of codes.
-        assert d.code_description.href == f"{README}#{d.code}"
-        assert f'<a id="{d.code}"></a>' in readme, d.code
+        # The link goes to the code's page on the documentation site.
+        assert d.code_description.href == f"{DOCS}rules/{d.code}/"
+        assert (pages / f"{d.code}.md").is_file(), d.code
     for d in diags:
         assert d.severity == types.DiagnosticSeverity.Error
         assert isinstance(d.data, dict)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Final
 
+from bt_lsp.project.schema import FILE_KEYS
 from bt_lsp.project.settings import BTCPP_CHOICES, Settings
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.registry import CODES
@@ -43,15 +44,8 @@ MAX_DEPTH: Final = 64
 
 # What ``min-severity`` may be.
 MIN_SEVERITIES: Final = ("error", "warning", "information", "hint")
-KEYS: Final = (
-    "models",
-    "btcpp",
-    "severity",
-    "min-severity",
-    "exclude",
-    "ros-packages",
-    "sources",
-)
+# The keys, as the configuration reference documents them (bt_lsp.project.schema).
+KEYS: Final = FILE_KEYS
 
 
 class ConfigError(Exception):

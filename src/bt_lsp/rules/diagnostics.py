@@ -28,7 +28,31 @@ if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document, History
 
 # The codes of these rules (see bt_lsp.rules.registry).
-XML_SYNTAX: Final = define("xml-syntax", Severity.ERROR, "the document is not well-formed XML", XML)
+XML_SYNTAX: Final = define(
+    "xml-syntax",
+    Severity.ERROR,
+    "the document is not well-formed XML",
+    XML,
+    doc="""
+        The document is not well-formed XML, and tinyxml2, the parser BehaviorTree.CPP uses,
+        rejects it too: `Error parsing the XML: Error=XML_ERROR_MISMATCHED_ELEMENT …`. bt-lsp
+        reports the first such error where it is, with one diagnostic per problem, and keeps
+        checking what it can. What tinyxml2 accepts but XML does not (a raw `&` in an attribute,
+        text after the root) is a warning instead (`xml-unescaped-char`, `xml-lenient`).
+        """,
+    why="The file does not load at all.",
+    bad="""
+        <Sequence>
+          <AlwaysSuccess>
+        </Sequence>
+        """,
+    good="""
+        <Sequence>
+          <AlwaysSuccess/>
+        </Sequence>
+        """,
+    since="Every version.",
+)
 XML_EXTRA_ROOT: Final = define(
     "xml-extra-root",
     Severity.WARNING,

@@ -49,9 +49,34 @@ NAME_FIX_TITLES: Final = {
     "clear": "Clear '{old}' ({where})",
 }
 
+# The versions the name rules apply to (the ``since`` of each code's page).
+_NAME_RULES_SINCE: Final = (
+    "BehaviorTree.CPP 4.8.4 and later (the release that added name validation). Earlier "
+    "releases, 3.x included, load the name, but Groot2 and every newer release reject it, "
+    "so bt-lsp reports it for every version."
+)
+
 # The codes of these rules (see bt_lsp.rules.registry).
 MODEL_NAME_EMPTY: Final = define(
-    "model-name-empty", Severity.ERROR, "a model name is empty", NAMES, fixes=NAME_FIX_TITLES
+    "model-name-empty",
+    Severity.ERROR,
+    "a model name is empty",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+    doc="""
+        BehaviorTree.CPP checks every model name it reads from a tree (a node type written as an
+        element, `<BehaviorTree ID>`, `<SubTree ID>`) when it loads the XML, and rejects an empty
+        one: `Model/Node type name cannot be empty` (an empty `<SubTree ID="">` is reported as a
+        missing `ID`). bt-lsp also checks the `ID` of explicit nodes and `<TreeNodesModel>` entries.
+        """,
+    why="""
+        The file does not load: `registerBehaviorTreeFromFile` or `createTreeFromFile` throws, and
+        the robot never starts the tree. A node or tree without a name cannot be registered,
+        called or shown in Groot2.
+        """,
+    bad='<SubTree ID=""/>',
+    good='<SubTree ID="Dock"/>',
+    since=_NAME_RULES_SINCE,
 )
 MODEL_NAME_RESERVED: Final = define(
     "model-name-reserved",
@@ -59,6 +84,26 @@ MODEL_NAME_RESERVED: Final = define(
     "a model name is `Root` or `root`",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        `Root` and `root` are reserved: BehaviorTree.CPP rejects either as a node type, a tree ID
+        or a SubTree ID when it loads the XML (`'Root' is a reserved name and cannot be used as a
+        node type`). The match is exact, so `ROOT` or `RootTree` are fine.
+        """,
+    why="""
+        The file does not load. `<root>` is the document's top element, so a node or tree called
+        `Root` is easily confused with it, in the XML and in Groot2.
+        """,
+    bad="""
+        <BehaviorTree ID="Root">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="RootTree">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 MODEL_NAME_FORBIDDEN_CHAR: Final = define(
     "model-name-forbidden-char",
@@ -66,9 +111,66 @@ MODEL_NAME_FORBIDDEN_CHAR: Final = define(
     "a model name contains a forbidden character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A model name (node type, tree ID, SubTree ID) may hold any character except whitespace,
+        `< > & " '`, `/ \\ :`, `* ? |`, `.` and the control characters (ASCII 0-31, 127); any
+        non-ASCII letter is allowed. BehaviorTree.CPP rejects the name when it loads the XML:
+        `Model name 'Main Tree' contains forbidden character ' '`.
+        """,
+    why="""
+        The file does not load. A space or a period in a node type cannot even be written as an
+        XML element name, and a tree ID with one cannot be used in compact form or saved by
+        Groot2.
+        """,
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Main Tree">
+          <BehaviorTree ID="Main Tree">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main_Tree">
+          <BehaviorTree ID="Main_Tree">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_EMPTY: Final = define(
-    "port-name-empty", Severity.ERROR, "a port name is empty", NAMES, fixes=NAME_FIX_TITLES
+    "port-name-empty",
+    Severity.ERROR,
+    "a port name is empty",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+    doc="""
+        A port declared in a `<TreeNodesModel>` `<SubTree>` entry (`<input_port name="…">`) must
+        have a name: BehaviorTree.CPP rejects an empty one when it loads the XML (`Port name
+        cannot be empty`).
+        """,
+    why="""
+        The file does not load, and a port without a name can never be remapped.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name=""/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="target"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_LEADING_DIGIT: Final = define(
     "port-name-leading-digit",
@@ -76,6 +178,18 @@ PORT_NAME_LEADING_DIGIT: Final = define(
     "a port name starts with an ASCII digit",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A port name cannot start with an ASCII digit. BehaviorTree.CPP rejects such a port in a
+        `<TreeNodesModel>` `<SubTree>` entry when it loads the XML (`Port name '2x' cannot start
+        with a digit`), and never treats a node attribute that starts with a digit as a port.
+        """,
+    why="""
+        The file does not load; and an attribute such as `2nd_goal` is not even a well-formed XML
+        attribute name, so the port can never be set from XML.
+        """,
+    bad='<SubTree ID="Dock" 2nd_goal="{goal}"/>',
+    good='<SubTree ID="Dock" second_goal="{goal}"/>',
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_RESERVED: Final = define(
     "port-name-reserved",
@@ -85,6 +199,36 @@ PORT_NAME_RESERVED: Final = define(
     "they load the model",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        `ID`, `name`, `_autoremap` and the pre- and post-condition attributes (`_skipIf`,
+        `_successIf`, `_failureIf`, `_while`, `_onSuccess`, `_onFailure`, `_onHalted`, `_post`)
+        are reserved: BehaviorTree.CPP reads them itself on every node. It rejects a port declared
+        with one of these names in a `<TreeNodesModel>` `<SubTree>` entry when it loads the XML
+        (`Port name '_autoremap' is a reserved attribute name`).
+        """,
+    why="""
+        The file does not load; and the port could never be set, since the attribute of that name
+        means something else on every node.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="_autoremap"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="autoremap"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_RESERVED_GROOT2: Final = define(
     "port-name-reserved-groot2",
@@ -116,6 +260,19 @@ PORT_NAME_FORBIDDEN_CHAR: Final = define(
     "a port name contains a forbidden character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A port name has the same forbidden characters as a model name (whitespace, `< > & " '`,
+        `/ \\ :`, `* ? |`, `.`, control characters). BehaviorTree.CPP rejects such a port in a
+        `<TreeNodesModel>` `<SubTree>` entry when it loads the XML, and never treats such a node
+        attribute as a port: `door.id="…"` is silently ignored, not passed to the node.
+        """,
+    why="""
+        A period reads like a member access (`request.name`) and cannot be remapped; the node
+        never gets the value it was given, with no error at run time.
+        """,
+    bad='<OpenDoor door.id="{door}"/>',
+    good='<OpenDoor door_id="{door}"/>',
+    since=_NAME_RULES_SINCE,
 )
 INSTANCE_NAME_CONTROL_CHAR: Final = define(
     "instance-name-control-char",
@@ -123,6 +280,19 @@ INSTANCE_NAME_CONTROL_CHAR: Final = define(
     "an instance name contains a control character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        An instance name (`name="…"`) is an attribute value, so spaces, periods and any Unicode
+        are fine; only control characters other than tab, line feed and carriage return (ASCII
+        0-8, 11, 12, 14-31, 127) are rejected. BehaviorTree.CPP checks it when it creates the
+        tree: `Instance name 'start\\x07' contains invalid control character (ASCII 7)`.
+        """,
+    why="""
+        Tree creation fails. A control character is invisible in editors, logs and Groot2, and is
+        not allowed in XML 1.0 at all, so other XML tools refuse the file.
+        """,
+    bad='<Sequence name="start&#7;">',
+    good='<Sequence name="start">',
+    since=_NAME_RULES_SINCE,
 )
 
 

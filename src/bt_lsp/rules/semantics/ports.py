@@ -113,7 +113,29 @@ class AttributeSuggestion(FixData):
 
 # The codes of these rules (see bt_lsp.rules.registry).
 UNDECLARED_PORT: Final = define(
-    "undeclared-port", Severity.ERROR, "an attribute the node's model does not declare", BT
+    "undeclared-port",
+    Severity.ERROR,
+    "an attribute the node's model does not declare",
+    BT,
+    doc="""
+        An attribute whose name is a valid port name is a port, and the node's type must declare
+        it in `providedPorts()`. BehaviorTree.CPP 4 throws when it creates the tree: `a port with
+        name [speed] is found in the XML (<MoveBase>, line 3) but not in the providedPorts() of
+        its registered node type`. bt-lsp knows a node's ports from the built-ins, a node
+        catalog (`models`), the project's C++ or a `<TreeNodesModel>`; against a catalog or the
+        C++ it is an error, against a tree file's own `<TreeNodesModel>` (which BehaviorTree.CPP
+        does not read for nodes) a hint. A `<SubTree>` call passes any attribute on as a
+        remapping, so there it is a warning at most.
+        """,
+    why="""
+        The tree is not created; most often the port is misspelt (`goal_pose` for `goal`), and
+        bt-lsp suggests the closest declared name.
+        """,
+    bad='<Sleep msec="500" duration="1"/>',
+    good='<Sleep msec="500"/>',
+    since="""
+        BehaviorTree.CPP 4 (3.x ignores an attribute that is not a declared port).
+        """,
 )
 MISSING_REQUIRED_PORT: Final = define(
     "missing-required-port",
@@ -128,15 +150,83 @@ MISSING_PORT_WITHOUT_DEFAULT: Final = define(
     "a custom node's port without a default that is not given (BehaviorTree.CPP does not "
     "check it; the node's code may read it as optional)",
     BT,
+    doc="""
+        BehaviorTree.CPP does not check, when it loads or creates a tree, that a port without a
+        default is given. A built-in node reads it when it is ticked and fails then (`Missing
+        parameter [num_cycles] in RepeatNode`): an error. A custom node's code often treats a
+        port without a default as optional (`getInput` returns an error it handles), so there it
+        is a hint. For a `<SubTree>` whose model declares a port without a default, creating
+        the tree fails unless the call remaps it or sets `_autoremap="true"`: an error.
+        """,
+    why="""
+        The node fails on its first tick, on the robot, long after the tree loaded without
+        complaint.
+        """,
+    bad="<Repeat><MoveBase/></Repeat>",
+    good='<Repeat num_cycles="3"><MoveBase/></Repeat>',
+    since="""
+        Every version (the built-ins' ports are those of the detected version).
+        """,
 )
 INVALID_PORT_VALUE: Final = define(
-    "invalid-port-value", Severity.ERROR, "a literal that does not convert to the port's type", BT
+    "invalid-port-value",
+    Severity.ERROR,
+    "a literal that does not convert to the port's type",
+    BT,
+    doc="""
+        A literal value (not a `{blackboard}` reference) of a strongly typed port must convert to
+        the port's type. BehaviorTree.CPP 4 converts it when it creates the tree and throws: `The
+        port with name "msec" and value "abc" can not be converted to unsigned int`. bt-lsp
+        converts numbers, booleans, enums it knows and the built-in types as BehaviorTree.CPP's
+        `convertFromString` does: like `std::from_chars`, an integer only needs a leading number
+        (`"12abc"` reads as 12). Against a model from a tree file's `<TreeNodesModel>` it is a
+        warning.
+        """,
+    why="""
+        The tree is not created; a wrong unit or a typo in a number is caught before the robot runs.
+        """,
+    bad='<Sleep msec="half"/>',
+    good='<Sleep msec="500"/>',
+    since="""
+        BehaviorTree.CPP 4. Version 3 converts a literal only when the node reads the port, so
+        for a 3.x project it is a warning for a built-in and a hint for a custom node.
+        """,
 )
 BLACKBOARD_TYPE_MISMATCH: Final = define(
     "blackboard-type-mismatch",
     Severity.ERROR,
     "one blackboard key used by ports of different types",
     BT,
+    doc="""
+        Within one tree, a blackboard entry gets its type from the first port that uses it; a
+        port of another type using the same `{key}` makes BehaviorTree.CPP throw when it creates
+        the tree: `The creation of the tree failed because the port [count] was initially
+        created with type [int] and, later type [unsigned int] was used somewhere else`. A
+        `std::string` entry accepts anything, and two shared pointers of different classes are
+        accepted when the application registers a polymorphic cast (a hint then, since only
+        the C++ knows).
+        """,
+    why="""
+        The tree is not created; when it is (an untyped port in between), the node reading the
+        key gets a value it cannot use.
+        """,
+    bad="""
+        <Sequence>
+          <Repeat num_cycles="{count}">  <!-- num_cycles: int -->
+            <AlwaysSuccess/>
+          </Repeat>
+          <Sleep msec="{count}"/>        <!-- msec: unsigned int -->
+        </Sequence>
+        """,
+    good="""
+        <Sequence>
+          <Repeat num_cycles="{count}">
+            <AlwaysSuccess/>
+          </Repeat>
+          <Sleep msec="{wait_ms}"/>
+        </Sequence>
+        """,
+    since="BehaviorTree.CPP 4 (and 3.8, whose ports are typed the same way).",
 )
 PORT_NAME_NOT_REMAPPABLE: Final = define(
     "port-name-not-remappable",

@@ -61,7 +61,37 @@ TREE_CHILD_COUNT: Final = define(
     BT,
 )
 UNKNOWN_SUBTREE: Final = define(
-    "unknown-subtree", Severity.ERROR, "a `<SubTree ID>` that names no tree", BT
+    "unknown-subtree",
+    Severity.ERROR,
+    "a `<SubTree ID>` that names no tree",
+    BT,
+    doc="""
+        `<SubTree ID="X">` calls the tree `X`, which must be loaded by the time the tree is
+        created: otherwise BehaviorTree.CPP throws `Can't find a tree with name: X`. bt-lsp looks
+        in the document, the files it includes and the other BehaviorTree.CPP files of the
+        workspace; a tree defined in a file that is not included is a hint (the application must
+        register that file too).
+        """,
+    why="""
+        The tree is not created; a renamed or misspelt tree ID breaks every call to it.
+        """,
+    bad="""
+        <BehaviorTree ID="Main">
+          <SubTree ID="Dokc"/>
+        </BehaviorTree>
+        <BehaviorTree ID="Dock">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="Main">
+          <SubTree ID="Dock"/>
+        </BehaviorTree>
+        <BehaviorTree ID="Dock">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    since="Every version.",
 )
 UNKNOWN_MAIN_TREE: Final = define(
     "unknown-main-tree", Severity.ERROR, "`main_tree_to_execute` names no tree", BT
