@@ -123,11 +123,13 @@ _SETTING_VALUES: dict[str, Any] = {
     "rosPackages": {"pkg": "/opt/pkg"},
     "debounceMs": 0,
     "maxDocumentBytes": 1000,
+    "minSeverity": "warning",
 }
 _FILE_VALUES: dict[str, str] = {
     "models": '["nodes.xml"]',
     "btcpp": '"3"',
     "severity": '{ unknown-node = "off" }',
+    "min-severity": '"warning"',
     "exclude": '["generated"]',
     "ros-packages": '{ pkg = "pkg" }',
     "sources": '["src/**"]',

@@ -143,6 +143,23 @@ MISSING_REQUIRED_PORT: Final = define(
     "a built-in's or a `<SubTree>` model's port without a default that is not given "
     "(BehaviorTree.CPP fails)",
     BT,
+    doc="""
+        BehaviorTree.CPP does not check, when it loads or creates a tree, that a port without a
+        default is given. A built-in node reads it when it is ticked and fails then (`Missing
+        parameter [num_cycles] in RepeatNode`). For a `<SubTree>` whose model declares a port
+        without a default, creating the tree fails unless the call remaps it or sets
+        `_autoremap="true"`. Both are errors. (A custom node's port without a default is
+        `missing-port-without-default`, a hint.)
+        """,
+    why="""
+        The node fails on its first tick, on the robot, long after the tree loaded without
+        complaint.
+        """,
+    bad="<Repeat><AlwaysSuccess/></Repeat>",
+    good='<Repeat num_cycles="3"><AlwaysSuccess/></Repeat>',
+    since="""
+        Every version (the built-ins' ports are those of the detected version).
+        """,
 )
 MISSING_PORT_WITHOUT_DEFAULT: Final = define(
     "missing-port-without-default",
@@ -151,21 +168,18 @@ MISSING_PORT_WITHOUT_DEFAULT: Final = define(
     "check it; the node's code may read it as optional)",
     BT,
     doc="""
-        BehaviorTree.CPP does not check, when it loads or creates a tree, that a port without a
-        default is given. A built-in node reads it when it is ticked and fails then (`Missing
-        parameter [num_cycles] in RepeatNode`): an error. A custom node's code often treats a
-        port without a default as optional (`getInput` returns an error it handles), so there it
-        is a hint. For a `<SubTree>` whose model declares a port without a default, creating
-        the tree fails unless the call remaps it or sets `_autoremap="true"`: an error.
+        A custom node's model (its C++ `providedPorts()`, a catalog or a `<TreeNodesModel>`)
+        declares a port without a default, and the node is used without it. BehaviorTree.CPP
+        checks nothing here: the node's code decides, and code often reads such a port as
+        optional (`getInput` returns an error the node handles, as Nav2's nodes do), so this is
+        a hint. Silence it with `severity = { missing-port-without-default = "off" }` without
+        losing the built-ins' `missing-required-port` errors.
         """,
     why="""
-        The node fails on its first tick, on the robot, long after the tree loaded without
-        complaint.
+        When the node's code does need the port, the node fails at its first tick.
         """,
-    bad="<Repeat><MoveBase/></Repeat>",
-    good='<Repeat num_cycles="3"><MoveBase/></Repeat>',
     since="""
-        Every version (the built-ins' ports are those of the detected version).
+        Every version.
         """,
 )
 INVALID_PORT_VALUE: Final = define(
