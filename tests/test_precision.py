@@ -200,7 +200,7 @@ def test_an_authors_model_makes_an_undeclared_port_a_hint() -> None:
         with_models('<Say msg1="hi"/>', '<Action ID="Say"><input_port name="msg"/></Action>')
     )
     assert found(doc, Context.from_document(doc)) == [
-        ("missing-required-port", H),
+        ("missing-port-without-default", H),
         ("undeclared-port", H),
     ]
 
@@ -242,3 +242,19 @@ def test_another_packages_models_do_not_apply(tmp_path: Path) -> None:
     doc = ws.document(nav)
     assert doc is not None
     assert "FollowPath" in ws.context_for(nav, doc).models
+
+
+# --- placeholders ----------------------------------------------------------------------------
+
+
+def test_a_placeholder_replaced_before_loading_is_not_converted() -> None:
+    """PlanSys2 fills `${arg}` in its action trees, launch files `$(arg x)`, before
+    BehaviorTree.CPP reads the text: such a value is not a literal of the port's type."""
+    models = '<Action ID="Go"><input_port name="n" type="int"/></Action>'
+    for value, codes in (
+        ("${goal_reached}", []),
+        ("$(arg count)", []),
+        ("many", [("invalid-port-value", E)]),
+    ):
+        doc = Document(with_models(f'<Go n="{value}"/>', ""))
+        assert found(doc, catalog_ctx(doc, models)) == codes, value

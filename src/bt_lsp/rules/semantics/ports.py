@@ -87,6 +87,10 @@ from bt_lsp.rules.semantics.base import (
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.tokens import Attr
 
+# A placeholder that something replaces before BehaviorTree.CPP reads the text: `${name}`
+# (PlanSys2 fills its action trees' `${arg1}`), `$(arg name)` (ROS launch substitution).
+_TEMPLATE: Final = re.compile(r"\$\{[^}]*\}|\$\([^)]*\)")
+
 
 @dataclass(frozen=True, slots=True)
 class MissingPorts(FixData):
@@ -417,6 +421,10 @@ def _check_port(
         return
     if not port.type or (st.v3 and not value):
         # BehaviorTree.CPP 3.8 reads an empty value as not given (the default applies).
+        return
+    if _TEMPLATE.search(value):
+        # A `${name}` or `$(arg x)` placeholder: the application (PlanSys2's action trees) or
+        # a launch file replaces it before BehaviorTree.CPP reads the text.
         return
     problem = _convert(value, port.type)
     if problem is not None:
