@@ -9,8 +9,9 @@
   tree that exists, that is the name of a built-in node or of a node in an authoritative
   catalog (error: BehaviorTree.CPP refuses it when it loads the file) or of a node only an
   advisory ``<TreeNodesModel>`` declares (warning: refused if that node is registered).
-  A ``<SubTree ID>`` naming no tree is ``unknown-subtree`` whatever a catalog declares, so
-  that a file gets the same diagnostic whether the catalog is in the workspace or not.
+  A ``<SubTree ID>`` naming no tree is this error when a built-in or an authoritative model
+  registers the name (VerifyXML refuses it at load), else ``unknown-subtree`` whatever an
+  author's model declares.
   Range: the value.
 * ``duplicate-tree-id`` (warning): a tree ID defined again, in this document or in a
   document of its include closure (BehaviorTree.CPP silently keeps the last one loaded).
@@ -121,6 +122,15 @@ def _where(st: State, decl: TreeDecl) -> str:
     if st.ctx.is_own(decl):
         return f"line {st.line_of(decl.start) + 1}"
     return os.path.basename(decl.path) if decl.path else "another document"
+
+
+def _surely_registered(st: State, tree_id: str) -> bool:
+    """Whether a built-in or an authoritative model (a catalog, the C++) registers
+    ``tree_id``."""
+    if tree_id in BUILTINS:
+        return True
+    decl = st.ctx.models.get(tree_id)
+    return decl is not None and decl.authoritative
 
 
 def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) -> bool:
@@ -235,9 +245,13 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
             # A tree that exists: its ID must not be a registered node's name.
             if not _registered_name(st, "SubTree", a.value, s, e):
                 _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
+        elif _surely_registered(st, a.value):
+            # BehaviorTree.CPP's VerifyXML refuses the name at load, before it would look
+            # for the tree: that is the error it reports.
+            _registered_name(st, "SubTree", a.value, s, e)
         elif not check_name(a.value, NameKind.MODEL):
-            # No such tree, whatever a catalog says of the name (an ID that breaks a name
-            # rule is one problem: the name rules report it).
+            # No such tree, whatever an author's model says of the name (an ID that breaks a
+            # name rule is one problem: the name rules report it).
             _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
     name = el.attr("name")
     if name is not None and name.value is not None:
