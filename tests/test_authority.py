@@ -124,7 +124,7 @@ def test_registered_name_as_tree_id_is_an_error_against_a_catalog() -> None:
         '<BehaviorTree ID="BatteryLow"><AlwaysSuccess/></BehaviorTree>'
         '<TreeNodesModel><Condition ID="BatteryLow"/></TreeNodesModel>'
     )
-    assert codes(own) == [("registered-name-as-tree-id", W)]
+    assert codes(own) == [("registered-name-as-tree-id", H)]
 
 
 def test_missing_port_of_a_custom_node_is_a_hint_that_says_why() -> None:

@@ -131,7 +131,7 @@ CASES: list[tuple[str, str, Expected]] = [
             '<BehaviorTree ID="⟦Say⟧"><AlwaysSuccess/></BehaviorTree>\n'
             '<TreeNodesModel><Action ID="Say"/></TreeNodesModel>'
         ),
-        [("registered-name-as-tree-id", W)],
+        [("registered-name-as-tree-id", H)],
     ),
     (
         "BehaviorTree with 2 children",
@@ -188,7 +188,7 @@ CASES: list[tuple[str, str, Expected]] = [
             '<TreeNodesModel><Action ID="Say"/></TreeNodesModel>',
             'BTCPP_format="4" main_tree_to_execute="Main"',
         ),
-        [("registered-name-as-tree-id", W), ("registered-name-as-tree-id", W)],
+        [("registered-name-as-tree-id", H), ("registered-name-as-tree-id", H)],
     ),
     (
         "SubTree ID breaking a name rule and naming no tree: one problem",

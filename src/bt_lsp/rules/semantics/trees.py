@@ -8,7 +8,7 @@
 * ``registered-name-as-tree-id``: a ``<BehaviorTree ID>``, or a ``<SubTree ID>`` naming a
   tree that exists, that is the name of a built-in node or of a node in an authoritative
   catalog (error: BehaviorTree.CPP refuses it when it loads the file) or of a node only an
-  advisory ``<TreeNodesModel>`` declares (warning: refused if that node is registered).
+  advisory ``<TreeNodesModel>`` declares (a hint: refused if the C++ registers that node).
   A ``<SubTree ID>`` naming no tree is this error when a built-in or an authoritative model
   registers the name (VerifyXML refuses it at load), else ``unknown-subtree`` whatever an
   author's model declares.
@@ -163,8 +163,9 @@ def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) ->
                 "registered-name-as-tree-id",
                 f"{quoted(tree_id)} is declared as a node type (<{decl.category}> in "
                 f"<TreeNodesModel>{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
-                "registered node, if the C++ registers it",
-                Severity.WARNING,
+                "registered node, if the C++ registers it (BehaviorTree.CPP reads the C++ "
+                "registration, not this model)",
+                Severity.HINT,
             )
         return True
     return False
