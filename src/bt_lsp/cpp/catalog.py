@@ -29,6 +29,7 @@ from bt_lsp.cpp.facts import (
 )
 from bt_lsp.cpp.literals import to_str
 from bt_lsp.cpp.names import last_name, split_top, strip_args
+from bt_lsp.cpp.types import Bases, TypeNames
 
 __all__ = [
     "FLAG_DEFAULT_EXPRESSION",
@@ -77,7 +78,12 @@ _SIMPLE_KINDS: Final = {
 
 @dataclass(frozen=True, slots=True)
 class CppPort:
-    """A port as the C++ declares it; ``span`` is its name argument's."""
+    """A port as the C++ declares it; ``span`` is its name argument's.
+
+    ``resolved`` is ``type`` with the project's aliases followed and its classes
+    qualified, as far as the C++ read says (:mod:`bt_lsp.cpp.types`); ``classes`` the
+    class definitions read that it names.
+    """
 
     name: str
     direction: str
@@ -87,6 +93,8 @@ class CppPort:
     path: str
     span: Span
     default_is_expr: bool = False
+    resolved: str | None = None
+    classes: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True, slots=True)
@@ -194,6 +202,7 @@ def _defined(f: FileFacts) -> set[str]:
     out.update("k:" + k for k in f.constants)
     out.update("m:" + m.name for m in f.macros)
     out.update("h:" + h.name for h in f.helpers)
+    out.update("t:" + last_name(a.name) for a in f.aliases)
     return out
 
 
@@ -239,6 +248,7 @@ class _Linker:
         self.macros: dict[str, MacroTemplate] = {}
         self.helpers: dict[str, list[Helper]] = {}
         self._called: set[str] = set()  # helpers whose calls were read
+        self._library = {path for path, _ in library}
         # Class and constant names looked up and not found: the project layer reads the
         # files that may define them (lazily: most files declare no node) and links again.
         self.missing: set[str] = set()
@@ -258,6 +268,8 @@ class _Linker:
                 self.macros.setdefault(m.name, m)
             for h in f.helpers:
                 self.helpers.setdefault(h.name, []).append(h)
+        # The project's own type names (not the library bases', whose members are not read).
+        self.types = TypeNames(files, self._type_bases)
 
     # --- registrations -----------------------------------------------------------------
 
@@ -657,9 +669,59 @@ class _Linker:
         default = p.default
         if default is not None and p.default_literal:
             default = to_str(default, type_)  # as BehaviorTree.CPP shows it
+        # Names are looked up from the class the port list belongs to; a template argument
+        # put in comes from another scope, and a simple node's from the registering call:
+        # then only names the project defines once are found.
+        scope = cls.facts.qualname if cls is not None and type_ == p.type else None
+        found = self.types.resolve(type_, scope)
+        for n in found.names:
+            self._note("c:" + n)
+            self._note("t:" + n)
+        for n in found.missing:
+            self._miss(n)
         return CppPort(
-            name, p.direction, type_, default, p.description, path, p.name_span, p.default_is_expr
+            name,
+            p.direction,
+            type_,
+            default,
+            p.description,
+            path,
+            p.name_span,
+            p.default_is_expr,
+            found.text,
+            found.classes,
         )
+
+    def _type_bases(self, qualname: str) -> Bases:
+        """The bases of the project class ``qualname``, for :class:`TypeNames`."""
+        last = last_name(qualname)
+        names = {last}
+        cands = [
+            c
+            for c in self.classes.get(last, [])
+            if c.facts.qualname == qualname and c.path not in self._library
+        ]
+        if not cands:
+            return Bases(names=frozenset(names))
+        cls = cands[0]
+        out: list[str] = []
+        # Two definitions of one class (copies, `#if` branches) with other bases: unknown.
+        complete = all(c.facts.bases == cls.facts.bases for c in cands)
+        bt = False
+        for b in cls.facts.bases:
+            names.add(last_name(strip_args(b)))
+            target, _ = self._resolve(b, cls, cls.path)
+            if isinstance(target, _Lib):
+                bt = True
+            elif (
+                isinstance(target, _Class)
+                and target.path not in self._library
+                and target.facts is not cls.facts
+            ):
+                out.append(target.facts.qualname)
+            else:
+                complete = False
+        return Bases(tuple(out), complete, bt, frozenset(names))
 
     def _constant(self, ref: str, cls: _Class | None, path: str) -> str | None:
         """The value of the string constant ``ref`` as seen from ``cls`` in ``path``."""

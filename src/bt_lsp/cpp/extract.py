@@ -19,6 +19,7 @@ import tree_sitter
 import tree_sitter_cpp
 
 from bt_lsp.cpp.facts import (
+    AliasFacts,
     ClassFacts,
     FileFacts,
     Helper,
@@ -74,6 +75,14 @@ _CLASS_KEYWORD: Final = re.compile(rb"\b(?:class|struct)\b")
 _DEFINE: Final = re.compile(rb"#[ \t]*define\b")
 _CONST_STRING: Final = re.compile(rb"\b(?:const|constexpr)\b[^;{}\n]*?(\")")
 _CLASS_TYPES: Final = frozenset({"class_specifier", "struct_specifier"})
+_ALIAS_KEYWORD: Final = re.compile(rb"\b(?:using|typedef)\b")
+_ALIAS_TYPES: Final = frozenset({"alias_declaration", "type_definition", "using_declaration"})
+# Where an alias is seen by the code of other scopes: a file, a namespace or a class body
+# (through ``#if`` blocks and ``extern "C"``), not a function body.
+_ALIAS_SCOPES: Final = frozenset({"translation_unit", "declaration_list", "field_declaration_list"})
+_PREPROC_BLOCKS: Final = frozenset(
+    {"preproc_if", "preproc_ifdef", "preproc_else", "preproc_elif", "preproc_elifdef"}
+)
 
 # Invocations of macros that may register nodes (ALL_CAPS names, or names that say so),
 # with one to four arguments: a type, then strings or names (an ID, constructor
@@ -186,6 +195,7 @@ class _Reader:
         self.macros: list[MacroTemplate] = []
         self.helpers: list[Helper] = []
         self.constants: dict[str, str] = {}
+        self.aliases: list[AliasFacts] = []
         self._seen_calls: set[int] = set()
 
     # --- text and positions ------------------------------------------------------------
@@ -244,6 +254,11 @@ class _Reader:
                 and cls.child_by_field_name("body") is not None
             ):
                 self._class(cls)
+        for m in _ALIAS_KEYWORD.finditer(src):
+            kw = root.descendant_for_byte_range(m.start(), m.end())
+            decl = kw.parent if kw is not None else None
+            if decl is not None and decl.type in _ALIAS_TYPES and decl.start_byte == m.start():
+                self._alias(decl)
         for m in _CALLEES.finditer(src):
             n = root.descendant_for_byte_range(m.start(), m.end())
             if (
@@ -263,6 +278,7 @@ class _Reader:
             self.constants,
             tuple(self.helpers),
             tuple(self._helper_calls(root)) if b'"' in self.src else (),
+            tuple(self.aliases),
         )
 
     # --- constants ---------------------------------------------------------------------
@@ -397,8 +413,79 @@ class _Reader:
                 aliases,
                 constants,
                 tuple(declared),
+                _in_function(n),
             )
         )
+
+    # --- type aliases ------------------------------------------------------------------
+
+    def _alias(self, decl: Node) -> None:
+        """The aliases one ``using``/``typedef`` declaration makes, if it is at namespace or
+        class scope (``using namespace`` makes none)."""
+        outer = decl.parent
+        params: tuple[str, ...] = ()
+        if outer is not None and outer.type == "template_declaration":
+            plist = outer.child_by_field_name("parameters")
+            if plist is not None:
+                params = tuple(p for p in map(self._template_param, plist.named_children) if p)
+            outer = outer.parent
+        while outer is not None and outer.type in _PREPROC_BLOCKS:
+            outer = outer.parent
+        if outer is None or outer.type not in _ALIAS_SCOPES or _in_function(outer):
+            return
+        if outer.type == "declaration_list" and (
+            outer.parent is None
+            or outer.parent.type not in ("namespace_definition", "linkage_specification")
+        ):
+            return
+        scope = self._scopes(decl)
+        if decl.type == "alias_declaration":
+            name, type_ = decl.child_by_field_name("name"), decl.child_by_field_name("type")
+            if name is not None and type_ is not None:
+                self._add_alias(scope, self.text(name), squash(self.text(type_)), params)
+        elif decl.type == "using_declaration":
+            named = [c for c in decl.named_children if c.type != "comment"]
+            if any(c.type == "namespace" for c in decl.children) or len(named) != 1:
+                return
+            target = squash(self.text(named[0]))
+            last = last_name(strip_args(target))
+            if "::" in target and last and last != target:
+                self._add_alias(scope, last, target, ())
+        else:
+            self._typedef(decl, scope)
+
+    def _typedef(self, decl: Node, scope: list[str]) -> None:
+        """``typedef Y X, *P;``: ``X`` is ``Y`` and ``P`` is ``Y*`` (arrays and function
+        types are left out)."""
+        type_ = decl.child_by_field_name("type")
+        if type_ is None:
+            return
+        if type_.child_by_field_name("body") is not None:
+            tname = type_.child_by_field_name("name")
+            if tname is None:
+                return  # `typedef struct {…} X;`: a class of its own, not read as one
+            target = squash(self.text(tname))
+        else:
+            start = type_.start_byte
+            for c in decl.children:
+                if c.type == "type_qualifier" and c.start_byte < start:
+                    start = c.start_byte
+            target = squash(self.src[start : type_.end_byte].decode("utf-8", "replace"))
+        for d in decl.children_by_field_name("declarator"):
+            suffix = ""
+            n: Node | None = d
+            while n is not None and n.type in ("pointer_declarator", "reference_declarator"):
+                suffix = ("*" if n.type == "pointer_declarator" else "&") + suffix
+                inner = n.child_by_field_name("declarator")
+                if inner is None and n.named_children:
+                    inner = n.named_children[-1]
+                n = inner
+            if n is not None and n.type == "type_identifier":
+                self._add_alias(scope, self.text(n), target + suffix, ())
+
+    def _add_alias(self, scope: list[str], name: str, target: str, params: tuple[str, ...]) -> None:
+        if target and name != target:
+            self.aliases.append(AliasFacts("::".join([*scope, name]), target, params))
 
     def _declared_ports_fn(self, m: Node) -> str | None:
         """``providedPorts``/``providedBasicPorts`` when ``m`` declares it without a body."""
@@ -936,6 +1023,17 @@ class _Reader:
                 tuple(self._span_of_bytes(m.start(g), m.end(g)) for g in groups),
                 self._span_of_bytes(m.start(), m.end()),
             )
+
+
+def _in_function(n: Node) -> bool:
+    """Whether ``n`` is inside a function body (a local class: its name is not seen from
+    the namespace around the function)."""
+    p = n.parent
+    while p is not None:
+        if p.type in ("compound_statement", "function_definition", "lambda_expression"):
+            return True
+        p = p.parent
+    return False
 
 
 _STRING_TYPES: Final = frozenset(

@@ -77,6 +77,8 @@ class ClassFacts(NamedTuple):
     # `providedPorts`/`providedBasicPorts` declared in the body without a body of their own
     # (`static PortsList providedPorts();`): defined out of line, maybe in a file not read.
     declared: tuple[str, ...] = ()
+    # Defined in a function body: a local class, whose name the code outside never sees.
+    local: bool = False
 
 
 class Registration(NamedTuple):
@@ -162,6 +164,21 @@ class HelperCall(NamedTuple):
     span: Span
 
 
+class AliasFacts(NamedTuple):
+    """A type alias at namespace or class scope: ``using X = Y;``, ``typedef Y X;``, or a
+    using-declaration ``using ns::Y;`` (which names ``ns::Y`` as ``Y`` in its scope).
+
+    ``name`` is qualified by the enclosing namespaces and classes (``foo::Node::Ptr``), as
+    far as the file says; ``target`` is the aliased type as written, looked up from that
+    scope; ``params`` are the parameters of an alias template.  ``using namespace`` is not
+    an alias, and neither is an alias a macro makes.
+    """
+
+    name: str
+    target: str
+    params: tuple[str, ...] = ()
+
+
 class FileFacts(NamedTuple):
     classes: tuple[ClassFacts, ...] = ()
     fns: tuple[PortsFn, ...] = ()
@@ -171,6 +188,7 @@ class FileFacts(NamedTuple):
     constants: dict[str, str] = {}  # noqa: RUF012 (never mutated)
     helpers: tuple[Helper, ...] = ()
     helper_calls: tuple[HelperCall, ...] = ()
+    aliases: tuple[AliasFacts, ...] = ()
 
 
 # --- JSON ------------------------------------------------------------------------------
@@ -221,7 +239,7 @@ def _dict(v: Any) -> dict[str, str]:
 
 def from_json(v: Any) -> FileFacts:
     """The facts :func:`to_json` wrote; raises ``ValueError``/``TypeError`` on anything else."""
-    classes, fns, regs, macros, calls, constants, helpers, helper_calls = v
+    classes, fns, regs, macros, calls, constants, helpers, helper_calls, aliases = v
     return FileFacts(
         tuple(
             ClassFacts(
@@ -234,6 +252,7 @@ def from_json(v: Any) -> FileFacts:
                 _dict(c[6]),
                 _dict(c[7]),
                 _strs(c[8]),
+                bool(c[9]),
             )
             for c in classes
         ),
@@ -297,4 +316,5 @@ def from_json(v: Any) -> FileFacts:
             )
             for c in helper_calls
         ),
+        tuple(AliasFacts(str(a[0]), str(a[1]), _strs(a[2])) for a in aliases),
     )

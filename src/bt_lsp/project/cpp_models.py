@@ -538,7 +538,15 @@ class CppModels:
     def decl(self, n: CppNode) -> ModelDecl:
         start, end = self.offsets(Path(n.path), n.id_span)
         ports = tuple(
-            PortModel(p.name, _direction(p.direction), p.type, p.default, p.description)
+            PortModel(
+                p.name,
+                _direction(p.direction),
+                p.type,
+                p.default,
+                p.description,
+                p.resolved,
+                p.classes,
+            )
             for p in n.ports
         )
         # A node read completely is what BehaviorTree.CPP registers (authoritative); one
@@ -588,7 +596,12 @@ def _with_catalog_types(cpp: ModelDecl, other: ModelDecl) -> ModelDecl:
     types = {p.name: p.type for p in other.ports if p.type}
     if not any(p.name in types and types[p.name] != p.type for p in cpp.ports):
         return cpp
-    ports = tuple(replace(p, type=types.get(p.name, p.type)) for p in cpp.ports)
+    ports = tuple(
+        replace(p, type=types[p.name], resolved=None, classes=frozenset())
+        if p.name in types and types[p.name] != p.type
+        else p
+        for p in cpp.ports
+    )
     return cpp._replace(ports=ports)
 
 

@@ -35,7 +35,7 @@ CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".h
 SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules", "__pycache__"})
 TEST_DIRS: Final = frozenset({"test", "tests"})
 # Bumped whenever the facts' shape or meaning changes, so old cache entries are not read.
-_FORMAT: Final = "3"
+_FORMAT: Final = "4"
 _LAZY_ROUNDS: Final = 3
 
 

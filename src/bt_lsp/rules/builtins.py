@@ -28,6 +28,9 @@ class PortModel:
     (``"unsigned int"``, ``"std::string"``, ``"NodeStatus"``, ``"any"``, ...).
     ``default`` is the default value as text, or ``None`` when the port has no default
     (so a missing value fails when the node reads it).
+    ``resolved`` is the type with the aliases of the project's C++ followed and its
+    classes qualified (``None`` when not read from C++); ``classes`` the class
+    definitions read that it names (see :mod:`bt_lsp.cpp.types`).
     """
 
     name: str
@@ -35,6 +38,8 @@ class PortModel:
     type: str
     default: str | None
     description: str
+    resolved: str | None = None
+    classes: frozenset[str] = frozenset()
 
     @property
     def required(self) -> bool:

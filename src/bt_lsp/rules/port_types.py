@@ -7,7 +7,9 @@ one type (spaces, ``const`` and references at the top, ``std::`` and fixed-width
 of built-in types, the ``string`` aliases, ROS message templates); :func:`is_closed` says
 whether every name in a type is one bt-lsp knows is not an alias of something else: the
 built-in types, the standard library's, BehaviorTree.CPP's and ROS interface types
-(``pkg::msg::Name``).  Any other name may be a ``using``/``typedef`` from a header bt-lsp
+(``pkg::msg::Name``), and the classes the project's C++ defines.  A port type read from
+C++ is compared as :mod:`bt_lsp.cpp.types` resolves it (the project's aliases followed,
+its classes qualified); any name left may be a ``using``/``typedef`` from a header bt-lsp
 did not read (``TaskPtr`` is ``std::shared_ptr<Task>``), so two types prove a mismatch
 only when both are closed.
 """
@@ -210,15 +212,19 @@ def _canonical_arg(a: str) -> str:
 
 
 @lru_cache(maxsize=4096)
-def is_closed(canon: str) -> bool:
-    """Whether every name in the canonical type ``canon`` is known not to be an alias."""
+def is_closed(canon: str, classes: frozenset[str] = frozenset()) -> bool:
+    """Whether every name in the canonical type ``canon`` is known not to be an alias.
+
+    ``classes`` are class definitions the project's C++ holds (qualified names, as
+    :mod:`bt_lsp.cpp.types` writes them into a resolved type): not aliases either.
+    """
     if canon in _BUILTIN.values():
         return True
     for m in _NAME.finditer(canon):
         name = m.group(0)
         if name == "const":
             continue
-        if name in _BUILTIN or name in _BUILTIN.values() or name in _STD:
+        if name in _BUILTIN or name in _BUILTIN.values() or name in _STD or name in classes:
             continue
         if _ROS_INTERFACE.fullmatch(name):
             continue

@@ -38,9 +38,11 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   different strong types (the first use fixes the entry's type; a ``std::string`` entry
   accepts anything).  Types are compared as C++ types (:mod:`bt_lsp.rules.port_types`:
   spellings of one built-in type, ``std::`` forms, top-level ``const`` and references are
-  one), and only when every name in both is known not to be an alias (built-in, standard
-  library, ROS interface types): any other name may be a ``using`` from a header bt-lsp
-  did not read, so it proves nothing.  An error when both models are exact, else a warning.  Shared
+  one; a type read from C++ with the project's own aliases followed, :mod:`bt_lsp.cpp.types`),
+  and only when every name in both is known not to be an alias (built-in, standard
+  library, ROS interface types, classes the project's C++ defines): any other name may be
+  a ``using`` from a header bt-lsp did not read, so it proves nothing.  An error when both
+  models are exact, else a warning.  Shared
   pointers of two classes read by an input port are a hint: BehaviorTree.CPP accepts the
   connection when the application registers a polymorphic cast between them (input ports
   only; an inout or output port must match exactly).  Range: the later value.
@@ -550,13 +552,25 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
     )
 
 
-def _closed(canon: str, res: Resolved) -> bool:
+def _closed(canon: str, res: Resolved, port: PortModel) -> bool:
     """Whether a port type proves what it names: a built-in's, one a BehaviorTree.CPP
     catalog wrote (``writeTreeNodesModelXML`` demangles the C++ type, so aliases are
-    resolved), or one whose every name is known not to be an alias."""
+    resolved), or one whose every name is known not to be an alias (the project's
+    classes among them, for a type read from its C++)."""
     if res.origin == "builtin" or (res.authoritative and not res.where):
         return True
-    return port_types.is_closed(canon)
+    return port_types.is_closed(canon, port.classes)
+
+
+def _port_type(port: PortModel) -> tuple[str | None, str]:
+    """The type to compare (the C++'s aliases followed) and the type as shown: as written,
+    with what it resolves to when that is another spelling."""
+    if port.resolved is None or canonical_type(port.type) is None:
+        return canonical_type(port.type), port.type
+    canon = canonical_type(port.resolved)
+    if canon is None or canon == canonical_type(port.type):
+        return canon, port.type
+    return canon, f"{port.type} (that is, {port.resolved})"
 
 
 def _blackboard_use(
@@ -569,7 +583,7 @@ def _blackboard_use(
     scope: TreeScope,
 ) -> None:
     st.pure = False  # the first use of a key in the tree counts
-    canon = canonical_type(port.type)
+    canon, shown = _port_type(port)
     if canon is None:
         return
     key = value.strip(" ")
@@ -577,12 +591,12 @@ def _blackboard_use(
     first = scope.keys.get(key)
     if first is None:
         scope.keys[key] = BlackboardUse(
-            canon, port.type, res.exact, a.name, res.id, _closed(canon, res)
+            canon, shown, res.exact, a.name, res.id, _closed(canon, res, port)
         )
         return
     if first.type == canon or first.type == "std::string":
         return
-    if not (first.closed and _closed(canon, res)):
+    if not (first.closed and _closed(canon, res, port)):
         # A name bt-lsp cannot resolve may be an alias of the other type (``TaskPtr`` of
         # ``std::shared_ptr<Task>``, from a header outside the project): nothing proven.
         return
@@ -594,7 +608,7 @@ def _blackboard_use(
             e,
             "blackboard-type-mismatch",
             f"Blackboard key {quoted(key)} holds a {first.shown} (port {quoted(first.port)} "
-            f"of {quoted(first.node)}) and is read as {port.type} here; BehaviorTree.CPP "
+            f"of {quoted(first.node)}) and is read as {shown} here; BehaviorTree.CPP "
             "creates the tree only if the application registers a polymorphic cast between "
             f"{held} and {wanted} (registerPolymorphicCast)",
             Severity.HINT,
@@ -605,7 +619,7 @@ def _blackboard_use(
         e,
         "blackboard-type-mismatch",
         f"Blackboard key {quoted(key)} was first used as {first.shown} (port "
-        f"{quoted(first.port)} of {quoted(first.node)}) and is {port.type} here; "
+        f"{quoted(first.port)} of {quoted(first.node)}) and is {shown} here; "
         "BehaviorTree.CPP refuses to create the tree",
         None if (first.exact and res.exact) else Severity.WARNING,
     )
