@@ -64,7 +64,7 @@ CASES: list[tuple[str, str, Expected]] = [
     (
         "no BTCPP_format",
         T("<AlwaysSuccess/>", root="").replace("<root>", "<⟦root⟧>"),
-        [("missing-format", W)],
+        [("missing-format", H)],  # the version is not known: a hint
     ),
     (
         "two <TreeNodesModel>",
@@ -252,7 +252,7 @@ CASES: list[tuple[str, str, Expected]] = [
             "</BehaviorTree>",
             root="",
         ).replace("<root>", "<⟦root⟧>"),
-        [("missing-format", W), ("unknown-node", W)],
+        [("missing-format", H), ("unknown-node", W)],
     ),
     (
         "typo RetryUntilSuccesful",
@@ -605,7 +605,7 @@ CASES: list[tuple[str, str, Expected]] = [
             "<AlwaysSuccess/></Parallel></BehaviorTree>",
             root="",
         ).replace("<root>", "<⟦root⟧>"),
-        [("missing-format", W), ("undeclared-port", W), ("undeclared-port", W)],
+        [("missing-format", H), ("undeclared-port", W), ("undeclared-port", W)],
     ),
 ]
 

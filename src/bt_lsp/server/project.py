@@ -111,6 +111,8 @@ def log_version(ls: BtServer, path: Path) -> None:
     ls.versions_logged[key] = value
     version = f"BehaviorTree.CPP {found.version}" if found.version else "BehaviorTree.CPP 4"
     why = found.source if found.version else "not detected; checked as version 4"
+    if found.conflict:
+        version, why = "BehaviorTree.CPP version unclear", f"{found.source}; checked as 4"
     ls.log_message(f"bt-lsp: {key}: {version} ({why})", types.MessageType.Info)
 
 
