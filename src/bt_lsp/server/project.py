@@ -103,6 +103,7 @@ def log_version(ls: BtServer, path: Path) -> None:
     of_project = (
         project.settings_for(path).btcpp in ("3", "4")
         or project.packages.btcpp_of(path.parent).version is not None
+        or found.conflict
     )
     key = folder if of_project or found.version is None else path
     value = (found.version, found.source)
