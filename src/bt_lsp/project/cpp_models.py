@@ -533,19 +533,6 @@ def cpp_diagnostics(text: str, scanner: Scanner | None = None) -> list[Diagnosti
     return cpp_name_diagnostics(facts, text)
 
 
-def _demote_own_catalogs(
-    models: dict[str, ModelDecl], catalogs: frozenset[str], cat: Catalog
-) -> None:
-    """Make the models of ``catalogs`` (shipped by packages whose C++ was read) advisory
-    for the nodes the C++ read does not register: what BehaviorTree.CPP registers is that
-    C++, in a form or a place not read, and the catalog may not match it."""
-    if not catalogs:
-        return
-    for id_, d in models.items():
-        if d.source == "ros" and d.path in catalogs and id_ not in cat.by_id:
-            models[id_] = d._replace(source="ros-workspace")
-
-
 def _category(kind: str | None) -> Category:
     if kind == "Condition":
         return "Condition"
@@ -572,6 +559,19 @@ def _under(f: Path, folder: Path) -> bool:
     except ValueError:
         return False
     return True
+
+
+def _demote_own_catalogs(
+    models: dict[str, ModelDecl], catalogs: frozenset[str], cat: Catalog
+) -> None:
+    """Make the models of ``catalogs`` (shipped by packages whose C++ was read) advisory
+    for the nodes the C++ read does not register: what BehaviorTree.CPP registers is that
+    C++, in a form or a place not read, and the catalog may not match it."""
+    if not catalogs:
+        return
+    for id_, d in models.items():
+        if d.source == "ros" and d.path in catalogs and id_ not in cat.by_id:
+            models[id_] = d._replace(source="ros-workspace")
 
 
 def _glob(patterns: Iterable[str]) -> list[Path]:
