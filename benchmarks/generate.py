@@ -331,7 +331,7 @@ def generate(size: int, seed: int = 0, bad: int | None = None) -> Generated:
             uses = text.count(f'"{m.id}"') + len(re.findall(rf"<{re.escape(m.id)}[\s/>]", text))
             planted.append(Planted("model-name-forbidden-char", m.id, uses))
         elif kind == "decl-reserved":
-            planted.append(Planted("port-name-reserved", "_skipIf", 1))
+            planted.append(Planted("port-name-reserved-groot2", "_skipIf", 1))
         elif kind == "decl-digit":
             planted.append(Planted("port-name-leading-digit", f"{i}nd_goal", 1))
     for t in trees:

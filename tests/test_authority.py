@@ -129,7 +129,7 @@ def test_registered_name_as_tree_id_is_an_error_against_a_catalog() -> None:
 
 def test_missing_port_of_a_custom_node_is_a_hint_that_says_why() -> None:
     got = found(T("<MoveBase/>"), model_files=[catalog()])
-    assert [(c, s) for c, s, _ in got] == [("missing-required-port", H)]
+    assert [(c, s) for c, s, _ in got] == [("missing-port-without-default", H)]
     assert "does not check ports when it loads or creates the tree" in got[0][2]
     assert "may be optional in the node's code" in got[0][2]
     # A built-in whose C++ throws keeps its error.

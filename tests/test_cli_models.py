@@ -43,7 +43,7 @@ def test_xml_has_writeTreeNodesModelXML_shape(capsys: pytest.CaptureFixture[str]
     assert pause is not None
     assert (pause.get("type"), pause.get("default"), pause.text) == (
         "double",
-        "0.5",
+        "0.500000",  # BT::toStr of the double 0.5, as writeTreeNodesModelXML writes it
         "seconds between two",
     )
     anything = say.find("input_port[@name='anything']")
@@ -82,20 +82,20 @@ def test_json_gives_positions_and_flags(capsys: pytest.CaptureFixture[str]) -> N
     assert spin["kind"] == "Action" and spin["authoritative"] is False
     assert spin["flags"] == ["ports-incomplete"]
     assert spin["registered"]["path"].endswith("limits/nodes.cpp")
-    assert spin["registered"]["line"] == 55 and spin["registered"]["column"] == 34
+    assert spin["registered"]["line"] == 62 and spin["registered"]["column"] == 34
     assert spin["classDeclared"]["line"] == 29
     wait = nodes["Wait"]["ports"][0]
     assert wait["defaultIsExpression"] is True
     assert wait["declared"]["line"] == 10
     assert doc["unresolved"] == [
         {
-            "form": "registerNodeType",
-            "name": "name",
+            "form": "registerLater",
+            "name": "computed_name",
             "path": doc["unresolved"][0]["path"],
-            "line": 47,
-            "column": 31,
-            "endLine": 47,
-            "endColumn": 35,
+            "line": 66,
+            "column": 32,
+            "endLine": 66,
+            "endColumn": 45,
         }
     ]
 

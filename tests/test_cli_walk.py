@@ -91,18 +91,66 @@ def test_sniffing() -> None:
 
 
 def test_broken_bt_files_are_still_checked(tmp_path: Path) -> None:
-    for text in ("", "<Root/>", "<root"):
-        p = tmp_path / "t.xml"
+    """A file that tries to be BT (trees under a misspelt top element, a truncated tree)
+    is checked; other XML, a generic <root> of another tool, an empty file are not."""
+    p = tmp_path / "t.xml"
+    for text in ("<Root><BehaviorTree ID='M'/></Root>", "<roo BTCPP_format='4'>"):
         p.write_text(text)
         assert is_bt_file(p), text
+    for text in ("", "<Root/>", "<root", "<root><item/></root>", "<root><Tree", "<server/>"):
+        p.write_text(text)
+        assert not is_bt_file(p), text
 
 
 def test_utf16_files_are_sniffed(tmp_path: Path) -> None:
     p = tmp_path / "t.xml"
-    p.write_bytes("\ufeff<root/>".encode("utf-16-le"))
+    p.write_bytes("\ufeff<root BTCPP_format='4'/>".encode("utf-16-le"))
     assert is_bt_file(p)
     p.write_bytes("<robot/>".encode("utf-16-be"))
     assert not is_bt_file(p)
+
+
+OTHER_TOOLS = {
+    # An MPLAB X project, an Open Liberty server, a DDS profile, a PlanSys2 fragment.
+    "nbproject/configurations.xml": (
+        "<configurationDescriptor version='65'><root/></configurationDescriptor>"
+    ),
+    "server.xml": "<?xml version='1.0'?>\n<server description='x'><featureManager/></server>",
+    "fastdds.xml": "<profiles><participant profile_name='p'/></profiles>",
+    "fragment.xml": "<Sequence name='ACTION_ID'><WaitAtStartReq/></Sequence>",
+    "generic.xml": "<root><item>1</item></root>",
+}
+
+
+def test_other_tools_xml_is_skipped(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    for name, text in OTHER_TOOLS.items():
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text(text)
+    (tmp_path / "main.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    (tmp_path / "typo.xml").write_text(
+        '<roo><BehaviorTree ID="T"><AlwaysSuccess/></BehaviorTree></roo>'
+    )
+    code, out, err = run(capsys, "--verbose", str(tmp_path))
+    assert code == 1
+    assert {line.split(":")[0] for line in out.splitlines()} == {str(tmp_path / "typo.xml")}
+    assert " error root-element " in out
+    assert "bt-lsp: skipped 5 files: not BehaviorTree.CPP XML" in err.splitlines()
+
+
+def test_an_included_file_is_checked(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A file that a BT file includes is loaded as BT XML, whatever it looks like."""
+    (tmp_path / "main.xml").write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="M"><include path="part.xml"/>'
+        '<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    (tmp_path / "part.xml").write_text("<Root/>")
+    (tmp_path / "lone.xml").write_text("<Root/>")
+    code, out, err = run(capsys, "--verbose", str(tmp_path))
+    assert code == 1
+    assert {line.split(":")[0] for line in out.splitlines()} == {str(tmp_path / "part.xml")}
+    assert "bt-lsp: skipped 1 file: not BehaviorTree.CPP XML" in err.splitlines()
 
 
 def test_exclude_globs(tmp_path: Path) -> None:

@@ -61,7 +61,8 @@ def test_the_command_reports_what_the_in_process_check_does(tmp_path: Path) -> N
     empty = tmp_path / "empty_models.xml"
     empty.write_text(compare.EMPTY_CATALOG, encoding="utf-8")
     catalog = compare.catalog_of(str(folder), str(empty))
-    argv = [sys.executable, "-m", "bt_lsp", "check", str(folder), "--format", "json"]
+    argv = [sys.executable, "-m", "bt_lsp", "check", str(folder), *compare.case_files(str(folder))]
+    argv += ["--format", "json"]
     proc = subprocess.run(
         [*argv, "--no-progress", "--models", catalog],
         capture_output=True,

@@ -120,14 +120,18 @@ def test_what_makes_the_registrations_all_known(tmp_path: Path) -> None:
     loads = 'void g() { f.registerFromPlugin("x.so"); }'
     dynamic = _completeness(_ws(tmp_path / "3", FACTORY + loads))
     assert not dynamic.complete and "loads node plugins chosen at run time" in dynamic.why
-    helper = _completeness(
-        _ws(
-            tmp_path / "4",
-            FACTORY + "template <class T> void reg(BT::BehaviorTreeFactory& f, const char* name)"
-            " { f.registerNodeType<T>(name); }",
-        )
+    reg = (
+        "template <class T> void reg(BT::BehaviorTreeFactory& f, const char* name)"
+        " { f.registerNodeType<T>(name); }\n"
     )
+    # A helper of the project registers for its callers: each call names its node.
+    called = _completeness(_ws(tmp_path / "4", FACTORY + reg + 'void g() { reg<A>(f, "B"); }'))
+    assert called.complete
+    helper = _completeness(_ws(tmp_path / "5", FACTORY + reg + "void g() { reg<A>(f, name); }"))
     assert not helper.complete and "is not known statically" in helper.why
+    # No call read: it registers from code bt-lsp does not see.
+    uncalled = _completeness(_ws(tmp_path / "6", FACTORY + reg))
+    assert not uncalled.complete and "is not known statically" in uncalled.why
 
 
 def test_dependencies_outside_the_workspace(tmp_path: Path) -> None:
@@ -182,9 +186,11 @@ def test_a_registering_macro_not_read_leaves_the_registrations_unknown(tmp_path:
     read = "#define REG(T) f.registerNodeType<T>(#T);\n"
     assert _completeness(_ws(tmp_path / "1", read + FACTORY)).complete
     composed = "#define REG_NS(ns, Name) \\\n  f.registerNodeType<ns::Name>(#Name);\n"
-    found = _completeness(_ws(tmp_path / "2", composed + FACTORY))
+    assert _completeness(_ws(tmp_path / "2", composed + FACTORY)).complete
+    pasted = "#define REG_P(Name) \\\n  f.registerNodeType<Name##Node>(#Name);\n"
+    found = _completeness(_ws(tmp_path / "3", pasted + FACTORY))
     assert not found.complete
-    assert found.why == "macro REG_NS of src/app/src/main.cpp registers nodes in a form not read"
+    assert found.why == "macro REG_P of src/app/src/main.cpp registers nodes in a form not read"
 
 
 _SLEEP_CPP = """#include <behaviortree_cpp_v3/bt_factory.h>
@@ -235,3 +241,31 @@ def test_a_v3_projects_own_sleep_is_its_c_plus_plus_node(
     severity, code, message = found[3]
     assert (severity, code) == ("error", "undeclared-port")
     assert "'Sleep' declares no port 'msec' (registered in src/napper/src/main.cpp:" in message
+
+
+def test_a_catalogs_port_types_win_over_the_spelling_of_the_cpp(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Nav2 writes ``uint16`` in its catalog and ``ActionResult::_error_code_type`` in its
+    C++: with the C++ read, the two spellings of one type must not make a mismatch."""
+    nodes = (
+        "struct Plan : BT::SyncActionNode { static BT::PortsList providedPorts() {\n"
+        '  return { BT::OutputPort<ActionResult::_error_code_type>("error_code_id") }; } };\n'
+        "struct Help : BT::ConditionNode { static BT::PortsList providedPorts() {\n"
+        '  return { BT::InputPort<uint16_t>("error_code") }; } };\n'
+        'int main() { BT::BehaviorTreeFactory f; f.registerNodeType<Plan>("Plan");\n'
+        'f.registerNodeType<Help>("Help"); }\n'
+    )
+    tree = _ws(tmp_path, nodes)
+    (tree.parent / "tree_nodes.xml").write_text(
+        '<root BTCPP_format="4"><TreeNodesModel>'
+        '<Action ID="Plan"><output_port name="error_code_id" type="uint16_t"/></Action>'
+        "</TreeNodesModel></root>\n"
+    )
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Plan error_code_id="{code}"/>\n<Help error_code="{code}"/>\n'
+        "</Sequence></BehaviorTree></root>\n"
+    )
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert not [f for f in found.values() if f[1] == "blackboard-type-mismatch"]

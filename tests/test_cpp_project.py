@@ -7,6 +7,7 @@ dependency, so its node is not visible to ``robot_nodes``' trees; ``build/`` is 
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -172,3 +173,93 @@ def test_a_change_links_again_only_the_nodes_it_touches(tmp_path: Path) -> None:
     sc = models.scanner
     facts = sorted((str(f), sc.facts(str(f), f.read_bytes())) for f in models.files_for(tree))
     assert link(facts, library_facts()) == moved
+
+
+_PKG = (
+    '<?xml version="1.0"?>\n<package format="3"><name>{}</name><version>0.1.0</version>'
+    "<description>d</description><maintainer email='a@b.c'>a</maintainer>"
+    "<license>MIT</license><depend>behaviortree_cpp</depend></package>\n"
+)
+_HEADER = """#include <behaviortree_cpp/bt_factory.h>
+class SetupGroup : public BT::SyncActionNode
+{
+public:
+  static BT::PortsList providedPorts();
+};
+inline void RegisterNodes(BT::BehaviorTreeFactory& factory)
+{
+  factory.registerNodeType<SetupGroup>("SetupGroup");
+}
+"""
+_PLUGIN = """#include "setup_group.h"
+BT_REGISTER_NODES(factory) { RegisterNodes(factory); }
+BT::PortsList SetupGroup::providedPorts()
+{
+  return { BT::InputPort<std::string>("group_name") };
+}
+"""
+_TREE = """<root BTCPP_format="4"><BehaviorTree ID="T">
+<SetupGroup group_name="arm"/>
+</BehaviorTree></root>
+"""
+
+
+def _plugin_ws(root: Path, with_plugin: bool = True) -> Path:
+    """A package whose node is declared in ``include/`` and defined in ``plugins/``, with a
+    test that registers a mock under the same ID and a package nested in it."""
+    pkg = root / "src" / "arm_bt"
+    (pkg / "include").mkdir(parents=True)
+    (pkg / "plugins" / "action").mkdir(parents=True)
+    (pkg / "test").mkdir()
+    (pkg / "trees").mkdir()
+    (pkg / "package.xml").write_text(_PKG.format("arm_bt"))
+    (pkg / "include" / "setup_group.h").write_text(_HEADER)
+    if with_plugin:
+        (pkg / "plugins" / "action" / "setup_group.cpp").write_text(_PLUGIN)
+    (pkg / "test" / "mock.cpp").write_text(
+        "struct Mock : BT::SyncActionNode { static BT::PortsList providedPorts() { return {}; } };"
+        '\nvoid f(BT::BehaviorTreeFactory& f) { f.registerNodeType<Mock>("SetupGroup"); }\n'
+    )
+    nested = pkg / "vendored" / "inner"
+    nested.mkdir(parents=True)
+    (nested / "package.xml").write_text(_PKG.format("inner"))
+    (nested / "inner.cpp").write_text(
+        "struct In : BT::SyncActionNode { static BT::PortsList providedPorts() { return {}; } };"
+        '\nvoid f(BT::BehaviorTreeFactory& f) { f.registerNodeType<In>("Inner"); }\n'
+    )
+    tree = pkg / "trees" / "t.xml"
+    tree.write_text(_TREE)
+    return tree
+
+
+def test_a_packages_cpp_is_every_folder_of_it_but_tests_and_nested_packages(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _plugin_ws(tmp_path)
+    pkg = tree.parents[1]
+    models = CppModels([tmp_path], scanner=Scanner(None))
+    files = {f.relative_to(pkg).as_posix() for f in models.files_for(tree)}
+    assert files == {"include/setup_group.h", "plugins/action/setup_group.cpp"}
+    node = models.catalog_for(tree).by_id["SetupGroup"]
+    assert node.authoritative and [p.name for p in node.ports] == ["group_name"]
+    # A tree in the test folder sees the nodes its tests register too.
+    in_test = pkg / "test" / "t.xml"
+    assert "test/mock.cpp" in {f.relative_to(pkg).as_posix() for f in models.files_for(in_test)}
+    # bt-lsp models reads the same files.
+    main(["models", str(pkg), "--format", "json", "--no-cache"])
+    ids = {n["id"]: n for n in json.loads(capsys.readouterr().out)["nodes"]}
+    assert set(ids) == {"SetupGroup"} and ids["SetupGroup"]["authoritative"]
+
+
+def test_a_port_list_declared_but_not_read_is_never_empty(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _plugin_ws(tmp_path, with_plugin=False)
+    models = CppModels([tmp_path], scanner=Scanner(None))
+    node = models.catalog_for(tree).by_id["SetupGroup"]
+    assert not node.authoritative and node.ports == ()
+    assert "providedPorts() is declared at" in node.notes[0]
+    assert "not in the C++ read" in node.notes[0]
+    main(["check", str(tmp_path)])
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "undeclared-port" in ln]
+    assert len(lines) == 1 and ": hint undeclared-port " in lines[0]

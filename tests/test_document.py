@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from bt_lsp.rules.diagnostics import own_diagnostics
 from bt_lsp.syntax.document import Document, looks_like_bt
+from bt_lsp.syntax.kind import HEAD_CHARS
 from bt_lsp.syntax.text import LineIndex
 
 BASE = (
@@ -64,7 +65,23 @@ def test_every_diagnostic_range_slices_its_token() -> None:
 
 
 _KIND_PIECES = st.sampled_from(
-    ["<root", " ", ">", "/", "x", "<ro", "ot ", "\n", "<Behavior", "Tree>", "<TreeNodesModel"]
+    [
+        "<root",
+        " ",
+        ">",
+        "/",
+        "x",
+        "<ro",
+        "ot ",
+        "\n",
+        "<Behavior",
+        "Tree>",
+        "<TreeNodesModel",
+        "<include/>",
+        "BTCPP_format=",
+        "<!--",
+        "-->",
+    ]
 )
 _KIND_TEXT = st.lists(_KIND_PIECES, max_size=8).map("".join)
 
@@ -91,11 +108,33 @@ def test_the_kind_after_edits_is_that_of_the_text(
 
 
 def test_looks_like_bt() -> None:
-    assert looks_like_bt("<root>")
+    """BT XML by its own content: a tree, a catalog or BTCPP_format anywhere in the head
+    (a misspelt top element still tries to be BT), or a <root> that includes others."""
     assert looks_like_bt("<?xml?><root BTCPP_format='4'/>")
     assert looks_like_bt("<x><BehaviorTree ID='a'/></x>")
+    assert looks_like_bt("<roo><BehaviorTree ID='a'/></roo>")
+    assert looks_like_bt("<Root><TreeNodesModel/></Root>")
+    assert looks_like_bt("<root><include path='a.xml'/></root>")
+    assert looks_like_bt("<root main_tree_to_execute = 'M'/>")
+    assert not looks_like_bt("<root>")  # another tool's generic <root>
+    assert not looks_like_bt("<root><Sequence/></root>")
+    assert not looks_like_bt("<Sequence name='ACTION_ID'><Action/></Sequence>")  # a fragment
+    assert not looks_like_bt("<profiles><root><include path='x'/></root></profiles>")
+    assert not looks_like_bt("<!-- <root BTCPP_format> --><server description='x'/>")
     assert not looks_like_bt("<launch><node name='a.b'/></launch>")
     assert not looks_like_bt("<package><name>rootless</name></package>")
+    # Only the head counts: what a sniff of a file's first bytes sees.
+    assert not looks_like_bt("<x>" + " " * HEAD_CHARS + "<BehaviorTree ID='a'/></x>")
+
+
+def test_an_edit_past_the_head_keeps_the_kind() -> None:
+    text = "<x>" + " " * HEAD_CHARS
+    doc = Document(text)
+    assert not doc.is_bt
+    doc.edit(HEAD_CHARS + 2, HEAD_CHARS + 2, "<BehaviorTree ID='a'/>")
+    assert not doc.is_bt
+    doc.edit(0, 0, "<root BTCPP_format='4'>")
+    assert doc.is_bt
 
 
 def _fresh_model(text: str) -> list[tuple[str, int, int]]:

@@ -11,7 +11,7 @@ from bt_lsp.ide.hover import hover_at
 from bt_lsp.ide.name_fixes import Fix, escape_value, fix_all, fixes_for_name
 from bt_lsp.ide.rename import RenamePlan, RenameRefused, rename
 from bt_lsp.rules.analysis import analyze
-from bt_lsp.rules.diagnostics import Diagnostic, own_diagnostics
+from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
 
@@ -35,11 +35,11 @@ DOC = (
 
 
 def name_diags(doc: Document) -> list[str]:
-    return [d.code for d in own_diagnostics(doc) if d.is_name_rule]
+    return [d.code for d in analyze(doc) if d.is_name_rule]
 
 
 def preferred_fix(doc: Document, name: str) -> tuple[str, str]:
-    for d in own_diagnostics(doc):
+    for d in analyze(doc):
         if d.is_name_rule and doc.text[d.start : d.end] == name:
             fixes = fixes_for_name(doc, d)
             assert fixes[0].preferred and not any(f.preferred for f in fixes[1:])
@@ -83,7 +83,7 @@ def test_replacement_is_unique() -> None:
 
 def test_fix_all_is_consistent_and_leaves_no_name_errors() -> None:
     doc = Document(DOC)
-    fixed = apply_edits(doc.text, fix_all(doc, own_diagnostics(doc)).edits)
+    fixed = apply_edits(doc.text, fix_all(doc, analyze(doc)).edits)
     etree.fromstring(fixed.encode())  # still well-formed
     assert name_diags(Document(fixed)) == []
     assert fixed.count("Main_Tree") == 3 and fixed.count("Open_Door") == 4
@@ -94,7 +94,7 @@ def test_fix_all_gives_distinct_names_to_distinct_symbols() -> None:
         '<root><BehaviorTree ID="A B"><SubTree ID="A.B"/></BehaviorTree>'
         '<BehaviorTree ID="A.B"><AlwaysSuccess/></BehaviorTree></root>'
     )
-    fixed = Document(apply_edits(doc.text, fix_all(doc, own_diagnostics(doc)).edits))
+    fixed = Document(apply_edits(doc.text, fix_all(doc, analyze(doc)).edits))
     ids = [r.text for r in fixed.model.refs if r.role == "tree ID"]
     assert len(set(ids)) == 2 and name_diags(fixed) == []
 
@@ -123,7 +123,7 @@ def test_fix_all_on_random_names_keeps_xml_well_formed(tree: str, node: str, por
         "</TreeNodesModel></root>"
     )
     doc = Document(text)
-    fixed = apply_edits(text, fix_all(doc, own_diagnostics(doc)).edits)
+    fixed = apply_edits(text, fix_all(doc, analyze(doc)).edits)
     etree.fromstring(fixed.encode())
     assert name_diags(Document(fixed)) == []
 
@@ -199,7 +199,7 @@ def _diag_at(doc: Document, needle: str, nth: int = 0) -> Diagnostic:
     start = -1
     for _ in range(nth + 1):
         start = doc.text.index(needle, start + 1)
-    for d in own_diagnostics(doc):
+    for d in analyze(doc):
         if d.is_name_rule and start <= d.start and d.end <= start + len(needle):
             return d
     raise AssertionError(f"no name diagnostic in {needle!r} #{nth}")
@@ -293,7 +293,7 @@ def test_bare_same_key_is_written_out_with_braces() -> None:
 
 def test_fix_all_renames_tree_ports_with_their_keys() -> None:
     doc = Document(PORTS)
-    result = fix_all(doc, own_diagnostics(doc))
+    result = fix_all(doc, analyze(doc))
     assert result.notes == []
     fixed = apply_edits(PORTS, result.edits)
     # Greet's key "bad.port" is renamed, so the {=} passed on to Leaf becomes that new key
@@ -307,7 +307,7 @@ def test_fix_all_is_the_same_as_the_quick_fixes_one_after_the_other() -> None:
     text = PORTS
     while True:
         doc = Document(text)
-        diags = [d for d in own_diagnostics(doc) if d.is_name_rule]
+        diags = [d for d in analyze(doc) if d.is_name_rule]
         if not diags:
             break
         text = apply_edits(text, fixes_for_name(doc, diags[0])[0].edits)
@@ -353,7 +353,7 @@ def test_refused_key_rename_falls_back_to_the_port_and_says_so() -> None:
     ]
     expected = AUTOREMAP.replace('name="bad.port"', 'name="bad_port"')
     assert apply_edits(AUTOREMAP, found[0].edits) == expected
-    result = fix_all(doc, own_diagnostics(doc))
+    result = fix_all(doc, analyze(doc))
     assert apply_edits(AUTOREMAP, result.edits) == expected
     assert result.notes == [
         "renamed 'bad.port' to 'bad_port' and left the key 'bad.port' in tree 'Sub' as it "
@@ -399,7 +399,7 @@ def test_a_new_name_that_would_merge_two_keys_is_passed_over() -> None:
         'value="{bad.port}"/></Sequence>', 'value="{badPort}"/></Sequence>'
     )
     assert apply_edits(text, found[0].edits) == expected
-    assert apply_edits(text, fix_all(doc, own_diagnostics(doc)).edits) == expected
+    assert apply_edits(text, fix_all(doc, analyze(doc)).edits) == expected
     assert _semantic(Document(expected)) == _semantic(doc)
 
 
@@ -429,12 +429,12 @@ def test_fixes_reach_tree_port_keys_in_other_documents() -> None:
         "{bad.port}", "{bad_port}"
     )
     # fix_all makes the same edits, in both documents.
-    both = fix_all(models, own_diagnostics(models), {"/ws/sub.xml": tree})
+    both = fix_all(models, analyze(models), {"/ws/sub.xml": tree})
     assert both.edits == list(fix.edits)
     assert both.other_edits == fix.other_edits
     # Without the document defining the tree, the port is left as it is: renaming the
     # declaration alone would disconnect it from the tree's key.
-    alone = fix_all(models, own_diagnostics(models))
+    alone = fix_all(models, analyze(models))
     assert alone.edits == [] and alone.other_edits == {}
     assert alone.notes == [
         "left 'bad.port' as it is: the tree 'Sub' is not defined in the workspace (it comes "

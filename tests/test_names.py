@@ -19,6 +19,7 @@ from bt_lsp.rules.names import (
     Violation,
     check_name,
     is_allowed_port_name,
+    reserved_port_declaration,
 )
 from bt_lsp.rules.registry import CODES
 
@@ -477,7 +478,10 @@ def test_port_messages() -> None:
     reserved = only("_skipIf", PORT, declaration=True)
     assert reserved.code == "port-name-reserved"
     assert "'_skipIf'" in reserved.message and "reserved" in reserved.message
-    assert "_skipIf" in reserved.rule and "__shared_blackboard" in reserved.rule
+    assert "_skipIf" in reserved.rule and "__shared_blackboard" not in reserved.rule
+    groot2 = only("__shared_blackboard", PORT, declaration=True)
+    assert groot2.code == "port-name-reserved-groot2"
+    assert "_skipIf" in groot2.rule and "__shared_blackboard" in groot2.rule
 
 
 # --- ports --------------------------------------------------------------------------------
@@ -491,7 +495,59 @@ def test_port_empty() -> None:
 @pytest.mark.parametrize("name", sorted(RESERVED_PORT_NAMES))
 def test_reserved_ports_only_flagged_in_declarations(name: str) -> None:
     assert codes(name, PORT) == []
-    assert codes(name, PORT, declaration=True) == ["port-name-reserved"]
+    # BehaviorTree.CPP's own reserved attributes, or the two only the name rules reserve.
+    code = (
+        "port-name-reserved" if name in BTCPP_RESERVED_ATTRIBUTES else "port-name-reserved-groot2"
+    )
+    assert codes(name, PORT, declaration=True) == [code]
+
+
+# A declared port's reserved name, by entry and BehaviorTree.CPP version ("3", "4", or None:
+# checked as 4 with neither a build nor BTCPP_format saying so).
+_GROOT1, _GROOT2, _BTCPP = "port-name-groot1", "port-name-reserved-groot2", "port-name-reserved"
+
+
+@pytest.mark.parametrize(
+    ("name", "entry", "btcpp", "code"),
+    [
+        # BehaviorTree.CPP 4.8.4+ validates <SubTree> model ports: its 11 names throw.
+        ("_autoremap", "SubTree", "4", _BTCPP),
+        ("ID", "SubTree", "4", _BTCPP),
+        ("_while", "SubTree", None, _BTCPP),
+        # ... and accepts the two only the name rules (Groot2) reserve.
+        ("__shared_blackboard", "SubTree", "4", _GROOT2),
+        ("_description", "SubTree", "4", _GROOT2),
+        ("_description", "SubTree", None, _GROOT2),
+        # Groot 1's v3 palette: right for BehaviorTree.CPP 3, which reads no models.
+        ("__shared_blackboard", "SubTree", "3", _GROOT1),
+        ("__shared_blackboard", "SubTree", None, _GROOT1),
+        ("_autoremap", "SubTree", "3", _GROOT2),
+        # Entries BehaviorTree.CPP never reads.
+        ("name", "Action", "4", _GROOT2),
+        ("_onSuccess", "Condition", None, _GROOT2),
+        ("__shared_blackboard", "Decorator", "4", _GROOT2),
+        ("ID", "Control", "3", _GROOT2),
+    ],
+)
+def test_reserved_port_declarations(name: str, entry: str, btcpp: str | None, code: str) -> None:
+    found = reserved_port_declaration(name, entry, btcpp)
+    assert found is not None and found.code == code
+    assert f"'{name}'" in found.message and "\n" not in found.message
+    assert found.rule.endswith(".")
+    if code == _BTCPP:
+        assert "4.8.4" in found.message and "throw" in found.message
+    elif code == _GROOT2:
+        assert "Groot2" in found.message
+        assert ("BehaviorTree.CPP 3" if btcpp == "3" else "BehaviorTree.CPP") in found.message
+    else:
+        assert "Groot 1" in found.message and "_autoremap" in found.message
+
+
+@pytest.mark.parametrize("name", ["goal", "Name", "_goal", "autoremap", ""])
+def test_unreserved_port_declarations(name: str) -> None:
+    for entry in ("SubTree", "Action"):
+        for btcpp in ("3", "4", None):
+            assert reserved_port_declaration(name, entry, btcpp) is None
 
 
 @pytest.mark.parametrize("name", ["Name", "id", "_SkipIf", "_skipif", "name_", "IDs", "_desc"])
@@ -578,8 +634,10 @@ def test_port_matches_reference(name: str, declaration: bool) -> None:
     else:
         if name[0] in "0123456789":
             expected.append("port-name-leading-digit")
-        if declaration and name in RESERVED_PORT_NAMES:
+        if declaration and name in BTCPP_RESERVED_ATTRIBUTES:
             expected.append("port-name-reserved")
+        elif declaration and name in RESERVED_PORT_NAMES:
+            expected.append("port-name-reserved-groot2")
         if reference_forbidden(name):
             expected.append("port-name-forbidden-char")
     assert codes(name, PORT, declaration=declaration) == expected

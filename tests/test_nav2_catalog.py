@@ -48,6 +48,6 @@ def test_stock_trees_with_the_nav2_catalog() -> None:
     assert loud == DEFECTS
     assert status == 1  # the misspelled built-in
     hints = Counter(d["code"] for d in found if d["severity"] == "hint")
-    assert set(hints) == {"missing-required-port"}
+    assert set(hints) == {"missing-port-without-default"}
     assert len({Path(d["path"]).name for d in found}) <= 17
     assert len(list(NAV2.glob("*.xml"))) == 17

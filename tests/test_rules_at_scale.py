@@ -112,7 +112,7 @@ def test_findings_that_depend_on_the_context_are_not_shared_between_trees() -> N
         return sorted(d.code for d in analyze(main, ctx) if d.code != "no-main-tree")
 
     assert codes(empty) == ["unknown-node"] * 3
-    assert codes(declared) == ["missing-required-port"] * 3  # a hint: a is not given
+    assert codes(declared) == ["missing-port-without-default"] * 3  # a hint: a is not given
     assert codes(empty) == ["unknown-node"] * 3
 
 

@@ -166,6 +166,30 @@ CASES: list[tuple[str, str, Expected]] = [
         [("unknown-subtree", E)],
     ),
     (
+        # Whether a catalog declaring the name is in the workspace or not: the same error.
+        "SubTree names no tree but a declared custom node",
+        R(
+            '<BehaviorTree ID="Main"><SubTree ID="⟦Say⟧"/></BehaviorTree>\n'
+            '<TreeNodesModel><Action ID="Say"/></TreeNodesModel>'
+        ),
+        [("unknown-subtree", E)],
+    ),
+    (
+        "SubTree names no tree but a built-in",
+        T('<SubTree ID="⟦Sequence⟧"/>'),
+        [("unknown-subtree", E)],
+    ),
+    (
+        "SubTree names a tree that is also a declared custom node",
+        R(
+            '<BehaviorTree ID="Main"><SubTree ID="⟦Say⟧"/></BehaviorTree>\n'
+            '<BehaviorTree ID="⟦Say⟧"><AlwaysSuccess/></BehaviorTree>\n'
+            '<TreeNodesModel><Action ID="Say"/></TreeNodesModel>',
+            'BTCPP_format="4" main_tree_to_execute="Main"',
+        ),
+        [("registered-name-as-tree-id", W), ("registered-name-as-tree-id", W)],
+    ),
+    (
         "SubTree ID breaking a name rule and naming no tree: one problem",
         T('<SubTree ID="No where"/>'),
         [],
@@ -403,6 +427,15 @@ CASES: list[tuple[str, str, Expected]] = [
         T('<Sleep msec="10" ⟦timeout⟧="1"/>'),
         [("undeclared-port", E)],
     ),
+    (
+        "Groot 1's shared blackboard port in a file not checked as version 4",
+        '<⟦root⟧ main_tree_to_execute="Main"><BehaviorTree ID="Main">'
+        '<SubTree ID="Sub" ⟦__shared_blackboard⟧="true"/></BehaviorTree>'
+        '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree><TreeNodesModel>'
+        '<SubTree ID="Sub"><input_port name="⟦__shared_blackboard⟧" default="true"/>'
+        "</SubTree></TreeNodesModel></root>",
+        [("missing-format", W), ("unknown-attribute", W), ("port-name-groot1", H)],
+    ),
     ("hyphenated undeclared port", T('<Sleep msec="10" ⟦foo-bar⟧="1"/>'), [("undeclared-port", E)]),
     (
         "undeclared port of a declared node",
@@ -504,7 +537,7 @@ CASES: list[tuple[str, str, Expected]] = [
         [("missing-required-port", W)],
     ),
     ("output ports are not required", T('<LoopInt queue="1;2;3"><AlwaysSuccess/></LoopInt>'), []),
-    ("required declared port missing", TM("<⟦Say⟧/>"), [("missing-required-port", H)]),
+    ("required declared port missing", TM("<⟦Say⟧/>"), [("missing-port-without-default", H)]),
     (
         "attribute neither port nor reserved",
         T('<AlwaysSuccess ⟦_skipif⟧="x"/>'),
@@ -679,7 +712,7 @@ def test_models_of_other_workspace_files_count() -> None:
     assert semantic(doc, ctx) == []
     doc2, want = expect(
         T('<MoveBase ⟦gaol⟧="{g}"/>').replace("<MoveBase", "<⟦MoveBase⟧"),
-        [("missing-required-port", H), ("undeclared-port", H)],
+        [("missing-port-without-default", H), ("undeclared-port", H)],
     )
     assert semantic(doc2, Context.combine(doc2, [("/w/other.xml", other, False)])) == want
 

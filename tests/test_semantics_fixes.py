@@ -133,7 +133,7 @@ def test_declare_into_an_existing_section() -> None:
         "        </Action>\n",
     )
     # Both uses give 'goal'; each lacks one of the others, which have no default.
-    assert codes(new) == ["missing-required-port", "missing-required-port"]
+    assert codes(new) == ["missing-port-without-default"] * 2
 
 
 def test_declare_creates_the_section() -> None:

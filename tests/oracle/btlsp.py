@@ -27,7 +27,13 @@ def check_folder(folder: str, models: str | None) -> list[dict[str, Any]] | str:
         progress=False,
         models=(os.path.abspath(models),) if models else (),
     )
-    check.run([folder], options, out=out, err=err)
+    # Each file is named too, as compare.py does: BehaviorTree.CPP is fed every one.
+    fed = sorted(
+        os.path.join(folder, f)
+        for f in os.listdir(folder)
+        if f.endswith(".xml") and f != "models.xml"
+    )
+    check.run([folder, *fed], options, out=out, err=err)
     text = out.getvalue()
     if not text.strip():
         return f"no JSON from bt-lsp: {err.getvalue().strip()[:200]}"

@@ -321,9 +321,9 @@ def test_a_held_request_that_is_cancelled_is_answered_at_once(session: Session) 
 
 
 def test_a_large_document_that_is_not_bt_is_told_apart_on_the_worker(session: Session) -> None:
-    """Whether a large text is BT XML (a search of all of it when it is not) is found
-    while it is prepared: a launch file gets no diagnostics, and an edit that makes it
-    BT XML (found around the edit, not by another search) gets them."""
+    """Whether a large text is BT XML (a search of its head) is found while it is
+    prepared: a launch file gets no diagnostics, and an edit that makes it BT XML gets
+    them."""
     s = session
     uri = "untitled:launch.xml"
     body = "".join(f'  <node pkg="p{i}" exec="e" name="n{i}"/>\n' for i in range(8_000))
@@ -340,7 +340,9 @@ def test_a_large_document_that_is_not_bt_is_told_apart_on_the_worker(session: Se
     end = {"line": 1, "character": 0}
     change = {
         "textDocument": {"uri": uri, "version": 2},
-        "contentChanges": [{"range": {"start": end, "end": end}, "text": "<root>\n"}],
+        "contentChanges": [
+            {"range": {"start": end, "end": end}, "text": '<root BTCPP_format="4">\n'}
+        ],
     }
     s.raw.write(frame(msg("textDocument/didChange", change)))
     assert s.log[s.until(published(uri, 2))]["params"]["diagnostics"] != []
@@ -359,7 +361,7 @@ def test_what_is_analysed_on_the_worker() -> None:
     assert background.wants(od(cpp, "cpp")) and background.wants(od(cpp, "plaintext", "/a.hpp"))
     assert not background.wants(od(cpp[: CPP_WORKER_CHARS - 10], "cpp"))
     assert not background.wants(od(cpp, "plaintext"))  # neither BT nor C++
-    bt = "<root>" + " " * WORKER_CHARS + "</root>"
+    bt = '<root BTCPP_format="4">' + " " * WORKER_CHARS + "</root>"
     assert background.wants(od(bt, "xml")) and not background.wants(od(bt[:-2000], "xml"))
 
 
@@ -455,3 +457,48 @@ def test_a_snapshot_continues_the_caches_of_its_document(monkeypatch: pytest.Mon
     got = analyze(snap)
     assert read == [1] and len(doc.model.sections) > 100
     assert got == analyze(Document(snap.text, "big.xml"))
+
+
+def _within_lines(text: str, outline: list[dict[str, Any]]) -> list[str]:
+    """The ranges of ``outline`` that are not inside the lines of ``text`` (UTF-16; the
+    raw client offers no encoding)."""
+    lengths = [len(line.encode("utf-16-le")) // 2 for line in text.split("\n")]
+    bad: list[str] = []
+    stack = list(outline)
+    while stack:
+        s = stack.pop()
+        for key in ("range", "selectionRange"):
+            for end in ("start", "end"):
+                p = s[key][end]
+                if p["line"] >= len(lengths) or p["character"] > lengths[p["line"]]:
+                    bad.append(f"{s['name']} {key} {end} {p}")
+        stack.extend(s.get("children", []))
+    return bad
+
+
+ADDED = '  <BehaviorTree ID="Added"><AlwaysSuccess/></BehaviorTree>\n'
+
+
+@pytest.mark.parametrize("ready", [False, True], ids=["with the open", "once analysed"])
+def test_an_outline_is_of_the_version_it_was_asked_of(session: Session, ready: bool) -> None:
+    """An outline asked right before an edit is the outline of the text before it: it was
+    made from a snapshot taken when the handler first ran, after the edit had been
+    handled, and listed the edit's tree (with ranges past the lines of the text asked)."""
+    s = session
+    big = big_document("Frobnicate")
+    at = {"line": big.count("\n") - 1, "character": 0}  # before </root>
+    change = {
+        "textDocument": {"uri": BIG_URI, "version": 2},
+        "contentChanges": [{"range": {"start": at, "end": at}, "text": ADDED}],
+    }
+    opened = frame(msg("textDocument/didOpen", open_params(BIG_URI, big)))
+    if ready:
+        s.raw.write(opened)
+        s.until(published(BIG_URI, 1, "unknown-node"))
+        opened = b""
+    s.raw.write(opened + symbols(BIG_URI, 31) + frame(msg("textDocument/didChange", change)))
+    outline = s.log[s.until(answer(31))]["result"]
+    assert [tree["name"] for tree in outline] == ["Main"]
+    assert _within_lines(big, outline) == []
+    s.raw.write(symbols(BIG_URI, 32))  # and the next one is of the edit
+    assert [tree["name"] for tree in s.log[s.until(answer(32))]["result"]] == ["Main", "Added"]

@@ -65,7 +65,7 @@ async def test_complete_registrations_make_errors(app_client: BtClient) -> None:
     assert typo is not None and typo.severity == types.DiagnosticSeverity.Error
     assert "did you mean 'Charge'?" in typo.message
     scan = _at(diags, 7, "undeclared-port")  # Scan's ports are built by code: advisory
-    assert scan is not None and scan.severity == types.DiagnosticSeverity.Warning
+    assert scan is not None and scan.severity == types.DiagnosticSeverity.Hint
 
 
 @pytest.mark.asyncio(loop_scope="module")

@@ -7,6 +7,7 @@ import re
 import pytest
 from lsprotocol import types
 
+from bt_lsp.rules.names import PROJECT_NAME_CODES
 from tests.server.conftest import (
     PROFILES,
     BtClient,
@@ -24,7 +25,7 @@ PROFILES["early-severity"] = Profile(
     "visual-studio-code",
     init_options={
         "debounceMs": 0,
-        "severity": {"port-name-reserved": "warning", "instance-name-control-char": "off"},
+        "severity": {"port-name-forbidden-char": "warning", "instance-name-control-char": "off"},
     },
 )
 
@@ -51,7 +52,7 @@ HEAD = (
 )
 TAIL = (
     "  <TreeNodesModel>\n"
-    '    <Action ID="Go"><input_port name="⟦name⟧"/></Action>\n'
+    '    <Action ID="Go"><input_port name="name"/></Action>\n'
     "  </TreeNodesModel>\n"
     '  <BehaviorTree ID="⟦Last.Tree⟧"><Go/></BehaviorTree>\n'
     "</root>\n"
@@ -66,7 +67,6 @@ def big_document(newline: str = "\n") -> tuple[Marked, list[str]]:
         "instance-name-control-char",
         "model-name-forbidden-char",
         "port-name-forbidden-char",
-        "port-name-reserved",
         "model-name-forbidden-char",
     ]
     return doc, codes
@@ -101,10 +101,14 @@ def _assert_names_of(
     first: types.PublishDiagnosticsParams, complete: types.PublishDiagnosticsParams
 ) -> None:
     """``first`` holds the name diagnostics of ``complete``, field for field (but for the
-    workspace's clause of the complete set's messages)."""
+    workspace's clause of the complete set's messages, and for the reserved name of a
+    declared port, which depends on the project: only the complete set has it)."""
     assert [_full(d) for d in first.diagnostics] == [
-        _full(_early(d)) for d in names_only(complete.diagnostics)
+        _full(_early(d))
+        for d in names_only(complete.diagnostics)
+        if d.code not in PROJECT_NAME_CODES
     ]
+    assert any(d.code == "port-name-reserved-groot2" for d in complete.diagnostics)
     assert any(_WORKSPACE_CLAUSE.search(d.message) for d in complete.diagnostics)
 
 
@@ -147,7 +151,7 @@ async def test_names_first_follow_the_severity_settings(client: BtClient) -> Non
     try:
         first, complete = await _publications(client, uri)
         levels = {(str(d.code), d.severity) for d in first.diagnostics}
-        assert ("port-name-reserved", types.DiagnosticSeverity.Warning) in levels
+        assert ("port-name-forbidden-char", types.DiagnosticSeverity.Warning) in levels
         assert "instance-name-control-char" not in {code for code, _ in levels}
         _assert_names_of(first, complete)
     finally:
@@ -176,6 +180,9 @@ async def test_pull_clients_get_no_early_push(client: BtClient) -> None:
         assert await _publications(client, uri, 0) == []
         report = await client.pull_report(uri)
         assert isinstance(report, types.RelatedFullDocumentDiagnosticReport)
-        assert sorted(str(d.code) for d in names_only(report.items)) == sorted(codes)
+        # The complete set: the early names and the declared port's reserved name.
+        assert sorted(str(d.code) for d in names_only(report.items)) == sorted(
+            [*codes, "port-name-reserved-groot2"]
+        )
     finally:
         client.close(uri)

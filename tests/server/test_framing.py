@@ -243,6 +243,15 @@ def test_messages_split_across_writes(server: RawServer) -> None:
         (b'{"jsonrpc": "2.0", "id": 5}', -32600),  # no method
         (b'{"jsonrpc": "2.0", "id": {"a": 1}, "method": "shutdown"}', -32600),
         (b'{"jsonrpc": "2.0", "id": [1], "method": "shutdown"}', -32600),
+        # Nested past the decoder's recursion limit: its RecursionError ended the server.
+        (b"[" * 900 + b"]" * 900, -32600),
+        (b"[" * 1000 + b"]" * 1000, -32700),
+        (b"[" * 20000, -32700),
+        (b'{"jsonrpc": "2.0", "id": 7, "method": "x", "params": ' + b'{"a": ' * 3000, -32700),
+        (
+            b'{"jsonrpc": "2.0", "method": "x", "params": ' + b"[" * 3000 + b"]" * 3000 + b"}",
+            -32700,
+        ),
     ],
 )
 def test_json_rpc_errors(server: RawServer, body: bytes, code: int) -> None:

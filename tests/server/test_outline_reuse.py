@@ -153,7 +153,7 @@ def test_a_kept_outline_is_its_json_text_only() -> None:
         secs = doc.model.sections
         assert all("outline" not in s.cache for s in secs)
         kept = [s.cache["outline-json"] for s in secs]
-        slots = ("categories", "column", "enc", "line", "text")
+        slots = ("categories", "enc", "state")  # (text, line, column): replaced at once
         assert all(type(k).__slots__ == slots for k in kept)
         assert first == "[" + ", ".join(k.text for k in kept) + "]"
         for new in ("x😋 ", "\r\n", "\n"):  # in the first tree, on the second's first line

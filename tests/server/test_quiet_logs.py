@@ -205,7 +205,7 @@ async def test_one_configuration_request_after_initialized() -> None:
     # The client declared codeDescriptionSupport: each diagnostic links to its code.
     assert diags
     for d in diags:
-        assert d["codeDescription"]["href"].endswith(f"#{d['code']}"), d
+        assert d["codeDescription"]["href"].endswith(f"/rules/{d['code']}/"), d
     assert len(asked(1) or []) == 1
     # A change after the answer asks again.
     s.notify("workspace/didChangeConfiguration", {"settings": None})

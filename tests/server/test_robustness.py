@@ -167,6 +167,36 @@ async def test_reversed_and_overlapping_changes(client: BtClient) -> None:
         (types.TEXT_DOCUMENT_DIAGNOSTIC, {"textDocument": "file:///x.xml"}),
         (types.CODE_ACTION_RESOLVE, {"kind": "quickfix", "edit": "no"}),
         (types.CODE_ACTION_RESOLVE, [1, 2, 3]),
+        # cattrs made these a URI "5" and a line 0 (answered null or as line 0).
+        (
+            types.TEXT_DOCUMENT_HOVER,
+            {"textDocument": {"uri": 5}, "position": {"line": 0, "character": 0}},
+        ),
+        (
+            types.TEXT_DOCUMENT_HOVER,
+            {"textDocument": {"uri": "file:///x.xml"}, "position": {"line": "0", "character": 0}},
+        ),
+        (
+            types.TEXT_DOCUMENT_DEFINITION,
+            {"textDocument": {"uri": "file:///x.xml"}, "position": {"line": 0, "character": True}},
+        ),
+        (
+            types.TEXT_DOCUMENT_REFERENCES,
+            {
+                "textDocument": {"uri": "file:///x.xml"},
+                "position": {"line": 0, "character": 0},
+                "context": {"includeDeclaration": "yes"},
+            },
+        ),
+        (types.TEXT_DOCUMENT_DOCUMENT_SYMBOL, {"textDocument": {"uri": ["file:///x.xml"]}}),
+        (
+            types.TEXT_DOCUMENT_COMPLETION,
+            {
+                "textDocument": {"uri": "file:///x.xml"},
+                "position": {"line": 0, "character": 0},
+                "context": {"triggerKind": 9},
+            },
+        ),
     ],
 )
 @each_client
@@ -341,4 +371,29 @@ async def test_a_nul_character_in_an_include_path(client: BtClient) -> None:
     assert "include-not-found" in {d.code for d in diags}
     errors = [m.message for m in client.log_messages[seen:] if m.type == types.MessageType.Error]
     assert errors == []
+    await _still_serving(client)
+
+
+# The states of typing ``<!--`` (or a DOCTYPE, a processing instruction) before ``<root>``:
+# the document has no element, and its outline was an internal error.
+HALF_DECLARATIONS = [
+    "<!<root>",
+    "<!-<root>",
+    "<!DOCTYPE<root>",
+    "<?<BehaviorTree ",
+    '<!<root BTCPP_format="4"><BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>',
+    '<!-<root BTCPP_format="4"><BehaviorTree ID="A"/></root>',
+    "<?x<root><BehaviorTree ID='A'/></root>",
+    "<![CDATA[<root>",
+]
+
+
+@clients("vscode", "nvim-0.11")
+async def test_outline_while_typing_a_declaration_before_root(client: BtClient) -> None:
+    for text in HALF_DECLARATIONS:
+        uri = client.open(text)
+        for method in (types.TEXT_DOCUMENT_DOCUMENT_SYMBOL, types.TEXT_DOCUMENT_FOLDING_RANGE):
+            answer = await raw_request(client, method, {"textDocument": {"uri": uri}})
+            assert answer is None or isinstance(answer, list), (text, method, answer)
+        client.close(uri)
     await _still_serving(client)

@@ -25,6 +25,9 @@ SEVERITY = {"port-name-reserved": "warning", "instance-name-control-char": "off"
 PROFILES["init-options"] = Profile(
     "visual-studio-code", init_options={"debounceMs": 0, "severity": SEVERITY}
 )
+PROFILES["min-severity"] = Profile(
+    "visual-studio-code", init_options={"debounceMs": 0, "minSeverity": "error"}
+)
 # debounceMs from initializationOptions, severities from workspace/configuration.
 PROFILES["configuration"] = Profile(
     "visual-studio-code", init_options={"debounceMs": 0}, configuration={"severity": SEVERITY}
@@ -41,7 +44,8 @@ DOC = (
     "    </Sequence>\n"
     "  </BehaviorTree>\n"
     "  <TreeNodesModel>\n"
-    '    <Action ID="Go"><input_port name="goal"/><input_port name="name"/></Action>\n'
+    '    <Action ID="Go"><input_port name="goal"/></Action>\n'
+    '    <SubTree ID="T"><input_port name="name" default="x"/></SubTree>\n'
     '    <Action ID="Bad.Id"/>\n'
     "  </TreeNodesModel>\n"
     "</root>\n"
@@ -109,6 +113,25 @@ async def test_initialization_options(client: BtClient) -> None:
     uri = client.open(DOC)
     assert _levels(await client.pushed(uri, 1)) == OVERRIDDEN
     await _no_debounce(client, uri, DOC, 1)
+
+
+@clients("min-severity")
+async def test_min_severity_publishes_the_errors_only(client: BtClient) -> None:
+    """The hint of Go's port without a default is not published, the errors are."""
+    uri = client.open(DOC)
+    published = await client.pushed(uri, 1)
+    assert {str(d.code) for d in published} == {c for c, _ in DEFAULTS}
+    assert {d.severity for d in published} == {Sev.Error}
+    _configure(client, {"minSeverity": "hint"})
+    await client.wait_until(
+        lambda: (
+            True
+            if (last := client.latest(uri)) is not None
+            and "missing-port-without-default" in {str(d.code) for d in last.diagnostics}
+            else None
+        ),
+        "the hint published with minSeverity hint",
+    )
 
 
 @clients("configuration", "configuration-pull")

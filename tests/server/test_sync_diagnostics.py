@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import io
+import json
 from pathlib import Path
 
 import pytest
 from lsprotocol import types
 
+from bt_lsp.cli.check import Options, run
 from tests.server.conftest import (
     PULL_CLIENTS,
     PUSH_CLIENTS,
@@ -24,7 +27,7 @@ from tests.server.conftest import (
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
-README = "https://github.com/bt-lsp/bt-lsp/blob/main/README.md"
+DOCS = "https://bt-lsp.github.io/bt-lsp/"
 
 TREE = marked(
     '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\n'
@@ -84,7 +87,7 @@ async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
     every = await client.diags(uri, 1)
     diags = names_only(every)
     assert summary(diags) == expected(client, TREE, TREE_CODES)
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    pages = Path(__file__).resolve().parents[2] / "docs" / "rules"
     td = client.profile.capabilities().text_document
     described = bool(
         td
@@ -99,9 +102,9 @@ async def test_open_reports_exact_name_diagnostics(client: BtClient) -> None:
             assert d.code_description is None
             continue
         assert d.code_description is not None
-        # The link goes to the code's row in the README's table of codes.
-        assert d.code_description.href == f"{README}#{d.code}"
-        assert f'<a id="{d.code}"></a>' in readme, d.code
+        # The link goes to the code's page on the documentation site.
+        assert d.code_description.href == f"{DOCS}rules/{d.code}/"
+        assert (pages / f"{d.code}.md").is_file(), d.code
     for d in diags:
         assert d.severity == types.DiagnosticSeverity.Error
         assert isinstance(d.data, dict)
@@ -221,6 +224,33 @@ async def test_non_bt_xml_gets_no_diagnostics(client: BtClient) -> None:
     else:
         await client.barrier()
         assert all(list(p.diagnostics) == [] for p in client.published.get(uri, []))
+
+
+MISSPELT_ROOT = (
+    '<roo BTCPP_format="4">\n  <BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree>\n</roo>\n'
+)
+GENERIC_ROOT = "<root>\n  <item>1</item>\n</root>\n"
+
+
+async def test_the_editor_and_check_agree_on_what_is_bt(client: BtClient, tmp_path: Path) -> None:
+    """One decision: a tree under a misspelt <roo> gets its root-element error, another
+    tool's <root> nothing, in the editor as from ``bt-lsp check`` over its folder."""
+    for i, text in enumerate((MISSPELT_ROOT, GENERIC_ROOT)):
+        folder = tmp_path / str(i)
+        folder.mkdir()
+        (folder / "t.xml").write_text(text)
+        out, err = io.StringIO(), io.StringIO()
+        run([str(folder)], Options(format="json", progress=False, cpp=False), out, err)
+        from_check = sorted(d["code"] for d in json.loads(out.getvalue() or "[]"))
+        uri = client.open(text, name=f"kind{i}")
+        if client.pull or from_check:
+            shown = await client.diags(uri, 1)
+        else:
+            await client.barrier()
+            last = client.latest(uri)
+            shown = [] if last is None else list(last.diagnostics)
+        assert sorted(str(d.code) for d in shown) == from_check
+        assert from_check == (["root-element"] if i == 0 else [])
 
 
 async def test_document_becoming_bt_and_back(client: BtClient) -> None:

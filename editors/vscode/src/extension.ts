@@ -88,7 +88,15 @@ function restart(): Promise<void> {
 
 /** The `btLsp` settings the server understands (every one declared in package.json but the
  * extension's own `server.command` and `trace.server`), also sent as initializationOptions. */
-const SERVER_SETTINGS = ['debounceMs', 'severity', 'maxDocumentBytes', 'rosPackages', 'modelFiles', 'btcpp'];
+const SERVER_SETTINGS = [
+  'debounceMs',
+  'severity',
+  'maxDocumentBytes',
+  'rosPackages',
+  'modelFiles',
+  'btcpp',
+  'minSeverity',
+];
 
 function serverSettings(): Record<string, unknown> {
   const config = vscode.workspace.getConfiguration('btLsp');

@@ -44,12 +44,22 @@ from bt_lsp.cli.formats.sarif import to_sarif
 from bt_lsp.cli.formats.text import format_text, visible
 from bt_lsp.cli.project import (
     BUILD_FOLDER,
+    NOT_BT,
     config_errors,
+    included_back,
     project_index,
     skip_reason,
     version_lines,
+    workspace_lines,
 )
-from bt_lsp.cli.results import FileResult, exit_code, file_diagnostics, findings_of, plural, summary
+from bt_lsp.cli.results import (
+    FileResult,
+    exit_code,
+    file_diagnostics,
+    findings_of,
+    plural,
+    summary,
+)
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import (
@@ -61,6 +71,7 @@ from bt_lsp.project.fileio import (
 )
 from bt_lsp.project.files import collect_files
 from bt_lsp.project.index import ProjectIndex, normalize
+from bt_lsp.project.settings import shown
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.diagnostics import with_severities
@@ -83,6 +94,8 @@ class Options:
     btcpp: str | None = None  # --btcpp
     verbose: bool = False
     follow_symlinks: bool = False  # --fix rewrites files linked from outside the folder
+    min_severity: Severity | None = None  # --min-severity (None: the configuration's)
+    quiet: bool = False  # --quiet: the diagnostics and errors only
     started: float = field(default_factory=time.time)  # older temporaries are stale
 
 
@@ -298,17 +311,31 @@ def run(
     if options.cpp:
         project.cpp = CppModels(project.roots, project.packages)
     skipped: Counter[str] = Counter()
+    not_bt: set[str] = set()  # kept by the walk until the includes are known
 
     def skip(path: str, is_dir: bool) -> bool:
         why = skip_reason(project, path, is_dir)
+        if why == NOT_BT:
+            not_bt.add(path)
+            return False
         if why is not None:
             skipped[why] += 1
         return why is not None
 
     files, walk_errors = collect_files(paths, skip)
+    named = {os.path.realpath(p) for p in paths if not os.path.isdir(p)}  # checked as given
+    not_bt = {p for p in not_bt if os.path.realpath(p) not in named}
+    not_bt -= included_back(project, files, not_bt)
+    if not_bt:
+        skipped[NOT_BT] += len(not_bt)
+        files = [f for f in files if f not in not_bt]
     if options.cpp:
         files += [str(f) for p in paths if os.path.isdir(p) for f in find_cpp_files([p])]
-    progress = Progress(err, len(files), options.progress and len(files) > 1 and _isatty(err))
+    progress = Progress(
+        err,
+        len(files),
+        options.progress and not options.quiet and len(files) > 1 and _isatty(err),
+    )
     if project.cpp is not None and progress.enabled:
         # The C++ is read when the first file of a package needs it: say so meanwhile.
         project.cpp.progress = lambda done, total: progress.line(
@@ -330,13 +357,18 @@ def run(
         say(err, f"bt-lsp: {e.message}\n")
     if not files:
         none = "no BehaviorTree.CPP XML files" if skipped else "no XML files"
-        say(err, f"bt-lsp: {none} to check\n")
+        if not options.quiet:
+            say(err, f"bt-lsp: {none} to check\n")
+        if options.format != "text":  # still a document a reader can parse
+            _report(out, options.format, [FileResult(e.path, error=e) for e in walk_errors])
         return 2 if walk_errors else 0
 
     if options.verbose:
         for why, n in sorted(skipped.items()):
             what = "folder" if why == BUILD_FOLDER else "file"
             say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
+        for line in workspace_lines(paths):
+            say(err, line + "\n")
         for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
     results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
@@ -345,7 +377,8 @@ def run(
     roots = [p for p in paths if os.path.isdir(p)]
     if options.fix:
         for tmp in _remove_stale_temporaries(files, options.started):
-            say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
+            if not options.quiet:
+                say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
 
     def keep_of(path: str) -> str | None:
         return None if options.follow_symlinks else _linked_from_outside(path, roots)
@@ -356,23 +389,29 @@ def run(
         progress.show(i, path)
         keep = keep_of(path)
         r = check_file(path, options, project, before, keep, planned.get(str(normalize(path))))
+        r.findings = shown(r.findings, project.settings_for(normalize(path)).min_severity)
         results.append(r)
         if r.error is not None:
             say(err, f"{r.detail}bt-lsp: {r.error.message}\n")
         if r.not_fixed is not None:
             say(err, f"bt-lsp: not fixing {visible(path)}: {r.not_fixed}\n")
-        if r.fixed:
+        if r.fixed and not options.quiet:
             say(err, f"fixed {plural(r.fixed, 'problem')} in {visible(path)}\n")
-        for note in r.notes:
+        for note in r.notes if not options.quiet else ():
             say(err, f"bt-lsp: {visible(path)}: {visible(note)}\n")
         if options.format == "text" and r.findings:
             say(out, "".join(line + "\n" for line in format_text(r.findings)))
     progress.clear()
 
-    if options.format == "json":
-        say(out, json.dumps(to_json(results), indent=2) + "\n")
-    elif options.format == "sarif":
-        say(out, json.dumps(to_sarif(results), indent=2) + "\n")
-    else:
+    if options.format != "text":
+        _report(out, options.format, results)
+    elif not options.quiet:
         say(err, summary(results) + "\n")
     return exit_code(results)
+
+
+def _report(out: TextIO, format: Format, results: Sequence[FileResult]) -> None:
+    """The JSON or SARIF document of ``results`` on ``out``."""
+    document = to_json(results) if format == "json" else to_sarif(results)
+    write(out, json.dumps(document, indent=2) + "\n")
+    out.flush()

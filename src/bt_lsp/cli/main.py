@@ -117,6 +117,18 @@ def build_parser() -> argparse.ArgumentParser:
         "detected from package.xml, CMakeLists.txt or BTCPP_format)",
     )
     check.add_argument(
+        "--min-severity",
+        choices=("error", "warning", "information", "hint"),
+        help="print only diagnostics at least this severe (default: the configuration's "
+        "min-severity, else hint: all)",
+    )
+    check.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="print the diagnostics and errors only: no summary, notes or progress",
+    )
+    check.add_argument(
         "--verbose",
         action="store_true",
         help="say which files were skipped and which BehaviorTree.CPP version each is "
@@ -187,6 +199,7 @@ def _serve(args: argparse.Namespace) -> int:
 
 def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     from bt_lsp.cli import check
+    from bt_lsp.rules.codes import Severity
 
     try:
         severities = check.parse_severities(args.severity)
@@ -202,8 +215,10 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         config=args.config,
         models=tuple(os.path.abspath(m) for m in args.models),
         btcpp=args.btcpp,
-        verbose=args.verbose,
+        verbose=args.verbose and not args.quiet,
         follow_symlinks=args.follow_symlinks,
+        min_severity=Severity.parse(args.min_severity) if args.min_severity else None,
+        quiet=args.quiet,
     )
     return check.run(args.paths, options)
 

@@ -19,7 +19,7 @@ from lxml import etree
 
 from bt_lsp.cpp.catalog import Catalog, CppNode, CppPort
 from bt_lsp.cpp.facts import Span
-from bt_lsp.project.cpp_scan import Scanner, default_cache_dir, find_cpp_files, scan
+from bt_lsp.project.cpp_scan import Scanner, cpp_sources, default_cache_dir, scan
 
 _PORT_TAGS = {"input": "input_port", "output": "output_port", "inout": "inout_port"}
 
@@ -121,7 +121,9 @@ def run(
     missing = [p for p in paths if not Path(p).exists()]
     for p in missing:
         print(f"bt-lsp models: {p}: no such file or directory", file=err)
-    files = find_cpp_files([p for p in paths if p not in missing])
+    # The same C++ as ``check`` and the server read for a package: every folder of it but
+    # build output and tests.
+    files = sorted({f for p in paths if p not in missing for f in cpp_sources(Path(p))})
     show = verbose or err.isatty()
 
     def progress(done: int, total: int) -> None:

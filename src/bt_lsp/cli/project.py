@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import os
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping, Sequence, Set
+from pathlib import Path
 from typing import Final, Protocol
 
-from bt_lsp.project.config import ConfigError, Configs, Layer, excluded
+from bt_lsp.project.config import MAX_DEPTH, ConfigError, Configs, Layer, excluded, find_config
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.sniff import is_bt_file
@@ -18,9 +19,13 @@ __all__ = [
     "NOT_BT",
     "WALK_SKIP_DIRS",
     "config_errors",
+    "included_back",
     "project_index",
     "skip_reason",
     "version_lines",
+    "workspace_lines",
+    "workspace_of",
+    "workspaces",
 ]
 
 # Folders a walk never enters: colcon's build, install and log folders, version control,
@@ -42,18 +47,105 @@ class ProjectOptions(Protocol):
     def severities(self) -> Mapping[str, Severity | None]: ...
     @property
     def max_bytes(self) -> int: ...
+    @property
+    def min_severity(self) -> Severity | None: ...
+
+
+def workspace_of(path: str | os.PathLike[str]) -> tuple[Path, str]:
+    """The workspace of a file named on the command line, and why: the nearest folder
+    above it with a configuration file (``bt-lsp.toml``, or ``pyproject.toml`` with
+    ``[tool.bt-lsp]``), else its repository's root (the nearest folder with ``.git``),
+    else its ROS package's colcon ``src`` folder (the package folder's parent or
+    grandparent named ``src``) or the package folder, else the file's folder.  The file is
+    then checked among that folder's trees, catalogs and C++, as a run over the folder
+    checks it."""
+    folder = normalize(path).parent
+    config = find_config(folder)
+    if config is not None:
+        return config.parent, f"the folder of {config.name}"
+    package: Path | None = None
+    f = folder
+    for _ in range(MAX_DEPTH):
+        if _exists(f / ".git"):
+            return f, "the repository root"
+        if package is None and _is_file(f / "package.xml"):
+            package = f
+        if f.parent == f:
+            break
+        f = f.parent
+    if package is not None:
+        for above in (package.parent, package.parent.parent):
+            if above.name == "src":
+                return above, "the ROS workspace's src folder"
+        return package, "the ROS package"
+    return folder, "the file's folder"
+
+
+def _exists(path: Path) -> bool:
+    try:
+        return path.exists()
+    except (OSError, ValueError):
+        return False
+
+
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def _under(path: Path, folder: Path) -> bool:
+    return path == folder or folder in path.parents
+
+
+def workspaces(paths: Sequence[str]) -> dict[Path, tuple[str, list[str]]]:
+    """The workspace folders of a run, each with why and the files named alone that it is
+    the workspace of: every folder named on the command line (its own workspace, with the
+    files named inside it), then the workspace of each other named file
+    (:func:`workspace_of`)."""
+    out: dict[Path, tuple[str, list[str]]] = {}
+    for p in paths:
+        if os.path.isdir(p):
+            out.setdefault(normalize(p), ("named on the command line", []))
+    named = list(out)
+    for p in paths:
+        if os.path.isdir(p):
+            continue
+        where = normalize(p)
+        inside = next((d for d in named if _under(where, d)), None)
+        if inside is not None:
+            out[inside][1].append(p)
+            continue
+        folder, why = workspace_of(p)
+        out.setdefault(folder, (why, []))[1].append(p)
+    return out
+
+
+def workspace_lines(paths: Sequence[str]) -> list[str]:
+    """For ``--verbose``: the workspace each file named alone is checked in, and why."""
+    return [
+        f"bt-lsp: workspace {folder} ({why}) for {len(files)} named "
+        f"file{'s' if len(files) != 1 else ''}"
+        for folder, (why, files) in workspaces(paths).items()
+        if files
+    ]
 
 
 def project_index(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex:
-    """The folders named on the command line as one workspace, each file with its
-    configuration file's settings and the flags over them."""
+    """The workspace of a run (:func:`workspaces`: the folders named on the command line,
+    and those found for the files named alone), each file with its configuration file's
+    settings and the flags over them."""
     overrides = Layer(
         models=tuple(normalize(m) for m in options.models) or None,
         btcpp=options.btcpp,
         severity=dict(options.severities) or None,
+        min_severity=options.min_severity,
     )
+    found = list(workspaces(paths))
+    roots = [r for r in found if not any(o != r and _under(r, o) for o in found)]
     return ProjectIndex(
-        [p for p in paths if os.path.isdir(p)],
+        roots,
         Settings(max_document_bytes=options.max_bytes),
         configs=Configs(normalize(options.config) if options.config else None),
         overrides=overrides,
@@ -91,8 +183,9 @@ def version_lines(workspace: ProjectIndex, files: Sequence[str]) -> list[str]:
 
 def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     """Why a walk over a folder leaves ``path`` out (``None``: it is checked): a build or
-    VCS folder, an ``exclude`` glob of its configuration, or a file whose top element is
-    not ``<root>`` (``package.xml``, launch files, URDF, pluginlib descriptions)."""
+    VCS folder, an ``exclude`` glob of its configuration, or a file whose content is not
+    BehaviorTree.CPP XML (``package.xml``, launch files, URDF, other tools' XML; see
+    :func:`bt_lsp.syntax.kind.looks_like_bt`)."""
     p = normalize(path)
     if is_dir:
         if p.name in WALK_SKIP_DIRS:
@@ -101,3 +194,21 @@ def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     if excluded(p, workspace.settings_for(p).exclude):
         return EXCLUDED
     return None if is_bt_file(p) else NOT_BT
+
+
+def included_back(workspace: ProjectIndex, files: Sequence[str], not_bt: Set[str]) -> set[str]:
+    """The files of ``not_bt`` (skipped for their content) that one of the other
+    ``files`` includes, directly or through others: BehaviorTree.CPP loads them as BT
+    XML, so they are checked as such."""
+    if not not_bt:
+        return set()
+    by_path = {normalize(f): f for f in not_bt}
+    out: set[str] = set()
+    for f in files:
+        if f in not_bt or not f.endswith(".xml"):
+            continue
+        for p in workspace.include_closure(normalize(f)):
+            hit = by_path.get(p)
+            if hit is not None:
+                out.add(hit)
+    return out

@@ -6,9 +6,11 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Final
 
 from bt_lsp.ide.name_targets import with_targets
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules import analysis
@@ -92,7 +94,7 @@ def plural(n: int, word: str, plural: str | None = None) -> str:
 
 
 def summary(results: Sequence[FileResult]) -> str:
-    """E.g. ``3 errors, 1 warning in 2 files``."""
+    """E.g. ``3 errors, 1 warning in 2 files`` (the BehaviorTree.CPP files checked)."""
     counts = Counter(f.severity for r in results for f in r.findings)
     parts = [
         plural(counts[Severity.ERROR], "error"),
@@ -102,9 +104,10 @@ def summary(results: Sequence[FileResult]) -> str:
         parts.append(plural(counts[Severity.INFORMATION], "information", "information"))
     if counts[Severity.HINT]:
         parts.append(plural(counts[Severity.HINT], "hint"))
-    checked = sum(1 for r in results if r.error is None)
+    # The BT files checked: the C++ files a folder run reads for the name rules are not.
+    checked = sum(1 for r in results if r.error is None and Path(r.path).suffix not in CPP_SUFFIXES)
     text = f"{', '.join(parts)} in {plural(checked, 'file')}"
-    unreadable = len(results) - checked
+    unreadable = sum(1 for r in results if r.error is not None)
     if unreadable:
         text += f"; {plural(unreadable, 'file')} could not be checked"
     return text

@@ -19,6 +19,7 @@ from typing import Final, NamedTuple
 from bt_lsp.cpp.facts import (
     ClassFacts,
     FileFacts,
+    Helper,
     MacroTemplate,
     Op,
     PortFacts,
@@ -26,6 +27,7 @@ from bt_lsp.cpp.facts import (
     Registration,
     Span,
 )
+from bt_lsp.cpp.literals import to_str
 from bt_lsp.cpp.names import last_name, split_top, strip_args
 
 __all__ = [
@@ -66,6 +68,11 @@ LIBRARY_KINDS: Final[dict[str, str]] = {
     "SimpleDecoratorNode": "Decorator",
 }
 _MAX_DEPTH: Final = 16
+_SIMPLE_KINDS: Final = {
+    "registerSimpleAction": "Action",
+    "registerSimpleCondition": "Condition",
+    "registerSimpleDecorator": "Decorator",
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -186,6 +193,7 @@ def _defined(f: FileFacts) -> set[str]:
     out.update(f"f:{last_name(fn.owner)}::{fn.name}" for fn in f.fns)
     out.update("k:" + k for k in f.constants)
     out.update("m:" + m.name for m in f.macros)
+    out.update("h:" + h.name for h in f.helpers)
     return out
 
 
@@ -229,6 +237,8 @@ class _Linker:
         self.file_constants: dict[str, dict[str, str]] = {}
         self.constants: dict[str, str] = {}
         self.macros: dict[str, MacroTemplate] = {}
+        self.helpers: dict[str, list[Helper]] = {}
+        self._called: set[str] = set()  # helpers whose calls were read
         # Class and constant names looked up and not found: the project layer reads the
         # files that may define them (lazily: most files declare no node) and links again.
         self.missing: set[str] = set()
@@ -246,6 +256,8 @@ class _Linker:
                 self.constants.setdefault(k, v)
             for m in f.macros:
                 self.macros.setdefault(m.name, m)
+            for h in f.helpers:
+                self.helpers.setdefault(h.name, []).append(h)
 
     # --- registrations -----------------------------------------------------------------
 
@@ -264,7 +276,9 @@ class _Linker:
                     continue
                 node = self._kept_or_made(path, i, reg, id_, made)
                 first = by_id.get(id_)
-                if first is not None:
+                if first is not None and _same(first, node):
+                    pass  # the same class registered again (a plugin and a test, copies)
+                elif first is not None:
                     note = f"ID {id_!r} is also registered at {_where(first.path, first.id_span)}"
                     node = _with_flag(node, FLAG_DUPLICATE_ID, note)
                     by_id[id_] = _with_flag(
@@ -276,6 +290,12 @@ class _Linker:
                 else:
                     by_id[id_] = node
                 nodes.append(node)
+        # A helper that takes the ID from its callers, with no call read: it registers
+        # from code not read (or a call not recognised), under IDs not known.
+        for path, f in self.files:
+            for h in f.helpers:
+                if h.id_param >= 0 and h.name not in self._called:
+                    unresolved.append(Unresolved(path, h.span, h.form, f"{h.name}(…)"))
         if self.memo is not None:
             self.memo.facts = dict(self.files)
             self.memo.nodes = made
@@ -311,7 +331,13 @@ class _Linker:
             m = self.macros.get(call.name)  # a change of it changes the registration
             if m is None or len(call.args) != len(m.params) or m.cls_param >= len(call.args):
                 continue
+            if m.form not in ("registerNodeType", "registerBuilder", *self.helpers):
+                continue  # the function or class it calls registers nothing
+            self._called.add(m.form)
             cls = call.args[m.cls_param]
+            if m.cls_text:
+                args = dict(zip(m.params, call.args, strict=False))
+                cls = "::".join(args.get(part, part) for part in m.cls_text.split("::"))
             if m.id_param >= 0:
                 arg = call.args[m.id_param]
                 span = call.arg_spans[m.id_param]
@@ -324,6 +350,21 @@ class _Linker:
             else:
                 id_, ref, span = m.id_literal, None, call.span
             regs.append(Registration(m.name, id_, ref, span, cls, None, None, call.span))
+        for hc in f.helper_calls:
+            for h in self.helpers.get(hc.name, ()):
+                if h.cls_tparam >= len(hc.targs) or h.id_param >= len(hc.args):
+                    continue  # another overload
+                self._called.add(h.name)
+                hcls = hc.targs[h.cls_tparam] if h.cls_tparam >= 0 else h.cls
+                if h.id_param >= 0:
+                    id_, ref = hc.values[h.id_param], None
+                    if id_ is None:
+                        ref = hc.args[h.id_param]
+                    span = hc.arg_spans[h.id_param]
+                else:
+                    id_, ref, span = h.id_literal, None, hc.span
+                kind = None if hcls is not None else _SIMPLE_KINDS.get(h.form)
+                regs.append(Registration(h.name, id_, ref, span, hcls, kind, h.ops, hc.span))
         return regs
 
     def _node(self, path: str, reg: Registration, id_: str) -> CppNode:
@@ -460,12 +501,26 @@ class _Linker:
         return None, why
 
     def _fn(self, cls: _Class, name: str) -> tuple[str, PortsFn] | None:
+        found = self._fns(cls, name)
+        return found[0] if found else None
+
+    def _fns(self, cls: _Class, name: str) -> list[tuple[str, PortsFn]]:
+        """Every definition of ``cls::name`` read (one, but for copies and ``#if`` branches)."""
         self._note(f"f:{cls.facts.name}::{name}")
         found = self.fns.get((cls.facts.name, name), [])
         q = cls.facts.qualname
-        for path, fn in found:
-            if fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q):
-                return path, fn
+        return [
+            (path, fn)
+            for path, fn in found
+            if fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q)
+        ]
+
+    def _other_definition(self, cls: _Class, name: str, first: tuple[str, PortsFn]) -> str | None:
+        """Where another definition of ``cls::name`` that reads differently is, if any."""
+        shape = _shape(first[1].ops)
+        for path, fn in self._fns(cls, name):
+            if fn is not first[1] and _shape(fn.ops) != shape:
+                return _where(path, fn.span)
         return None
 
     def _ports_of(self, cls: _Class, subst: dict[str, str], depth: int) -> _Ports:
@@ -477,6 +532,20 @@ class _Linker:
         own = self._fn(cls, "providedPorts")
         if own is not None:
             self._eval(own[1].ops, cls, subst, own[0], out, None, depth)
+            other = self._other_definition(cls, "providedPorts", own)
+            if other is not None:
+                out.missing.append(
+                    f"{cls.facts.qualname}::providedPorts() is defined differently in "
+                    f"{_where(own[0], own[1].span)} and {other}: which one is built is not known"
+                )
+            return out
+        if "providedPorts" in cls.facts.declared:
+            # Declared in the class, defined out of line in a file that was not read: its
+            # ports are unknown, never "none" (nor the base's, which it hides).
+            out.missing.append(
+                f"{cls.facts.qualname}::providedPorts() is declared at "
+                f"{_where(cls.path, cls.facts.span)} but its definition is not in the C++ read"
+            )
             return out
         if cls.facts.using_ports:
             target, s2 = self._resolve(cls.facts.using_ports, cls, cls.path)
@@ -513,6 +582,8 @@ class _Linker:
             fn = self._fn(cur, "providedBasicPorts")
             if fn is not None:
                 return cur, fn, subst
+            if "providedBasicPorts" in cur.facts.declared:
+                return None  # defined out of line in a file that was not read
             target, s2, _ = self._lineage(cur, depth)
             if not isinstance(target, _Class):
                 return None
@@ -565,6 +636,11 @@ class _Linker:
                 else:
                     bcls, (bpath, fn), s2 = found
                     self._eval(fn.ops, bcls, _compose(s2, subst), bpath, out, inner, depth + 1)
+                    if not _uses_param(fn.ops):
+                        # A body that was not read (a library base whose basic ports
+                        # depend on its release): the node's own ports are still among
+                        # what it returns, as in every providedBasicPorts.
+                        out.merge(inner)
             elif op.kind == "param":
                 if arg is not None:
                     out.merge(arg)
@@ -578,8 +654,11 @@ class _Linker:
         if name is None:
             return None
         type_ = _substitute(p.type, subst) if p.type is not None else "AnyTypeAllowed"
+        default = p.default
+        if default is not None and p.default_literal:
+            default = to_str(default, type_)  # as BehaviorTree.CPP shows it
         return CppPort(
-            name, p.direction, type_, p.default, p.description, path, p.name_span, p.default_is_expr
+            name, p.direction, type_, default, p.description, path, p.name_span, p.default_is_expr
         )
 
     def _constant(self, ref: str, cls: _Class | None, path: str) -> str | None:
@@ -613,6 +692,41 @@ class _Linker:
         if ref not in self.constants:
             self._miss(ref)
         return self.constants.get(ref)
+
+
+def _same(a: CppNode, b: CppNode) -> bool:
+    """Whether two registrations of one ID make the same node (class, kind and ports)."""
+
+    def ports(n: CppNode) -> list[tuple[str, str, str, str | None]]:
+        return [(p.name, p.direction, p.type, p.default) for p in n.ports]
+
+    return (
+        a.cls is not None
+        and a.cls == b.cls
+        and a.kind == b.kind
+        and a.flags == b.flags
+        and ports(a) == ports(b)
+    )
+
+
+def _uses_param(ops: Sequence[Op]) -> bool:
+    return any(op.kind == "param" or _uses_param(op.ops) for op in ops)
+
+
+_NOWHERE: Final[Span] = (0, 0, 0, 0)
+
+
+def _shape(ops: Sequence[Op]) -> tuple[object, ...]:
+    """A port list's steps without their positions (two copies of one body compare equal)."""
+    return tuple(
+        (
+            op.kind,
+            None if op.port is None else op.port._replace(name_span=_NOWHERE, span=_NOWHERE),
+            op.ref,
+            _shape(op.ops),
+        )
+        for op in ops
+    )
 
 
 def _args_of_last(ref: str) -> list[str]:

@@ -21,6 +21,8 @@ import tree_sitter_cpp
 from bt_lsp.cpp.facts import (
     ClassFacts,
     FileFacts,
+    Helper,
+    HelperCall,
     MacroCall,
     MacroTemplate,
     Op,
@@ -29,7 +31,7 @@ from bt_lsp.cpp.facts import (
     Registration,
     Span,
 )
-from bt_lsp.cpp.names import last_name, squash, strip_args, unescape
+from bt_lsp.cpp.names import last_name, split_top, squash, strip_args, unescape
 from bt_lsp.cpp.tree_walk import declared_name, enclosing_call, template_args, up, up_to
 
 Node = tree_sitter.Node
@@ -100,8 +102,55 @@ _MACRO_CALL: Final = re.compile(
     rb"([A-Za-z_][\w:]*(?:<[^()<>;\n]*>)?)[ \t\r\n]*" + _MACRO_ARG * 3 + rb"\)"
 )
 _MACRO_BODY: Final = re.compile(
-    r"(registerNodeType|registerBuilder)\s*<\s*([A-Za-z_]\w*)\s*>\s*\(\s*"
+    r"(registerNodeType|registerBuilder)\s*<\s*((?:::)?[A-Za-z_]\w*(?:\s*::\s*[A-Za-z_]\w*)*)\s*>"
+    r"\s*\(\s*"
     r"(?:#\s*([A-Za-z_]\w*)|([A-Za-z_]\w*)|\"((?:[^\"\\]|\\.)*)\")"
+)
+
+
+# A macro whose body calls a function template or makes an object of a class template
+# with a parameter as its class and a stringified parameter (or a literal) as the ID:
+# ``#define REG(T) static Registrar<T> reg_##T(#T);``, ``#define REG(T) reg<T>(f, #T)``.
+# It registers when the function or class is a registering helper of the project.
+_MACRO_HELPER: Final = re.compile(
+    r"\b([A-Za-z_]\w*)\s*<\s*((?:::)?[A-Za-z_]\w*(?:\s*::\s*[A-Za-z_]\w*)*)\s*>\s*"
+    r"(?:[A-Za-z_][\w#]*\s*)?[({]\s*(?:[^(){};\"]*?,\s*)?"
+    r"(?:#\s*([A-Za-z_]\w*)|\"((?:[^\"\\]|\\.)*)\")"
+)
+# Calls that may be of a project's registering helper: a function template called with
+# template arguments (``reg<MyNode>(factory, "MyNode")``), or a function whose name says
+# it registers.  Only those with a string literal among their arguments are kept.
+_HELPER_CALL: Final = re.compile(rb"\b([A-Za-z_]\w*)[ \t]*(?:<[^;{}()]*?>[ \t\r\n]*\(|\()")
+_REGISTRAR_OBJECT: Final = re.compile(
+    rb"\b([A-Za-z_]\w*)[ \t]*<[^;{}()]*?>[ \t\r\n]*[A-Za-z_]\w*[ \t]*[({][ \t\r\n]*\""
+)
+_HELPER_NAME: Final = re.compile(r"[Rr]egist|^[Rr]eg(?:[A-Z_]|$)|^add[A-Z]")
+_NOT_HELPERS: Final = frozenset(
+    {
+        *_PORT_FUNCTIONS,
+        *_TEMPLATE_REGISTRARS,
+        *_SIMPLE_REGISTRARS,
+        "registerBehavior",
+        "CreateManifest",
+        "CreateBuilder",
+        "make_shared",
+        "make_unique",
+        "getInput",
+        "setOutput",
+        "get",
+        "set",
+        "static_cast",
+        "dynamic_cast",
+        "reinterpret_cast",
+        "const_cast",
+        "registerScriptingEnum",
+        "registerFromPlugin",
+        "registerFromROSPlugins",
+        "registerBehaviorTreeFromFile",
+        "registerBehaviorTreeFromText",
+        "registerPolymorphicCast",
+        "unregisterBuilder",
+    }
 )
 
 
@@ -135,6 +184,7 @@ class _Reader:
         self.fns: list[PortsFn] = []
         self.regs: list[Registration] = []
         self.macros: list[MacroTemplate] = []
+        self.helpers: list[Helper] = []
         self.constants: dict[str, str] = {}
         self._seen_calls: set[int] = set()
 
@@ -211,6 +261,8 @@ class _Reader:
             tuple(self.macros),
             calls,
             self.constants,
+            tuple(self.helpers),
+            tuple(self._helper_calls(root)) if b'"' in self.src else (),
         )
 
     # --- constants ---------------------------------------------------------------------
@@ -265,6 +317,15 @@ class _Reader:
                 if c.type == "raw_string_content":
                     return self.text(c)
             return ""
+        if n.type == "user_defined_literal":  # "x"s, "x"sv
+            inner = n.named_children
+            if (
+                len(inner) == 2
+                and inner[1].type == "literal_suffix"
+                and self.text(inner[1]) in ("s", "sv")
+            ):
+                return self.string(inner[0])
+            return None
         if n.type == "concatenated_string":
             parts = [self.string(c) for c in n.named_children]
             if any(p is None for p in parts):
@@ -305,7 +366,13 @@ class _Reader:
         using_ports: str | None = None
         aliases: dict[str, str] = {}
         constants: dict[str, str] = {}
+        declared: list[str] = []
         for m in body.named_children:
+            if m.type in ("field_declaration", "declaration"):
+                fn = self._declared_ports_fn(m)
+                if fn is not None:
+                    declared.append(fn)
+                    continue
             if m.type == "using_declaration":
                 t = self.text(m)
                 if "providedPorts" in t:
@@ -329,8 +396,23 @@ class _Reader:
                 using_ports,
                 aliases,
                 constants,
+                tuple(declared),
             )
         )
+
+    def _declared_ports_fn(self, m: Node) -> str | None:
+        """``providedPorts``/``providedBasicPorts`` when ``m`` declares it without a body."""
+        for d in m.children_by_field_name("declarator"):
+            while d.type in ("pointer_declarator", "reference_declarator"):
+                inner = d.child_by_field_name("declarator")
+                if inner is None:
+                    break
+                d = inner
+            if d.type == "function_declarator":
+                name = d.child_by_field_name("declarator")
+                if name is not None and self.text(name) in ("providedPorts", "providedBasicPorts"):
+                    return self.text(name)
+        return None
 
     def _template_param(self, p: Node) -> str | None:
         for c in p.named_children:
@@ -379,10 +461,10 @@ class _Reader:
                 return
             margs = margs_node.named_children
             if margs:
-                ops = self.ports_expr(margs[1], {}) if len(margs) > 1 else None
+                ops = self._ports_arg(margs[1], call) if len(margs) > 1 else None
                 self._registration("CreateManifest", margs[0], mt[0], None, ops, call)
         elif name in _SIMPLE_REGISTRARS and args:
-            ops = self.ports_expr(args[2], {}) if len(args) > 2 else ()
+            ops = self._ports_arg(args[2], call) if len(args) > 2 else ()
             self._registration(name, args[0], None, _SIMPLE_REGISTRARS[name], ops, call)
         elif name == "registerBehavior" and targs and len(args) >= 2:
             self._registration(name, args[1], targs[0], None, None, call)
@@ -397,10 +479,135 @@ class _Reader:
         call: Node,
     ) -> None:
         value = self.string(id_node)
+        if self._helper(form, id_node, value, cls, ops, call):
+            return
         ref = None if value is not None else squash(self.text(id_node))
         self.regs.append(
             Registration(form, value, ref, self.span(id_node), cls, kind, ops, self.span(call))
         )
+
+    def _helper(
+        self,
+        form: str,
+        id_node: Node,
+        value: str | None,
+        cls: str | None,
+        ops: tuple[Op, ...] | None,
+        call: Node,
+    ) -> bool:
+        """Record the registration as a helper's when its class is a template parameter or
+        its ID a parameter of the function around it (registered for each caller)."""
+        fn = up_to(call, ("function_definition",), 64)
+        if fn is None:
+            return False
+        decl = fn.child_by_field_name("declarator")
+        while decl is not None and decl.type != "function_declarator":
+            decl = decl.child_by_field_name("declarator")
+        if decl is None:
+            return False
+        name_node, plist = (
+            decl.child_by_field_name("declarator"),
+            decl.child_by_field_name("parameters"),
+        )
+        if name_node is None or plist is None:
+            return False
+        params: list[str] = []
+        for p in plist.named_children:
+            d = p.child_by_field_name("declarator")
+            nm = declared_name(d) if d is not None else None
+            params.append(self.text(nm) if nm is not None else "")
+        tparams: tuple[str, ...] = ()
+        holder = fn.parent
+        if holder is not None and holder.type == "field_declaration_list":
+            # A member (a registrar's constructor): the class template's parameters.
+            holder = holder.parent.parent if holder.parent is not None else None
+        if holder is not None and holder.type == "template_declaration":
+            tl = holder.child_by_field_name("parameters")
+            if tl is not None:
+                tparams = tuple(p for p in map(self._template_param, tl.named_children) if p)
+        id_text = self.text(id_node).strip()
+        id_param = params.index(id_text) if value is None and id_text in params else -1
+        cls_tparam = tparams.index(cls) if cls is not None and cls in tparams else -1
+        if id_param < 0 and cls_tparam < 0:
+            return False
+        if id_param < 0 and value is None:
+            return False  # an ID that is neither a literal nor a parameter: unresolved
+        self.helpers.append(
+            Helper(
+                last_name(strip_args(self.text(name_node))),
+                form,
+                cls_tparam,
+                None if cls_tparam >= 0 else cls,
+                id_param,
+                value,
+                ops,
+                self.span(call),
+            )
+        )
+        return True
+
+    def _helper_calls(self, root: Node) -> Iterator[HelperCall]:
+        yield from self._registrar_objects(root)
+        for m in _HELPER_CALL.finditer(self.src):
+            name = m.group(1).decode()
+            templated = m.group(0).rstrip(b"( \t\r\n").endswith(b">")
+            if name in _NOT_HELPERS or not (templated or _HELPER_NAME.search(name)):
+                continue
+            ident = root.descendant_for_byte_range(m.start(1), m.end(1))
+            if ident is None or ident.type != "identifier" or ident.start_byte != m.start(1):
+                continue
+            call = enclosing_call(ident)
+            if call is None or call.id in self._seen_calls:
+                continue
+            args_node = call.child_by_field_name("arguments")
+            if args_node is None:
+                continue
+            args = [a for a in args_node.named_children if a.type != "comment"]
+            values = tuple(self.string(a) for a in args)
+            if all(v is None for v in values) and not (
+                (templated and len(args) >= 2) or (args and _HELPER_NAME.search(name))
+            ):
+                continue
+            yield HelperCall(
+                name,
+                tuple(template_args(call.child_by_field_name("function"))),
+                tuple(squash(self.text(a)) for a in args),
+                values,
+                tuple(self.span(a) for a in args),
+                self.span(call),
+            )
+
+    def _registrar_objects(self, root: Node) -> Iterator[HelperCall]:
+        """Objects of a class template made with a string argument, which may be of a
+        registrar: ``static Registrar<MyNode> reg("MyNode");``."""
+        for m in _REGISTRAR_OBJECT.finditer(self.src):
+            ident = root.descendant_for_byte_range(m.start(1), m.end(1))
+            if ident is None or ident.type != "type_identifier":
+                continue
+            decl = up_to(ident, ("declaration",), 4)
+            tt = ident.parent
+            if decl is None or tt is None or tt.type != "template_type":
+                continue
+            for d in decl.children_by_field_name("declarator"):
+                if d.type != "init_declarator":
+                    continue
+                value = d.child_by_field_name("value")
+                if value is None or value.type not in ("argument_list", "initializer_list"):
+                    continue
+                args = [a for a in value.named_children if a.type != "comment"]
+                values = tuple(self.string(a) for a in args)
+                if all(v is None for v in values):
+                    continue
+                targs = tt.child_by_field_name("arguments")
+                inner = self.text(targs)[1:-1] if targs is not None else ""
+                yield HelperCall(
+                    self.text(ident),
+                    tuple(squash(a) for a in split_top(inner)),
+                    tuple(squash(self.text(a)) for a in args),
+                    values,
+                    tuple(self.span(a) for a in args),
+                    self.span(d),
+                )
 
     def _ports_fn(self, ident: Node, name: str) -> None:
         decl = ident.parent
@@ -449,23 +656,7 @@ class _Reader:
             if t == "comment":
                 continue
             if t == "declaration":
-                for d in st.children_by_field_name("declarator"):
-                    if d.type == "init_declarator":
-                        target = d.child_by_field_name("declarator")
-                        value = d.child_by_field_name("value")
-                        if target is not None and value is not None:
-                            if value.type == "argument_list":
-                                inner = value.named_children
-                                ops = (
-                                    self.ports_expr(inner[0], local)
-                                    if len(inner) == 1
-                                    else ((Op("unknown", ref=self.text(value)),) if inner else ())
-                                )
-                            else:
-                                ops = self.ports_expr(value, local)
-                            local[self.text(target)] = list(ops)
-                    elif d.type == "identifier":
-                        local[self.text(d)] = []
+                self._declare(st, local)
                 continue
             if t == "expression_statement" and st.named_children:
                 e = st.named_children[0]
@@ -481,6 +672,58 @@ class _Reader:
         if result is None:
             return (*extra, Op("unknown", ref="no return of a port list"))
         return (*extra, *result)
+
+    def _declare(self, st: Node, local: dict[str, list[Op]]) -> None:
+        """The port lists a declaration statement makes (``PortsList p = {…};``)."""
+        for d in st.children_by_field_name("declarator"):
+            if d.type == "init_declarator":
+                target = d.child_by_field_name("declarator")
+                value = d.child_by_field_name("value")
+                if target is not None and value is not None:
+                    if value.type == "argument_list":
+                        inner = value.named_children
+                        ops = (
+                            self.ports_expr(inner[0], local)
+                            if len(inner) == 1
+                            else ((Op("unknown", ref=self.text(value)),) if inner else ())
+                        )
+                    else:
+                        ops = self.ports_expr(value, local)
+                    local[self.text(target)] = list(ops)
+            elif d.type == "identifier":
+                local[self.text(d)] = []
+
+    def _locals_before(self, call: Node, names: set[str]) -> dict[str, list[Op]]:
+        """The port lists named ``names`` that the statements before ``call``'s, in its
+        block, build: ``PortsList ports = {…}; ports.insert(…);`` then the call."""
+        st: Node | None = call
+        while st is not None and st.parent is not None and st.parent.type != "compound_statement":
+            st = st.parent
+        local: dict[str, list[Op]] = {}
+        if st is None or st.parent is None:
+            return local
+        for prev in st.parent.named_children:
+            if prev.start_byte >= st.start_byte:
+                break
+            if prev.type == "declaration" and any(
+                (nm := declared_name(d)) is not None and self.text(nm) in names
+                for d in prev.children_by_field_name("declarator")
+            ):
+                self._declare(prev, local)
+            elif prev.type == "expression_statement" and prev.named_children:
+                e = prev.named_children[0]
+                if e.type == "call_expression":
+                    self._insert(e, local)
+                elif e.type == "assignment_expression":
+                    left, right = e.child_by_field_name("left"), e.child_by_field_name("right")
+                    if left is not None and right is not None and self.text(left) in names:
+                        local[self.text(left)] = list(self.ports_expr(right, local))
+        return local
+
+    def _ports_arg(self, arg: Node, call: Node) -> tuple[Op, ...]:
+        """The port list an argument of a registering call gives (maybe a local)."""
+        local = self._locals_before(call, {self.text(arg)}) if arg.type == "identifier" else {}
+        return self.ports_expr(arg, local)
 
     def _insert(self, call: Node, local: dict[str, list[Op]]) -> bool:
         fn = call.child_by_field_name("function")
@@ -545,9 +788,34 @@ class _Reader:
                 if last == "providedBasicPorts" and len(args) <= 1:
                     inner = self.ports_expr(args[0], local) if args else ()
                     return (Op("basic", ref=scope, ops=inner),)
+                # A helper not followed (``appendPorts(Base::providedPorts(), {…})``): its
+                # result is unknown, the port lists given to it are kept.
+                given = [
+                    op
+                    for a in args
+                    if self._is_port_list(a, local)
+                    for op in self.ports_expr(a, local)
+                ]
+                if given:
+                    return (Op("unknown", ref=squash(self.text(n))[:80]), *given)
         if t == "parenthesized_expression" and n.named_children:
             return self.ports_expr(n.named_children[0], local)
         return (Op("unknown", ref=squash(self.text(n))[:80]),)
+
+    def _is_port_list(self, n: Node, local: dict[str, list[Op]]) -> bool:
+        """Whether ``n`` is plainly a port list: ``{InputPort…}``, a local port list,
+        ``X::providedPorts()``."""
+        if n.type == "initializer_list":
+            return any(self._is_port_call(c) for c in n.named_children)
+        if n.type == "identifier":
+            return self.text(n) in local
+        if n.type == "call_expression":
+            fn = n.child_by_field_name("function")
+            return fn is not None and last_name(strip_args(self.text(fn))) in (
+                "providedPorts",
+                "providedBasicPorts",
+            )
+        return False
 
     def _port_direction(self, call: Node) -> str | None:
         fn = call.child_by_field_name("function")
@@ -573,12 +841,12 @@ class _Reader:
         name = self.string(name_node)
         name_ref = None if name is not None else squash(self.text(name_node))
         default: str | None = None
-        is_expr = False
+        is_expr = literal = False
         desc_node: Node | None = None
         if len(args) == 2:
             desc_node = args[1]
         elif len(args) >= 3:
-            default, is_expr = self._default(args[1])
+            default, is_expr, literal = self._default(args[1])
             desc_node = args[2]
         desc = (self.string(desc_node) if desc_node is not None else "") or ""
         return PortFacts(
@@ -591,18 +859,20 @@ class _Reader:
             is_expr,
             desc,
             self.span(call),
+            literal,
         )
 
-    def _default(self, n: Node) -> tuple[str, bool]:
+    def _default(self, n: Node) -> tuple[str, bool, bool]:
+        """A default's text, whether it is an expression, whether a number/bool literal."""
         s = self.string(n)
         if s is not None:
-            return s, False
+            return s, False, False
         text = squash(self.text(n))
         if n.type in ("number_literal", "true", "false") or (
-            n.type == "unary_expression" and re.fullmatch(r"[-+]\s*[\d.][\w.]*", text)
+            n.type == "unary_expression" and re.fullmatch(r"[-+]\s*[\d.][\w.']*", text)
         ):
-            return text.replace(" ", ""), False
-        return text, True
+            return text.replace(" ", ""), False, True
+        return text, True, False
 
     # --- macros ------------------------------------------------------------------------
 
@@ -614,13 +884,20 @@ class _Reader:
         )
         if name is None or params is None or value is None:
             return
-        body = self.text(value)
+        body = re.sub(r"\\\r?\n", " ", self.text(value))  # continuation lines joined
         m = _MACRO_BODY.search(body)
-        if m is None:
-            return
+        if m is not None:
+            form, cls_text, str_p, id_p, lit = m.groups()
+        else:
+            h = _MACRO_HELPER.search(body)
+            if h is None or h.group(1) in _NOT_HELPERS:
+                return
+            (form, cls_text, str_p, lit), id_p = h.groups(), None
         plist = tuple(self.text(p) for p in params.named_children)
-        form, cls_p, str_p, id_p, lit = m.groups()
-        if cls_p not in plist:
+        cls_text = re.sub(r"\s+", "", cls_text)
+        # The class is a parameter, or a name made of parameters (``ns::name``).
+        cls_p = next((p for p in cls_text.split("::") if p in plist), None)
+        if cls_p is None:
             return
         id_name = str_p or id_p
         if id_name is not None and id_name not in plist:
@@ -634,6 +911,7 @@ class _Reader:
                 plist.index(id_name) if id_name is not None else -1,
                 str_p is not None,
                 None if lit is None else unescape(lit),
+                "" if cls_text == cls_p else cls_text,
             )
         )
 

@@ -30,6 +30,9 @@ class PortFacts(NamedTuple):
     default_is_expr: bool
     description: str
     span: Span
+    # The default is a C++ number or bool literal as written (``0.7f``, ``10u``, ``-1``,
+    # ``true``): BehaviorTree.CPP shows it converted (``toStr`` of the port's type).
+    default_literal: bool = False
 
 
 class Op(NamedTuple):
@@ -71,6 +74,9 @@ class ClassFacts(NamedTuple):
     using_ports: str | None  # `using Base::providedPorts;`
     aliases: dict[str, str]  # `using Base = BT::RosActionNode<X>;`
     constants: dict[str, str]
+    # `providedPorts`/`providedBasicPorts` declared in the body without a body of their own
+    # (`static PortsList providedPorts();`): defined out of line, maybe in a file not read.
+    declared: tuple[str, ...] = ()
 
 
 class Registration(NamedTuple):
@@ -108,6 +114,9 @@ class MacroTemplate(NamedTuple):
     id_param: int
     stringify: bool
     id_literal: str | None
+    # The class as the body writes it when it is more than the parameter
+    # (``ns::class_name``, each parameter replaced by its argument); empty otherwise.
+    cls_text: str = ""
 
 
 class MacroCall(NamedTuple):
@@ -119,6 +128,40 @@ class MacroCall(NamedTuple):
     span: Span
 
 
+class Helper(NamedTuple):
+    """A function of the project that registers a node for its callers.
+
+    E.g. ``template <class T> void reg(Factory& f, const std::string& id)
+    { f.registerNodeType<T>(id); }``.  The class is the template parameter at
+    ``cls_tparam`` (or ``cls`` as written); the ID the function parameter at ``id_param``
+    (or ``id_literal``).  ``ops`` are the port list the registration passes, if any.
+    """
+
+    name: str
+    form: str
+    cls_tparam: int
+    cls: str | None
+    id_param: int
+    id_literal: str | None
+    ops: tuple[Op, ...] | None
+    span: Span
+
+
+class HelperCall(NamedTuple):
+    """A call ``name<targs>(args)`` that may be of a registering helper defined anywhere.
+
+    ``args`` are the arguments as written and ``values`` their string values (``None`` for
+    one that is not a string literal).
+    """
+
+    name: str
+    targs: tuple[str, ...]
+    args: tuple[str, ...]
+    values: tuple[str | None, ...]
+    arg_spans: tuple[Span, ...]
+    span: Span
+
+
 class FileFacts(NamedTuple):
     classes: tuple[ClassFacts, ...] = ()
     fns: tuple[PortsFn, ...] = ()
@@ -126,6 +169,8 @@ class FileFacts(NamedTuple):
     macros: tuple[MacroTemplate, ...] = ()
     macro_calls: tuple[MacroCall, ...] = ()
     constants: dict[str, str] = {}  # noqa: RUF012 (never mutated)
+    helpers: tuple[Helper, ...] = ()
+    helper_calls: tuple[HelperCall, ...] = ()
 
 
 # --- JSON ------------------------------------------------------------------------------
@@ -142,7 +187,7 @@ def _span(v: Any) -> Span:
 
 
 def _port(v: Any) -> PortFacts:
-    d, t, n, nr, ns, df, de, desc, sp = v
+    d, t, n, nr, ns, df, de, desc, sp, dl = v
     return PortFacts(
         str(d),
         None if t is None else str(t),
@@ -153,6 +198,7 @@ def _port(v: Any) -> PortFacts:
         bool(de),
         str(desc),
         _span(sp),
+        bool(dl),
     )
 
 
@@ -175,7 +221,7 @@ def _dict(v: Any) -> dict[str, str]:
 
 def from_json(v: Any) -> FileFacts:
     """The facts :func:`to_json` wrote; raises ``ValueError``/``TypeError`` on anything else."""
-    classes, fns, regs, macros, calls, constants = v
+    classes, fns, regs, macros, calls, constants, helpers, helper_calls = v
     return FileFacts(
         tuple(
             ClassFacts(
@@ -187,6 +233,7 @@ def from_json(v: Any) -> FileFacts:
                 None if c[5] is None else str(c[5]),
                 _dict(c[6]),
                 _dict(c[7]),
+                _strs(c[8]),
             )
             for c in classes
         ),
@@ -218,6 +265,7 @@ def from_json(v: Any) -> FileFacts:
                 int(m[4]),
                 bool(m[5]),
                 None if m[6] is None else str(m[6]),
+                str(m[7]),
             )
             for m in macros
         ),
@@ -225,4 +273,28 @@ def from_json(v: Any) -> FileFacts:
             MacroCall(str(c[0]), _strs(c[1]), tuple(map(_span, c[2])), _span(c[3])) for c in calls
         ),
         _dict(constants),
+        tuple(
+            Helper(
+                str(h[0]),
+                str(h[1]),
+                int(h[2]),
+                None if h[3] is None else str(h[3]),
+                int(h[4]),
+                None if h[5] is None else str(h[5]),
+                None if h[6] is None else _ops(h[6]),
+                _span(h[7]),
+            )
+            for h in helpers
+        ),
+        tuple(
+            HelperCall(
+                str(c[0]),
+                _strs(c[1]),
+                _strs(c[2]),
+                tuple(None if x is None else str(x) for x in c[3]),
+                tuple(map(_span, c[4])),
+                _span(c[5]),
+            )
+            for c in helper_calls
+        ),
     )

@@ -30,6 +30,9 @@ _NAV2_BASES: Final = (
     ("BtServiceNode", "ServiceT"),
     ("BtCancelActionNode", "ActionT"),
 )
+# Bases of BehaviorTree.ROS2 forks (RoboMaster sentry projects): a stateful action whose
+# basic ports are the fork's, not known here.
+_FORK_BASES: Final = (("RosTopicPubStatefulActionNode", "TopicT", "StatefulActionNode"),)
 
 
 def _source() -> bytes:
@@ -46,6 +49,15 @@ def _source() -> bytes:
             f'      "__default__placeholder__", "{desc}")}};',
             "    basic.insert(addition.begin(), addition.end());",
             "    return basic;",
+            "  }",
+            "  static PortsList providedPorts() { return providedBasicPorts({}); }",
+            "};",
+        ]
+    for cls, param, base in _FORK_BASES:
+        out += [
+            f"template <class {param}> class {cls} : public {base} {{",
+            "  static PortsList providedBasicPorts(PortsList addition) {",
+            "    return basic_ports_of_the_fork_built(addition);",
             "  }",
             "  static PortsList providedPorts() { return providedBasicPorts({}); }",
             "};",

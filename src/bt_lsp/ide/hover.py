@@ -18,9 +18,11 @@ from bt_lsp.ide.name_fixes import preferred_renaming
 from bt_lsp.ide.ports import builtins_in, ports_of
 from bt_lsp.rules.builtins import PortModel
 from bt_lsp.rules.builtins_v3 import V3_BUILTINS
+from bt_lsp.rules.codes import NAMES, defined
 from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.diagnostics import name_violations
-from bt_lsp.rules.names import RULES
+from bt_lsp.rules.names import RULES, Violation
+from bt_lsp.rules.semantics.models import reserved_declaration_at
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import DECLARING_ROLES, NameRef, Role
 
@@ -225,14 +227,26 @@ def _where_defined(
         )
 
 
+def _violations(doc: Document, ref: NameRef, ctx: Context | None) -> tuple[Violation, ...]:
+    """The name rules ``ref`` breaks, as its diagnostics say: a declared port's reserved
+    name as the project's BehaviorTree.CPP version makes it (a name-rule code only)."""
+    found = name_violations(ref)
+    if found:
+        return found
+    reserved = reserved_declaration_at(doc.model, ref, ctx)
+    if reserved is None or defined(reserved.code).family != NAMES:
+        return ()
+    return (reserved,)
+
+
 def _bad_name(
     w: _Writer,
     doc: Document,
     ref: NameRef,
+    violations: tuple[Violation, ...],
     others: Mapping[str, Document],
     ctx: Context | None = None,
 ) -> None:
-    violations = name_violations(ref)
     assert ref.kind is not None
     title = _KIND_TITLE[str(ref.kind)]
     w.title(f"{title} {w.code(ref.text)} breaks the BehaviorTree.CPP naming rules")
@@ -323,8 +337,9 @@ def hover_at(
             return None
         _key_hover(w, doc, key, ctx)
         return HoverText(w.text(), key.start, key.end, markdown)
-    if name_violations(ref):
-        _bad_name(w, doc, ref, others, ctx)
+    violations = _violations(doc, ref, ctx)
+    if violations:
+        _bad_name(w, doc, ref, violations, others, ctx)
     else:
         w.title(_what(w, ref))
         decl = (

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Final
 
+from bt_lsp.project.schema import FILE_KEYS
 from bt_lsp.project.settings import BTCPP_CHOICES, Settings
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.registry import CODES
@@ -41,7 +42,10 @@ MAX_CONFIG_BYTES: Final = 1024 * 1024
 # How far upward a configuration is looked for (folders).
 MAX_DEPTH: Final = 64
 
-KEYS: Final = ("models", "btcpp", "severity", "exclude", "ros-packages", "sources")
+# What ``min-severity`` may be.
+MIN_SEVERITIES: Final = ("error", "warning", "information", "hint")
+# The keys, as the configuration reference documents them (bt_lsp.project.schema).
+KEYS: Final = FILE_KEYS
 
 
 class ConfigError(Exception):
@@ -78,6 +82,7 @@ class Layer:
     exclude: tuple[str, ...] | None = None
     ros_packages: Mapping[str, str] | None = None
     sources: tuple[str, ...] | None = None
+    min_severity: Severity | None = None
 
     def over(self, base: Settings) -> Settings:
         """``base`` with what this layer gives; severities are merged code by code."""
@@ -94,6 +99,8 @@ class Layer:
             kw["ros_packages"] = {**base.ros_packages, **self.ros_packages}
         if self.sources is not None:
             kw["sources"] = self.sources
+        if self.min_severity is not None:
+            kw["min_severity"] = self.min_severity
         return replace(base, **kw) if kw else base
 
 
@@ -250,6 +257,18 @@ def _parse(path: Path, text: str, table: dict[str, Any], prefix: tuple[str, ...]
         kw["btcpp"] = word
     if "severity" in table:
         kw["severity"] = _severities(path, text, prefix, table["severity"])
+    if "min-severity" in table:
+        raw = table["min-severity"]
+        minimum = Severity.parse(raw) if raw in MIN_SEVERITIES else None
+        if minimum is None:
+            raise _error(
+                path,
+                text,
+                (*prefix, "min-severity"),
+                f'\'min-severity\' must be "error", "warning", "information" or '
+                f'"hint", not {_toml(raw)}',
+            )
+        kw["min_severity"] = minimum
     exclude = strings("exclude")
     if exclude is not None:
         kw["exclude"] = tuple(anchor(folder, g) for g in exclude)

@@ -3,9 +3,10 @@
 A file inside a ROS package (the nearest ``package.xml``) sees the C++ of that package and
 of the packages it depends on that are in the same workspace (colcon ``src/``), not every
 node of the workspace; a file outside any package sees the C++ under the workspace
-folders.  A package's C++ is its ``src/`` and ``include/`` (the whole package when it has
-neither), or what the ``sources`` globs of the configuration name; build, install and
-log folders and the ``exclude`` globs are skipped.
+folders.  A package's C++ is every C++ file of the package, wherever it keeps it
+(:func:`~bt_lsp.project.cpp_scan.cpp_sources`, the rule ``bt-lsp models`` follows too), or
+what the ``sources`` globs of the configuration name; build, install and log folders,
+test folders (but for the one holding the tree) and the ``exclude`` globs are skipped.
 
 Files are read once and again only after :meth:`CppModels.file_changed` (or when their
 modification time or size changed, for the command line); their facts come from the
@@ -33,7 +34,7 @@ from typing import Final, NamedTuple
 from bt_lsp.cpp.catalog import Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
-from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files, scan
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, cpp_sources, find_cpp_files, scan
 from bt_lsp.project.packages import BTCPP_PACKAGES, Manifest, Packages, is_file
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.builtins import Category, Direction, PortModel
@@ -124,6 +125,10 @@ class CppModels:
             tuple[Path, tuple[str, ...], tuple[str, ...]], tuple[int, tuple[Path, ...]]
         ] = {}
         self._known: set[Path] = set()
+        # The folders searched for C++ files, with their modification times when searched:
+        # without watched files, one that changed (a file created or deleted in it) means
+        # the file lists are found again (see :meth:`revalidate`).
+        self._folder_stamps: dict[Path, int] = {}
         self.tree_generation = 0  # bumps when a C++ file or manifest appears or goes
         self._decls: dict[tuple[int, str | None], MappingProxyType[str, ModelDecl]] = {}
         self._line_starts: dict[Path, tuple[bytes, list[int]]] = {}
@@ -188,11 +193,65 @@ class CppModels:
                 return hit[1]
             generation = self.tree_generation
         files = self._find(path, sources, exclude)
+        folders = {} if self.watched else self._searched_folders(path, files)
         with self._lock:
             if generation == self.tree_generation:
                 self._files[key] = (generation, files)
                 self._known.update(files)
+                self._folder_stamps.update(folders)
         return files
+
+    def _searched_folders(self, path: Path, files: tuple[Path, ...]) -> dict[Path, int]:
+        """The folders whose modification time says whether a C++ file was created or
+        deleted where :meth:`_find` looked for ``path``: the package folders (or
+        workspace folders), their ``src`` and ``include``, the folders below them that
+        were walked, and those of the files found (the ``sources`` globs' too)."""
+        pkgs = self.visible_packages(path)
+        tops = (
+            [m.folder for m in pkgs]
+            if pkgs is not None
+            else [r if r.is_dir() else r.parent for r in self.roots]
+        )
+        found: dict[Path, int] = {}
+        for top in tops:
+            for folder in (top, top / "src", top / "include"):
+                stamp = _mtime(folder)
+                if stamp is not None:
+                    found[folder] = stamp
+        for f in files:
+            for folder in f.parents:
+                if folder in found:
+                    break
+                stamp = _mtime(folder)
+                if stamp is None:
+                    break
+                found[folder] = stamp
+                if not any(_under(folder, t) for t in tops):
+                    break
+        return found
+
+    def revalidate(self) -> bool:
+        """Without watched files: forget the C++ files whose modification time or size
+        changed since they were read (deleted ones too), and find the files again when a
+        folder searched changed (a file created or deleted in it).  Only stats: the files
+        read and the folders searched.  ``True`` if anything changed."""
+        if self.watched:
+            return False
+        with self._lock:
+            read = [(p, stamp) for p, (stamp, _) in self._bytes.items()]
+            folders = list(self._folder_stamps.items())
+        changed = [p for p, stamp in read if _file_stamp(p) != stamp]
+        for p in changed:
+            self.file_changed(p)
+        moved = [d for d, t in folders if _mtime(d) != t]
+        if moved:
+            with self._lock:
+                for d in moved:
+                    self._folder_stamps.pop(d, None)
+                self._workspace_packages = None
+                self.tree_generation += 1
+                self.generation += 1
+        return bool(changed or moved)
 
     def _find(
         self, path: Path, sources: Sequence[str] = (), exclude: Sequence[str] = ()
@@ -210,9 +269,7 @@ class CppModels:
         else:
             found = []
             for folder in folders:
-                parts = [folder / "src", folder / "include"]
-                present = [p for p in parts if p.is_dir()] if pkgs is not None else []
-                found.extend(find_cpp_files(present or [folder]))
+                found.extend(cpp_sources(folder, path))
         if exclude:
             found = [f for f in found if not any(f.match(g) for g in exclude)]
         return tuple(sorted(dict.fromkeys(found))[:MAX_CPP_FILES])
@@ -295,9 +352,12 @@ class CppModels:
             return False
         with self._lock:
             self._bytes.pop(path, None)
-            if path.name == "package.xml" or path not in self._known or not path.exists():
+            gone = not path.exists()
+            if path.name == "package.xml" or path not in self._known or gone:
                 self._workspace_packages = None
                 self.tree_generation += 1
+            if gone:  # created again later, it is a new file: the file lists change again
+                self._known.discard(path)
             self.generation += 1
         return True
 
@@ -348,8 +408,10 @@ class CppModels:
         builtins = builtins_for(ctx.btcpp_version)
         decls = self.decls(cat, ctx.btcpp_version)
         for id_, d in decls.items():
-            if id_ not in merged or cat.by_id[id_].authoritative:
+            if id_ not in merged:
                 merged[id_] = d
+            elif cat.by_id[id_].authoritative:
+                merged[id_] = _with_catalog_types(d, merged[id_])
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
@@ -533,6 +595,23 @@ def cpp_diagnostics(text: str, scanner: Scanner | None = None) -> list[Diagnosti
     return cpp_name_diagnostics(facts, text)
 
 
+def _with_catalog_types(cpp: ModelDecl, other: ModelDecl) -> ModelDecl:
+    """The C++ model, with the port types of an authoritative catalog of the same node.
+
+    The C++ says which ports there are (a catalog may be older than the code); a catalog
+    spells their types as BehaviorTree.CPP exports them, where the C++ spells them as
+    written (``ActionResult::_error_code_type``, ``PoseStamped`` under a ``using``), so
+    types compared across nodes of both sources agree.
+    """
+    if not other.authoritative:
+        return cpp
+    types = {p.name: p.type for p in other.ports if p.type}
+    if not any(p.name in types and types[p.name] != p.type for p in cpp.ports):
+        return cpp
+    ports = tuple(replace(p, type=types.get(p.name, p.type)) for p in cpp.ports)
+    return cpp._replace(ports=ports)
+
+
 def _category(kind: str | None) -> Category:
     if kind == "Condition":
         return "Condition"
@@ -551,6 +630,22 @@ def _registers_no_nodes(dep: str) -> bool:
 
 def _direction(d: str) -> Direction:
     return "output" if d == "output" else "inout" if d == "inout" else "input"
+
+
+def _mtime(folder: Path) -> int | None:
+    try:
+        return os.stat(folder).st_mtime_ns
+    except (OSError, ValueError):
+        return None
+
+
+def _file_stamp(path: Path) -> tuple[int, int] | None:
+    """What :meth:`CppModels._read` keeps a file's bytes by (``None``: not there)."""
+    try:
+        st = path.stat()
+    except (OSError, ValueError):
+        return None
+    return (st.st_mtime_ns, st.st_size)
 
 
 def _under(f: Path, folder: Path) -> bool:

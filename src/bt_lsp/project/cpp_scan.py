@@ -33,8 +33,9 @@ from bt_lsp.cpp.library import library_facts
 
 CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp"})
 SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules", "__pycache__"})
+TEST_DIRS: Final = frozenset({"test", "tests"})
 # Bumped whenever the facts' shape or meaning changes, so old cache entries are not read.
-_FORMAT: Final = "2"
+_FORMAT: Final = "3"
 _LAZY_ROUNDS: Final = 3
 
 
@@ -54,13 +55,54 @@ def find_cpp_files(paths: Iterable[str | Path], exclude: Sequence[str] = ()) -> 
         if p.is_file():
             out.append(p)
             continue
-        for root, dirs, files in os.walk(p):
-            dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.startswith("."))
-            for name in sorted(files):
-                f = Path(root) / name
-                if f.suffix in CPP_SUFFIXES and not _excluded(f, p, exclude):
-                    out.append(f)
+        out.extend(_walk(p, exclude, skip_packages=False, skip_tests=False))
     return sorted(dict.fromkeys(out))
+
+
+def cpp_sources(folder: Path, near: Path | None = None) -> list[Path]:
+    """The C++ that a folder (a ROS package, a workspace, a plain CMake project) registers
+    its nodes in: every C++ file under it, wherever the package keeps it (``src/``,
+    ``include/``, ``plugins/``, ``nodes/``, ...), sorted.
+
+    One rule for ``bt-lsp models``, ``check`` and the server.  Build, install, log and
+    hidden folders are skipped; so are test folders (``test``, ``tests``: test programs
+    register mocks under the IDs of the real nodes), but for the one that holds ``near``
+    (a tree in a test folder sees the nodes its tests register).  A package folder does
+    not hold the packages nested in it (each is a package of its own, seen through the
+    dependencies).
+    """
+    if folder.is_file():
+        return [folder]
+    found = _walk(folder, (), skip_packages=(folder / "package.xml").is_file(), skip_tests=True)
+    if near is not None:
+        try:
+            parts = near.relative_to(folder).parts[:-1]
+        except ValueError:
+            parts = ()
+        for i, part in enumerate(parts):
+            if part in TEST_DIRS:
+                found.extend(_walk(folder.joinpath(*parts[: i + 1]), (), True, False))
+                break
+    return sorted(dict.fromkeys(found))
+
+
+def _walk(base: Path, exclude: Sequence[str], skip_packages: bool, skip_tests: bool) -> list[Path]:
+    out: list[Path] = []
+    for root, dirs, files in os.walk(base):
+        here = Path(root)
+        dirs[:] = sorted(
+            d
+            for d in dirs
+            if d not in SKIP_DIRS
+            and not d.startswith(".")
+            and not (skip_tests and d in TEST_DIRS)
+            and not (skip_packages and (here / d / "package.xml").is_file())
+        )
+        for name in sorted(files):
+            f = here / name
+            if f.suffix in CPP_SUFFIXES and not _excluded(f, base, exclude):
+                out.append(f)
+    return out
 
 
 def _excluded(f: Path, base: Path, exclude: Sequence[str]) -> bool:
@@ -229,6 +271,7 @@ def _link_lazily(
     for _ in range(_LAZY_ROUNDS):
         names = set(catalog.missing)
         names.update(m.name for f in read_facts.values() for m in f.macros)
+        names.update(h.name for f in read_facts.values() for h in f.helpers)
         if not names or not rest:
             break
         wanted = re.compile(

@@ -226,6 +226,10 @@ class ProjectIndex:
         changed += self.configs.revalidate()  # bt-lsp.toml created, edited or deleted
         for p in changed:
             self.file_changed(p)
+        # The C++ files read and the folders searched for them, by the same stamps.
+        cpp = self.cpp is not None and self.cpp.revalidate()
+        if cpp:
+            self.generation += 1
         if self._files is not None and any(_folder_stamp(d) != t for d, t in self._folders.items()):
             before = self._files
             self._files = None
@@ -235,7 +239,7 @@ class ProjectIndex:
                     self.file_changed(p)  # a catalog, a package.xml: forgotten
                 self._files = now
                 return True
-        return bool(changed)
+        return bool(changed) or cpp
 
     def refresh(self) -> None:
         """Forget everything read from disk (for clients that do not report file changes)."""

@@ -3,10 +3,10 @@ reported, never fatal."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Final
+from typing import Any, Final, Protocol, TypeVar
 
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.registry import CODES
@@ -35,6 +35,8 @@ class Settings:
     exclude: tuple[str, ...] = ()
     # Globs of the project's C++ sources (read by the C++ catalog reader).
     sources: tuple[str, ...] = ()
+    # The least severe diagnostics shown (published, printed): less severe ones are not.
+    min_severity: Severity = Severity.HINT
 
     @classmethod
     def parse(cls, raw: Any, problems: list[str] | None = None) -> Settings:
@@ -90,4 +92,39 @@ class Settings:
                 kw["btcpp"] = str(btcpp)
             else:
                 problems.append(f"btcpp must be one of {', '.join(BTCPP_CHOICES)}, not {btcpp!r}")
+        minimum = raw.get("minSeverity")
+        if minimum is not None:
+            found = _min_severity(minimum)
+            if found is None:
+                problems.append(
+                    f"minSeverity must be one of error, warning, information, hint, not {minimum!r}"
+                )
+            else:
+                kw["min_severity"] = found
         return cls(**kw)
+
+
+def _min_severity(word: object) -> Severity | None:
+    """A ``minSeverity`` value: a severity word (``None`` if it is not one; ``off`` is
+    not one here)."""
+    if not isinstance(word, str):
+        return None
+    try:
+        return Severity.parse(word)
+    except ValueError:
+        return None
+
+
+def shown(diags: Iterable[D], minimum: Severity) -> list[D]:
+    """The diagnostics at least as severe as ``minimum`` (the ``min-severity`` setting)."""
+    if minimum == Severity.HINT:
+        return list(diags)
+    return [d for d in diags if d.severity <= minimum]
+
+
+class _HasSeverity(Protocol):
+    @property
+    def severity(self) -> Severity: ...
+
+
+D = TypeVar("D", bound=_HasSeverity)

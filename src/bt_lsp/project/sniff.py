@@ -1,24 +1,19 @@
 """What kind of XML a file is, from its first bytes: enough to tell a BehaviorTree.CPP
-document (top element ``<root>``) from the other XML of a source tree (``package.xml``,
-launch files, URDF and xacro, pluginlib descriptions) without parsing it."""
+document from the other XML of a source tree (``package.xml``, launch files, URDF and
+xacro, pluginlib descriptions, other tools' files) without parsing it."""
 
 from __future__ import annotations
 
 import codecs
-import re
 from pathlib import Path
 from typing import Final
+
+from bt_lsp.syntax.kind import HEAD_CHARS, looks_like_bt, top_element
 
 __all__ = ["SNIFF_BYTES", "head_of", "is_bt_file", "top_element"]
 
 SNIFF_BYTES: Final = 64 * 1024
 
-# Before the top element: an XML declaration, processing instructions, comments, a
-# DOCTYPE without an internal subset, white space.
-_TOP: Final = re.compile(
-    r"(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>\[]*(?:\[.*?\])?\s*>)*<([^\s/>!?]+)",
-    re.DOTALL,
-)
 _BOMS: Final = (
     (codecs.BOM_UTF32_LE, "utf-32-le"),
     (codecs.BOM_UTF32_BE, "utf-32-be"),
@@ -45,26 +40,12 @@ def head_of(path: Path | str, size: int = SNIFF_BYTES) -> str | None:
     return data.decode("utf-8", "replace")
 
 
-def top_element(text: str) -> str | None:
-    """The name of the first element of an XML text (``None`` if there is none in it)."""
-    m = _TOP.match(text.removeprefix("\ufeff"))
-    return m.group(1) if m is not None else None
-
-
-# The top elements of the other XML a ROS source tree holds: package manifests, launch
-# files, URDF and xacro, pluginlib descriptions, Gazebo SDF, ament/catkin metadata.
-OTHER_XML: Final = frozenset(
-    {"package", "launch", "robot", "library", "class_libraries", "sdf", "model", "world"}
-)
-
-
 def is_bt_file(path: Path | str) -> bool:
-    """Whether the file is to be checked as BehaviorTree.CPP XML: anything but the known
-    other XML of a source tree (its top element one of :data:`OTHER_XML`), so that a
-    broken BT file (no element, a misspelt ``<root>``) is still reported. A file that
-    cannot be read counts as one, so that reading it reports the error."""
-    head = head_of(path)
+    """Whether the file is to be checked as BehaviorTree.CPP XML when a folder is walked:
+    what its content says (:func:`bt_lsp.syntax.kind.looks_like_bt`, the decision the
+    workspace and the editor make too).  A file that cannot be read counts as one, so
+    that reading it reports the error."""
+    head = head_of(path, 4 * HEAD_CHARS)
     if head is None:
         return True
-    top = top_element(head)
-    return top is None or top.rpartition(":")[2] not in OTHER_XML
+    return looks_like_bt(head)

@@ -5,16 +5,24 @@ fixes are defined with :func:`define` in the module of the rule that reports it,
 the rule's messages; :mod:`bt_lsp.rules.registry` imports every such module and is the one
 table of all codes (the README's code table, the server's ``codeDescription`` links and
 the severity settings read it).  Codes are stable once released (see CHANGELOG.md).
+
+Each code has a page on the documentation site (``docs/rules/<code>.md``, written by
+``scripts/docs_gen.py``); the optional prose of :func:`define` (``doc``, ``why``, ``bad``,
+``good``, ``since``) is what that page says beyond the summary.
 """
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import IntEnum
 from types import MappingProxyType
+from typing import Final
 
-DOCS_URL = "https://github.com/bt-lsp/bt-lsp/blob/main/README.md"
+#: The documentation site (MkDocs, ``mkdocs.yml``, published as the project's GitHub Pages);
+#: every code's page is ``rules/<code>/`` under it (:attr:`Code.url`).
+DOCS_URL: Final = "https://bt-lsp.github.io/bt-lsp/"
 
 
 class Severity(IntEnum):
@@ -46,17 +54,26 @@ class Severity(IntEnum):
 @dataclass(frozen=True, slots=True, eq=False)
 class Code:
     """One diagnostic code.  ``fixes`` are the titles of its quick fixes by fix, as
-    :meth:`str.format` templates (see :meth:`fix_title`)."""
+    :meth:`str.format` templates (see :meth:`fix_title`).  The rest is the prose of the
+    code's documentation page, each part optional (Markdown; ``bad`` and ``good`` are XML):
+    what BehaviorTree.CPP does, why it matters, a document that gets the diagnostic and the
+    same document fixed, and the BehaviorTree.CPP versions the rule applies to."""
 
     code: str
     severity: Severity
     summary: str
     family: str
     fixes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    doc: str = ""
+    why: str = ""
+    bad: str = ""
+    good: str = ""
+    since: str = ""
 
     @property
     def url(self) -> str:
-        return f"{DOCS_URL}#{self.code}"
+        """The code's page on the documentation site (the ``codeDescription`` link)."""
+        return f"{DOCS_URL}rules/{self.code}/"
 
     def fix_title(self, fix: str, **values: object) -> str:
         """The title of the fix ``fix`` with ``values`` filled in."""
@@ -91,14 +108,35 @@ def define(
     family: str,
     *,
     fixes: Mapping[str, str] | None = None,
+    doc: str = "",
+    why: str = "",
+    bad: str = "",
+    good: str = "",
+    since: str = "",
 ) -> Code:
-    """Define (and register) a code; a name defined twice is a programming error."""
+    """Define (and register) a code; a name defined twice is a programming error.  The
+    prose (``doc`` … ``since``, see :class:`Code`) is optional: without it the code's page
+    says the summary."""
     if code in _DEFINED:
         raise ValueError(f"diagnostic code {code!r} is defined twice")
     found = _DEFINED[code] = Code(
-        code, severity, summary, family, MappingProxyType(dict(fixes or {}))
+        code,
+        severity,
+        summary,
+        family,
+        MappingProxyType(dict(fixes or {})),
+        doc=_dedent(doc),
+        why=_dedent(why),
+        bad=_dedent(bad),
+        good=_dedent(good),
+        since=since.strip(),
     )
     return found
+
+
+def _dedent(text: str) -> str:
+    """Prose written as an indented triple-quoted string, without its indentation."""
+    return textwrap.dedent(text).strip()
 
 
 def defined(code: str) -> Code:

@@ -28,7 +28,31 @@ if TYPE_CHECKING:
     from bt_lsp.syntax.document import Document, History
 
 # The codes of these rules (see bt_lsp.rules.registry).
-XML_SYNTAX: Final = define("xml-syntax", Severity.ERROR, "the document is not well-formed XML", XML)
+XML_SYNTAX: Final = define(
+    "xml-syntax",
+    Severity.ERROR,
+    "the document is not well-formed XML",
+    XML,
+    doc="""
+        The document is not well-formed XML, and tinyxml2, the parser BehaviorTree.CPP uses,
+        rejects it too: `Error parsing the XML: Error=XML_ERROR_MISMATCHED_ELEMENT …`. bt-lsp
+        reports the first such error where it is, with one diagnostic per problem, and keeps
+        checking what it can. What tinyxml2 accepts but XML does not (a raw `&` in an attribute,
+        text after the root) is a warning instead (`xml-unescaped-char`, `xml-lenient`).
+        """,
+    why="The file does not load at all.",
+    bad="""
+        <Sequence>
+          <AlwaysSuccess>
+        </Sequence>
+        """,
+    good="""
+        <Sequence>
+          <AlwaysSuccess/>
+        </Sequence>
+        """,
+    since="Every version.",
+)
 XML_EXTRA_ROOT: Final = define(
     "xml-extra-root",
     Severity.WARNING,
@@ -133,8 +157,8 @@ def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTIC
     return Capped(diags, more)
 
 
-# The violations of each name text, per role (a role decides the kind and whether the
-# name is declared): model and port names repeat (every use of a node type or port), and
+# The violations of each name text, per role (a role decides the kind): model and port
+# names repeat (every use of a node type or port), and
 # a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
 # names rarely repeat and their rule is quick: they are not kept (they would cost memory
 # in proportion to the documents).  Bounded.
@@ -143,11 +167,14 @@ _MAX_CACHED = 4096
 
 
 def violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
-    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role)."""
+    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role), as
+    the document alone tells: a reserved name of a declared port is reported by the
+    semantic checks, which know the model entry and the BehaviorTree.CPP version
+    (:func:`bt_lsp.rules.names.reserved_port_declaration`)."""
     cache = _VIOLATIONS[role]
     found = cache.get(text)
     if found is None:
-        found = check_name(text, kind, declaration=role is Role.PORT_DECL)
+        found = check_name(text, kind)
         if kind is not NameKind.INSTANCE:
             if len(cache) >= _MAX_CACHED:
                 cache.clear()

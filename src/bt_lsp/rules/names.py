@@ -16,7 +16,7 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Final
 
-from bt_lsp.rules.codes import NAMES, FixData, Severity, define
+from bt_lsp.rules.codes import BT, NAMES, FixData, Severity, define
 from bt_lsp.syntax.elements import Role
 from bt_lsp.syntax.vocabulary import (
     BTCPP_RESERVED_ATTRIBUTES,
@@ -49,9 +49,34 @@ NAME_FIX_TITLES: Final = {
     "clear": "Clear '{old}' ({where})",
 }
 
+# The versions the name rules apply to (the ``since`` of each code's page).
+_NAME_RULES_SINCE: Final = (
+    "BehaviorTree.CPP 4.8.4 and later (the release that added name validation). Earlier "
+    "releases, 3.x included, load the name, but Groot2 and every newer release reject it, "
+    "so bt-lsp reports it for every version."
+)
+
 # The codes of these rules (see bt_lsp.rules.registry).
 MODEL_NAME_EMPTY: Final = define(
-    "model-name-empty", Severity.ERROR, "a model name is empty", NAMES, fixes=NAME_FIX_TITLES
+    "model-name-empty",
+    Severity.ERROR,
+    "a model name is empty",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+    doc="""
+        BehaviorTree.CPP checks every model name it reads from a tree (a node type written as an
+        element, `<BehaviorTree ID>`, `<SubTree ID>`) when it loads the XML, and rejects an empty
+        one: `Model/Node type name cannot be empty` (an empty `<SubTree ID="">` is reported as a
+        missing `ID`). bt-lsp also checks the `ID` of explicit nodes and `<TreeNodesModel>` entries.
+        """,
+    why="""
+        The file does not load: `registerBehaviorTreeFromFile` or `createTreeFromFile` throws, and
+        the robot never starts the tree. A node or tree without a name cannot be registered,
+        called or shown in Groot2.
+        """,
+    bad='<SubTree ID=""/>',
+    good='<SubTree ID="Dock"/>',
+    since=_NAME_RULES_SINCE,
 )
 MODEL_NAME_RESERVED: Final = define(
     "model-name-reserved",
@@ -59,6 +84,26 @@ MODEL_NAME_RESERVED: Final = define(
     "a model name is `Root` or `root`",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        `Root` and `root` are reserved: BehaviorTree.CPP rejects either as a node type, a tree ID
+        or a SubTree ID when it loads the XML (`'Root' is a reserved name and cannot be used as a
+        node type`). The match is exact, so `ROOT` or `RootTree` are fine.
+        """,
+    why="""
+        The file does not load. `<root>` is the document's top element, so a node or tree called
+        `Root` is easily confused with it, in the XML and in Groot2.
+        """,
+    bad="""
+        <BehaviorTree ID="Root">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="RootTree">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 MODEL_NAME_FORBIDDEN_CHAR: Final = define(
     "model-name-forbidden-char",
@@ -66,9 +111,66 @@ MODEL_NAME_FORBIDDEN_CHAR: Final = define(
     "a model name contains a forbidden character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A model name (node type, tree ID, SubTree ID) may hold any character except whitespace,
+        `< > & " '`, `/ \\ :`, `* ? |`, `.` and the control characters (ASCII 0-31, 127); any
+        non-ASCII letter is allowed. BehaviorTree.CPP rejects the name when it loads the XML:
+        `Model name 'Main Tree' contains forbidden character ' '`.
+        """,
+    why="""
+        The file does not load. A space or a period in a node type cannot even be written as an
+        XML element name, and a tree ID with one cannot be used in compact form or saved by
+        Groot2.
+        """,
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Main Tree">
+          <BehaviorTree ID="Main Tree">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main_Tree">
+          <BehaviorTree ID="Main_Tree">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_EMPTY: Final = define(
-    "port-name-empty", Severity.ERROR, "a port name is empty", NAMES, fixes=NAME_FIX_TITLES
+    "port-name-empty",
+    Severity.ERROR,
+    "a port name is empty",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+    doc="""
+        A port declared in a `<TreeNodesModel>` `<SubTree>` entry (`<input_port name="…">`) must
+        have a name: BehaviorTree.CPP rejects an empty one when it loads the XML (`Port name
+        cannot be empty`).
+        """,
+    why="""
+        The file does not load, and a port without a name can never be remapped.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name=""/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="target"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_LEADING_DIGIT: Final = define(
     "port-name-leading-digit",
@@ -76,20 +178,101 @@ PORT_NAME_LEADING_DIGIT: Final = define(
     "a port name starts with an ASCII digit",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A port name cannot start with an ASCII digit. BehaviorTree.CPP rejects such a port in a
+        `<TreeNodesModel>` `<SubTree>` entry when it loads the XML (`Port name '2x' cannot start
+        with a digit`), and never treats a node attribute that starts with a digit as a port.
+        """,
+    why="""
+        The file does not load; and an attribute such as `2nd_goal` is not even a well-formed XML
+        attribute name, so the port can never be set from XML.
+        """,
+    bad='<SubTree ID="Dock" 2nd_goal="{goal}"/>',
+    good='<SubTree ID="Dock" second_goal="{goal}"/>',
+    since=_NAME_RULES_SINCE,
 )
 PORT_NAME_RESERVED: Final = define(
     "port-name-reserved",
     Severity.ERROR,
-    "a port declared in `<TreeNodesModel>` uses a reserved attribute name",
+    "a port of a `<SubTree>` model is named after an attribute BehaviorTree.CPP reserves "
+    "(`ID`, `name`, `_autoremap`, the pre/post conditions); 4.8.4 and later throw when "
+    "they load the model",
+    NAMES,
+    fixes=NAME_FIX_TITLES,
+    doc="""
+        `ID`, `name`, `_autoremap` and the pre- and post-condition attributes (`_skipIf`,
+        `_successIf`, `_failureIf`, `_while`, `_onSuccess`, `_onFailure`, `_onHalted`, `_post`)
+        are reserved: BehaviorTree.CPP reads them itself on every node. It rejects a port declared
+        with one of these names in a `<TreeNodesModel>` `<SubTree>` entry when it loads the XML
+        (`Port name '_autoremap' is a reserved attribute name`).
+        """,
+    why="""
+        The file does not load; and the port could never be set, since the attribute of that name
+        means something else on every node.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="_autoremap"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="autoremap"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
+)
+PORT_NAME_RESERVED_GROOT2: Final = define(
+    "port-name-reserved-groot2",
+    Severity.WARNING,
+    "a port declared in `<TreeNodesModel>` has a name the name rules (Groot2) reserve, "
+    "where BehaviorTree.CPP accepts it (`__shared_blackboard`, `_description`, or an entry "
+    "BehaviorTree.CPP does not read)",
     NAMES,
     fixes=NAME_FIX_TITLES,
 )
+# Not a name-rule code: the name is right for Groot 1 and BehaviorTree.CPP 3, so no fix
+# renames it (the name fixes and ``check --fix`` act on every code of the NAMES family).
+PORT_NAME_GROOT1: Final = define(
+    "port-name-groot1",
+    Severity.HINT,
+    "`__shared_blackboard` declared as a port of a `<SubTree>` model, Groot 1's way of "
+    "writing BehaviorTree.CPP 3's shared blackboard, in a file not checked as version 4",
+    BT,
+)
+
+#: The name codes that depend on the project's BehaviorTree.CPP version and on the model
+#: entry a port is declared in: reported by the semantic checks
+#: (:func:`reserved_port_declaration`), never by a document's own name rules nor the early
+#: name pass.
+PROJECT_NAME_CODES: Final = frozenset({"port-name-reserved", "port-name-reserved-groot2"})
 PORT_NAME_FORBIDDEN_CHAR: Final = define(
     "port-name-forbidden-char",
     Severity.ERROR,
     "a port name contains a forbidden character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A port name has the same forbidden characters as a model name (whitespace, `< > & " '`,
+        `/ \\ :`, `* ? |`, `.`, control characters). BehaviorTree.CPP rejects such a port in a
+        `<TreeNodesModel>` `<SubTree>` entry when it loads the XML, and never treats such a node
+        attribute as a port: `door.id="…"` is silently ignored, not passed to the node.
+        """,
+    why="""
+        A period reads like a member access (`request.name`) and cannot be remapped; the node
+        never gets the value it was given, with no error at run time.
+        """,
+    bad='<OpenDoor door.id="{door}"/>',
+    good='<OpenDoor door_id="{door}"/>',
+    since=_NAME_RULES_SINCE,
 )
 INSTANCE_NAME_CONTROL_CHAR: Final = define(
     "instance-name-control-char",
@@ -97,6 +280,19 @@ INSTANCE_NAME_CONTROL_CHAR: Final = define(
     "an instance name contains a control character",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        An instance name (`name="…"`) is an attribute value, so spaces, periods and any Unicode
+        are fine; only control characters other than tab, line feed and carriage return (ASCII
+        0-8, 11, 12, 14-31, 127) are rejected. BehaviorTree.CPP checks it when it creates the
+        tree: `Instance name 'start\\x07' contains invalid control character (ASCII 7)`.
+        """,
+    why="""
+        Tree creation fails. A control character is invisible in editors, logs and Groot2, and is
+        not allowed in XML 1.0 at all, so other XML tools refuse the file.
+        """,
+    bad='<Sequence name="start&#7;">',
+    good='<Sequence name="start">',
+    since=_NAME_RULES_SINCE,
 )
 
 
@@ -105,6 +301,7 @@ __all__ = [
     "FORBIDDEN",
     "POSTCONDITIONS",
     "PRECONDITIONS",
+    "PROJECT_NAME_CODES",
     "RESERVED_MODEL_NAMES",
     "RESERVED_PORT_NAMES",
     "RULES",
@@ -114,6 +311,7 @@ __all__ = [
     "check_name",
     "is_allowed_port_name",
     "may_hold_bad_instance_name",
+    "reserved_port_declaration",
 ]
 
 
@@ -251,7 +449,18 @@ _RULE_PORT_LEADING_DIGIT: Final = "A port name cannot start with a digit (0-9)."
 _RULE_PORT_RESERVED: Final = (
     "A port declared in <TreeNodesModel> cannot use a reserved attribute name: "
     + ", ".join(_RESERVED_PORT_ORDER)
-    + "."
+    + " (the name rules, as Groot2 applies them to every model entry)."
+)
+_RULE_PORT_RESERVED_BTCPP: Final = (
+    "A port of a <SubTree> model cannot be named after an attribute BehaviorTree.CPP "
+    "reserves: "
+    + ", ".join(n for n in _RESERVED_PORT_ORDER if n in BTCPP_RESERVED_ATTRIBUTES)
+    + " (BehaviorTree.CPP 4.8.4 and later throw when they load such a model)."
+)
+_RULE_PORT_GROOT1: Final = (
+    "Groot 1 declares __shared_blackboard, BehaviorTree.CPP 3's attribute of a <SubTree> "
+    "call, as a port of <SubTree> models; BehaviorTree.CPP 3 does not read them, Groot2 "
+    "reserves the name and BehaviorTree.CPP 4 shares a blackboard with _autoremap instead."
 )
 _RULE_PORT_FORBIDDEN: Final = f"A port name cannot contain {_FORBIDDEN_LIST}."
 _RULE_INSTANCE_CONTROL: Final = (
@@ -266,7 +475,8 @@ RULES: Final[dict[str, str]] = {
     "model-name-forbidden-char": _RULE_MODEL_FORBIDDEN,
     "port-name-empty": _RULE_PORT_EMPTY,
     "port-name-leading-digit": _RULE_PORT_LEADING_DIGIT,
-    "port-name-reserved": _RULE_PORT_RESERVED,
+    "port-name-reserved": _RULE_PORT_RESERVED_BTCPP,
+    "port-name-reserved-groot2": _RULE_PORT_RESERVED,
     "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
     "instance-name-control-char": _RULE_INSTANCE_CONTROL,
     # Where names are born (bt_lsp.rules.cpp_names).
@@ -287,9 +497,12 @@ RULES: Final[dict[str, str]] = {
 def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple[Violation, ...]:
     """Every rule ``name`` breaks as a ``kind`` of name; ``()`` when it is valid.
 
-    ``declaration`` is true for a port declared in ``<TreeNodesModel>``: only there is a
-    reserved attribute name (:data:`RESERVED_PORT_NAMES`) an error. Port violations come
-    in the order empty, leading digit, reserved, forbidden character.
+    ``declaration`` is true for a port declared in ``<TreeNodesModel>``: only there does a
+    reserved attribute name (:data:`RESERVED_PORT_NAMES`) break a rule, ``port-name-reserved``
+    for one BehaviorTree.CPP reserves, ``port-name-reserved-groot2`` for the two only the
+    name rules reserve. What a document reports for such a declaration depends on the
+    entry and the BehaviorTree.CPP version (:func:`reserved_port_declaration`). Port
+    violations come in the order empty, leading digit, reserved, forbidden character.
     """
     if kind is NameKind.MODEL:
         if not name:
@@ -329,7 +542,14 @@ def check_name(name: str, kind: NameKind, *, declaration: bool = False) -> tuple
                 f"Port name {_quote(name)} is a reserved attribute name and cannot be "
                 "declared as a port"
             )
-            found.append(Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED))
+            if name in BTCPP_RESERVED_ATTRIBUTES:
+                found.append(
+                    Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED_BTCPP)
+                )
+            else:
+                found.append(
+                    Violation("port-name-reserved-groot2", message, (), _RULE_PORT_RESERVED)
+                )
         if _FORBIDDEN_RE.search(name) is not None:
             found.append(
                 _char_violation(
@@ -391,6 +611,87 @@ def is_allowed_port_name(name: str) -> bool:
         and _FORBIDDEN_RE.search(name) is None
         and name not in BTCPP_RESERVED_ATTRIBUTES
     )
+
+
+# What each attribute BehaviorTree.CPP reserves is, for the messages.
+_RESERVED_MEANING: Final[dict[str, str]] = {
+    "ID": "`ID` names the tree a <SubTree> calls",
+    "name": "`name` is the instance name of every node",
+    "_autoremap": "`_autoremap` is an attribute of the <SubTree> call itself, not a port",
+    **{n: f"`{n}` is a precondition script of every node" for n in PRECONDITIONS},
+    **{n: f"`{n}` is a postcondition script of every node" for n in POSTCONDITIONS},
+}
+_BTCPP4_RESERVES = "it reserves only ID, name, _autoremap and the pre/post conditions"
+
+
+def reserved_port_declaration(name: str, entry: str, btcpp: str | None) -> Violation | None:
+    """What a document reports for a port declared as ``name`` in a ``<TreeNodesModel>``
+    entry ``<entry>`` when the name is reserved (:data:`RESERVED_PORT_NAMES`), else ``None``.
+
+    ``btcpp`` is the BehaviorTree.CPP major version the file is checked against: ``"3"``,
+    ``"4"``, or ``None`` when it is checked as 4 without a build or ``BTCPP_format``
+    saying so. BehaviorTree.CPP 3 reads no ``<TreeNodesModel>``; 4 reads only its
+    ``<SubTree>`` entries, and since 4.8.4 throws for a port named after an attribute it
+    reserves (``validatePortName``). So that is the one error (``port-name-reserved``);
+    ``__shared_blackboard`` in a ``<SubTree>`` model of a file not known to be for
+    version 4 is Groot 1's convention for version 3 (a hint, ``port-name-groot1``); every
+    other reserved name only the name rules (Groot2) reject (``port-name-reserved-groot2``).
+    """
+    if name not in RESERVED_PORT_NAMES:
+        return None
+    q = _quote(name)
+    subtree = entry == "SubTree"
+    if subtree and name == "__shared_blackboard" and btcpp != "4":
+        why = (
+            "this project builds against BehaviorTree.CPP 3"
+            if btcpp == "3"
+            else "no BTCPP_format or build says this file is for BehaviorTree.CPP 4"
+        )
+        message = (
+            f"Port {q} of a <SubTree> model is how Groot 1 writes BehaviorTree.CPP 3's "
+            f"__shared_blackboard attribute of a <SubTree> call ({why}); BehaviorTree.CPP 3 "
+            "does not read <TreeNodesModel>. Groot2's name rules reserve the name, and "
+            "BehaviorTree.CPP 4 ignores that attribute: it shares a blackboard with "
+            '_autoremap="true"'
+        )
+        return Violation("port-name-groot1", message, (), _RULE_PORT_GROOT1)
+    if subtree and btcpp != "3" and name in BTCPP_RESERVED_ATTRIBUTES:
+        message = (
+            f"Port name {q} is reserved by BehaviorTree.CPP: {_RESERVED_MEANING[name]}. "
+            "BehaviorTree.CPP 4.8.4 and later throw when they load this <SubTree> model "
+            f'("Port name {q} is a reserved attribute name"); 4.0 to 4.8.3 accepted it'
+        )
+        return Violation("port-name-reserved", message, (), _RULE_PORT_RESERVED_BTCPP)
+    start = f"Port name {q} is reserved by the name rules (Groot2 rejects it)"
+    if btcpp == "3":
+        message = (
+            f"{start}; BehaviorTree.CPP 3, which this project builds against, does not "
+            "read <TreeNodesModel>"
+        )
+        if subtree and name in BTCPP_RESERVED_ATTRIBUTES:
+            message += ", and BehaviorTree.CPP 4.8.4 and later throw when they load it"
+    elif not subtree:
+        message = (
+            f"{start}; BehaviorTree.CPP reads only the <SubTree> entries of "
+            "<TreeNodesModel>, but no C++ node can declare a port of that name "
+            "(BehaviorTree.CPP 4's CreatePort throws for it), so this entry describes a port "
+            "its node cannot have"
+        )
+    elif name == "__shared_blackboard":
+        message = (
+            f"{start}; BehaviorTree.CPP 4 accepts it in a <SubTree> model "
+            f"({_BTCPP4_RESERVES}) but ignores a __shared_blackboard attribute of a "
+            "<SubTree> call, BehaviorTree.CPP 3's way of sharing the blackboard: version 4 "
+            'shares it with _autoremap="true"'
+        )
+    else:
+        message = (
+            f"{start}; BehaviorTree.CPP 4 accepts it in a <SubTree> model "
+            f"({_BTCPP4_RESERVES}) but never passes a <SubTree> attribute of that name on "
+            "as a remapping (it does not start with a letter), so the port only takes its "
+            "default"
+        )
+    return Violation("port-name-reserved-groot2", message, (), _RULE_PORT_RESERVED)
 
 
 # --- helpers ------------------------------------------------------------------------------

@@ -24,7 +24,7 @@ from bt_lsp import __version__
 from bt_lsp.ide.name_targets import with_targets
 from bt_lsp.project.config import CONFIG_NAMES
 from bt_lsp.project.index import ProjectIndex
-from bt_lsp.project.settings import Settings
+from bt_lsp.project.settings import Settings, shown
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.registry import CODES
@@ -148,7 +148,8 @@ class BtServer(LanguageServer):
         """The diagnostics of ``doc`` (``od``'s document or a snapshot of it) after
         severity settings.  Sends nothing, so the worker thread may call it."""
         if not od.is_bt:
-            return self.cpp.diagnostics(od, doc)
+            found = self.cpp.diagnostics(od, doc)
+            return shown(found, self._settings_of(od).min_severity) if found else found
         with doc.history.lock:  # the caches it shares with the open document's snapshots
             if doc.utf8_size > self.settings.max_document_bytes:
                 result = size_limited(doc, self.settings.max_document_bytes)
@@ -156,8 +157,12 @@ class BtServer(LanguageServer):
                 result = self.project.diagnostics(od.path, doc)
             else:
                 result = with_targets(doc, analyze(doc))
-        settings = self.settings if od.path is None else self.project.settings_for(od.path)
-        return with_severities(result, settings.severity)
+        settings = self._settings_of(od)
+        return shown(with_severities(result, settings.severity), settings.min_severity)
+
+    def _settings_of(self, od: OpenDocument) -> Settings:
+        """The settings of an open document: its file's, or the editor's if it is none."""
+        return self.settings if od.path is None else self.project.settings_for(od.path)
 
     def diagnostics_computed(
         self, od: OpenDocument, key: tuple[int | None, int, int], result: list[Diagnostic]
@@ -209,7 +214,7 @@ class BtServer(LanguageServer):
         worker thread while ``od`` is prepared, published by the loop ahead of the
         complete set."""
         settings = self.settings if od.path is None else self.project.settings_for(od.path)
-        found = with_severities(found, settings.severity)
+        found = shown(with_severities(found, settings.severity), settings.min_severity)
         params = types.PublishDiagnosticsParams(
             uri=od.uri,
             diagnostics=[
@@ -482,11 +487,14 @@ def create_server() -> BtServer:
     @server.feature(types.WORKSPACE_DID_CHANGE_WATCHED_FILES)
     def did_change_watched_files(ls: BtServer, params: types.DidChangeWatchedFilesParams) -> None:
         project_files = False
-        for change in params.changes:
-            path = to_fs_path(change.uri)
-            if path:
-                ls.project.file_changed(path)
-                project_files = project_files or is_project_file(Path(path))
+        for change in params.changes:  # each alone: one that fails leaves the others
+            try:
+                path = to_fs_path(change.uri)
+                if path:
+                    ls.project.file_changed(path)
+                    project_files = project_files or is_project_file(Path(path))
+            except Exception:
+                ls.log_error(f"reading the change of {change.uri}")
         ls.refresh_all()
         if project_files:
             sync_config_diagnostics(ls)

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import asyncio
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Awaitable, Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -137,6 +137,22 @@ class Background:
         if self._aside is None:
             self._aside = ThreadPoolExecutor(max_workers=1, thread_name_prefix="bt-lsp-requests")
         return asyncio.get_running_loop().run_in_executor(self._aside, func, *args)
+
+    def beside(
+        self, func: Callable[..., R], *args: Any
+    ) -> tuple[Callable[..., Awaitable[R]], tuple[Any, ...], None]:
+        """What a generator handler yields to have ``func(*args)`` run :meth:`aside`
+        (pygls runs the yielded coroutine and sends its result back into the handler).
+
+        A coroutine handler runs only once the loop gets to its task, and the messages
+        read meanwhile (an edit sent right after the request, or held with it for a
+        document being prepared) are handled first: a snapshot taken there was of a
+        later version than the request's.  A generator handler runs at once, up to its
+        ``yield``, so its arguments here are taken when the request arrives."""
+        return self._aside_awaited, (func, *args), None
+
+    async def _aside_awaited(self, func: Callable[..., R], *args: Any) -> R:
+        return await self.aside(func, *args)
 
     # -- preparing a large document --------------------------------------------------------
 

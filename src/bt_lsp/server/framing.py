@@ -7,7 +7,8 @@ headers), lines may end in LF alone, and after a framing error the reader says w
 and resynchronises on the next ``Content-Length`` header.  A length above
 :data:`MAX_BODY` is refused without reading the body into memory.
 
-A body that is not one JSON value is answered as JSON-RPC asks (see
+A body that is not one JSON value (or one nested too deeply for the decoder, whose
+RecursionError ended the server) is answered as JSON-RPC asks (see
 :func:`bt_lsp.server.jsonrpc.check_message`); a length a few bytes off is recovered when
 the bytes around the body show where the message really ends.
 """
@@ -215,7 +216,7 @@ class Framer:
         try:
             text = pending[lead:].decode("utf-8")
             value, end = json.JSONDecoder().raw_decode(text)
-        except (ValueError, UnicodeDecodeError):
+        except (ValueError, UnicodeDecodeError, RecursionError):
             await self.stream.skip_to_header(0)
             return None
         self.stream.drop(lead + len(text[:end].encode("utf-8")))
@@ -228,6 +229,8 @@ class Framer:
             return Body(json.loads(raw))
         except (ValueError, UnicodeDecodeError):
             pass
+        except RecursionError:  # valid JSON, perhaps, but nested past Python's stack
+            return Body(error=f"JSON nested too deeply to be read: {shown(raw)}")
         if MARKER.match((raw[:64] + self.stream.peek(32)).lstrip()):
             # No body at all: the length ran into the next message's header (after a
             # repeated Content-Length, say), which is read as the next message.
@@ -238,7 +241,7 @@ class Framer:
         stripped = text.lstrip()
         try:
             value, end = json.JSONDecoder().raw_decode(stripped)
-        except ValueError:
+        except (ValueError, RecursionError):
             value, end = None, -1
         if end >= 0:
             # The body holds a whole value and then more: the length was too long, and
@@ -254,7 +257,7 @@ class Framer:
         tail = await self.stream.skip_to_header(MAX_HEADER_LINE)
         try:
             value = json.loads(raw + tail)
-        except (ValueError, UnicodeDecodeError):
+        except (ValueError, UnicodeDecodeError, RecursionError):
             self._framing_error(f"Content-Length {n} does not end a JSON value", raw + tail)
             return Body(error=f"invalid JSON: {shown(raw)}")
         self.log(f"bt-lsp: framing error: Content-Length {n} is {len(tail.rstrip())} bytes short")

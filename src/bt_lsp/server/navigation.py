@@ -10,10 +10,10 @@ import os
 import re
 import tempfile
 from bisect import bisect_right
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from itertools import repeat
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
@@ -291,41 +291,51 @@ class _Rendered:
     (``line``, ``column``) its section started at then, the encoding, and the custom
     node types' categories it shows: only the text is kept, neither the symbols nor
     pieces to fill in (they took a large outline's server to 32 times its document).
-    Where the section moved, its numbers are moved in the text (:meth:`at`)."""
+    Where the section moved, its numbers are moved in the text (:meth:`at`).
 
-    __slots__ = ("categories", "column", "enc", "line", "text")
+    The text and its position are one tuple, replaced in one assignment: a section is
+    shared by the open document and its snapshots, whose outlines may be written on two
+    threads at once, and a text moved from one position must never be kept with another."""
+
+    __slots__ = ("categories", "enc", "state")
 
     def __init__(
         self, text: str, line: int, column: int, enc: Encoding, categories: dict[str, str]
     ) -> None:
-        self.text, self.line, self.column = text, line, column
+        self.state = (text, line, column)
         self.enc, self.categories = enc, categories
+
+    @property
+    def text(self) -> str:
+        return self.state[0]
 
     def at(self, line: int, column: int) -> str:
         """The text for a section that now starts at (``line``, ``column``)."""
-        dl, dc = line - self.line, column - self.column
-        if dl or dc:
-            if dc:  # the columns on the section's first line move too
-                first = str(self.line)
+        text, line0, column0 = self.state
+        dl, dc = line - line0, column - column0
+        if not (dl or dc):
+            return text
+        if dc:  # the columns on the section's first line move too
+            first = str(line0)
 
-                def move(m: re.Match[str]) -> str:
-                    row, col = m[1], int(m[2])
-                    return _POSITION % (int(row) + dl, col + dc if row == first else col)
+            def move(m: re.Match[str]) -> str:
+                row, col = m[1], int(m[2])
+                return _POSITION % (int(row) + dl, col + dc if row == first else col)
 
-                self.text = _POSITIONS.sub(move, self.text)
-            else:
-                moved: dict[str, str] = {}  # a line's positions are written alike
+            text = _POSITIONS.sub(move, text)
+        else:
+            moved: dict[str, str] = {}  # a line's positions are written alike
 
-                def move_line(m: re.Match[str]) -> str:
-                    row = m[1]
-                    found = moved.get(row)
-                    if found is None:
-                        found = moved[row] = _LINE % (int(row) + dl)
-                    return found
+            def move_line(m: re.Match[str]) -> str:
+                row = m[1]
+                found = moved.get(row)
+                if found is None:
+                    found = moved[row] = _LINE % (int(row) + dl)
+                return found
 
-                self.text = _LINES.sub(move_line, self.text)
-            self.line, self.column = line, column
-        return self.text
+            text = _LINES.sub(move_line, text)
+        self.state = (text, line, column)
+        return text
 
 
 _POSITIONS = re.compile(r'"line": (\d+), "character": (\d+)')
@@ -540,15 +550,19 @@ def register(server: BtServer) -> None:
         return rename_edit(ls, od, plan.edits, dict(plan.other_edits), sources, what)
 
     @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
-    async def document_symbol(ls: BtServer, params: types.DocumentSymbolParams) -> RawJson | None:
+    def document_symbol(
+        ls: BtServer, params: types.DocumentSymbolParams
+    ) -> Generator[Any, Any, RawJson | None]:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
         ctx = context_of(ls, od)
         if not ls.background.wants(od):
             return outline_json(od.doc, ctx, ls.encoding)
-        # A large document's: beside the loop, which answers the other requests meanwhile.
-        return await ls.background.aside(outline_json, _snapshot(od), ctx, ls.encoding)
+        # A large document's: beside the loop, which answers the other requests meanwhile,
+        # from the document as the request found it (see Background.beside).
+        outline: RawJson = yield ls.background.beside(outline_json, _snapshot(od), ctx, ls.encoding)
+        return outline
 
     @server.feature(types.WORKSPACE_SYMBOL)
     def workspace_symbol(
@@ -573,7 +587,9 @@ def register(server: BtServer) -> None:
         return out
 
     @server.feature(types.TEXT_DOCUMENT_FOLDING_RANGE)
-    async def folding_range(ls: BtServer, params: types.FoldingRangeParams) -> RawJson | None:
+    def folding_range(
+        ls: BtServer, params: types.FoldingRangeParams
+    ) -> Generator[Any, Any, RawJson | None]:
         od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return None
@@ -581,7 +597,7 @@ def register(server: BtServer) -> None:
         if (kept is not None and kept[0] == od.version) or not ls.background.wants(od):
             return folding_json(od)
         version = od.version
-        text = await ls.background.aside(folding_text, _snapshot(od))
+        text: str = yield ls.background.beside(folding_text, _snapshot(od))
         if od.version == version:  # (else an edit came meanwhile: not the current ones)
             od.folding = (version, text)
         return RawJson(text)

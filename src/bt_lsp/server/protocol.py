@@ -13,18 +13,27 @@ import contextlib
 import inspect
 import json
 import os
+import reprlib
 import sys
 from collections.abc import Generator
-from typing import Any
+from typing import Any, cast
 
-from cattrs import ClassValidationError, transform_error
+from cattrs import ClassValidationError, Converter, IterableValidationError, transform_error
+from cattrs.v import format_exception
 from lsprotocol import types
+from lsprotocol.types import ResponseErrorMessage
 from pygls.exceptions import (
     JsonRpcException,
     JsonRpcInternalError,
     JsonRpcInvalidParams,
 )
-from pygls.protocol import LanguageServerProtocol, lsp_method
+from pygls.protocol import (
+    JsonRPCNotification,
+    JsonRPCRequestMessage,
+    JsonRPCResponseMessage,
+    LanguageServerProtocol,
+    lsp_method,
+)
 
 from bt_lsp.server import jsonrpc
 from bt_lsp.server.convert import RawJson
@@ -33,15 +42,85 @@ from bt_lsp.server.framing import Body
 REQUEST_CANCELLED = types.LSPErrorCodes.RequestCancelled.value
 
 
+def _json_type(value: object) -> str:
+    """The JSON name of a value's type, for a message about it."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, int | float):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    return "an array" if isinstance(value, list) else "an object"
+
+
+def _short(value: object) -> str:
+    """A short quotation of a value from a message (deep or long ones elided)."""
+    return reprlib.repr(value)
+
+
+def _structure_str(value: object, kind: type[str]) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"a string was expected, not {_json_type(value)}: {_short(value)}")
+    return value if kind is str else kind(value)  # a string enumeration checks its values
+
+
+def _structure_int(value: object, kind: type[int]) -> int:
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise TypeError(f"an integer was expected, not {_json_type(value)}: {_short(value)}")
+    return value if kind is int else kind(value)  # an IntEnum (FileChangeType) checks its values
+
+
+def _structure_bool(value: object, _: object) -> bool:
+    if not isinstance(value, bool):
+        raise TypeError(f"a boolean was expected, not {_json_type(value)}: {_short(value)}")
+    return value
+
+
+def strict(converter: Converter) -> Converter:
+    """``converter`` with strings, integers and booleans taken as they are only: cattrs
+    converts by calling the type, so ``"uri": 5`` became the URI ``"5"`` (a request
+    answered ``null``) and ``"line": "0"`` the line 0, where LSP asks for InvalidParams.
+    The hooks take the subclasses too (lsprotocol's enumerations derive from ``int`` or
+    ``str``), which are made by calling the enumeration, as before."""
+    converter.register_structure_hook(str, _structure_str)
+    converter.register_structure_hook(int, _structure_int)
+    converter.register_structure_hook(bool, _structure_bool)
+    return converter
+
+
+def _reason(exc: BaseException, kind: Any) -> str:
+    """One failure of a value, with the validator's own words (the range a version
+    must be in, the enumeration's values) where it has some."""
+    if isinstance(exc, TypeError | ValueError) and str(exc):
+        return str(exc)[:200]
+    return format_exception(exc, kind)
+
+
+def _why(exc: BaseException) -> str:
+    """What is wrong with a message's params, in one line."""
+    cause = exc.__cause__ if isinstance(exc, JsonRpcException) else exc
+    if isinstance(cause, ClassValidationError | IterableValidationError):
+        return "; ".join(transform_error(cause, format_exception=_reason))
+    return repr(cause)
+
+
 class BtProtocol(LanguageServerProtocol):
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
+    def __init__(self, server: Any, converter: Converter, *args: Any, **kwargs: Any) -> None:
+        super().__init__(server, strict(converter), *args, **kwargs)
         self._initialize_seen = False
         self._writes: set[asyncio.Future[Any]] = set()  # writes in flight (websockets)
 
     def receive(self, body: Body) -> None:
         """One message body from the framing: answered with the JSON-RPC error it
         deserves, or structured and handled.  Nothing here may end the read loop."""
+        try:
+            self._receive(body)
+        except Exception as exc:  # (a value nested deep enough to fail a repr, a bug)
+            self.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    def _receive(self, body: Body) -> None:
         if body.error is not None:
             self.log(f"bt-lsp: parse error: {body.error}")
             self._send_error(None, jsonrpc.PARSE_ERROR, f"Parse error: {body.error}")
@@ -52,15 +131,82 @@ class BtProtocol(LanguageServerProtocol):
             self.log(f"bt-lsp: invalid request: {why}")
             self._send_error(msg_id, jsonrpc.INVALID_REQUEST, f"Invalid request: {why}")
             return
+        value = self._screened(cast(dict[str, Any], body.value))
+        if value is None:
+            return
         try:
-            message = self.structure_message(body.value)  # type: ignore[arg-type]
-        except Exception as exc:  # a request among them is already answered (InvalidParams)
-            self._server._report_server_error(exc, JsonRpcException)
+            message = self.structure_message(value)
+        except Exception as exc:  # a request is already answered (InvalidParams)
+            self.refused(body.value, exc)
             return
         try:
             self.handle_message(message)
         except Exception as exc:  # a bug must not end the read loop
             self.log(f"bt-lsp: internal error handling a message: {exc!r}")
+
+    def _screened(self, data: dict[str, Any]) -> dict[str, Any] | None:
+        """The message with what would make it fail as a whole taken out: a watched-file
+        event of an unknown type (or shape) is left out of its batch, whose other events
+        are handled (one bad event dropped them all); a ``$/cancelRequest`` whose id is
+        neither a number nor a string is ignored.  Each is logged in one line; ``None``
+        when nothing is left to handle."""
+        method = data.get("method")
+        params = data.get("params")
+        if method == types.CANCEL_REQUEST and "id" not in data:
+            msg_id = params.get("id") if isinstance(params, dict) else None
+            if msg_id is None or not jsonrpc.valid_id(msg_id):
+                self.log(
+                    "bt-lsp: $/cancelRequest ignored: the id of the request to cancel must "
+                    f"be a number or a string, not {_json_type(msg_id)}"
+                )
+                return None
+            return data
+        if method != types.WORKSPACE_DID_CHANGE_WATCHED_FILES or "id" in data:
+            return data
+        if not isinstance(params, dict) or not isinstance(params.get("changes"), list):
+            return data  # refused as a whole (see refused)
+        changes: list[Any] = params["changes"]
+        kept: list[Any] = []
+        bad: list[str] = []
+        for k, event in enumerate(changes):
+            try:
+                self._converter.structure(event, types.FileEvent)
+            except Exception as exc:
+                bad.append(f"event {k} ({_short(event)}): {_why(exc)}")
+            else:
+                kept.append(event)
+        if bad:
+            self.log(
+                f"bt-lsp: workspace/didChangeWatchedFiles: {len(bad)} of {len(changes)} "
+                f"events ignored, the others handled: {'; '.join(bad[:3])}"
+                + (f"; and {len(bad) - 3} more" if len(bad) > 3 else "")
+            )
+            if not kept:
+                return None
+        return {**data, "params": {**params, "changes": kept}} if bad else data
+
+    def refused(self, data: Any, exc: BaseException) -> None:
+        """Say in one line of the client's log why a message whose params do not have
+        its method's shape was not handled (pygls printed cattrs's tracebacks on stderr,
+        and an editor shows those as a crash)."""
+        method = data.get("method") if isinstance(data, dict) else None
+        if method is None:
+            self.log(f"bt-lsp: a response that could not be read, ignored: {_why(exc)}")
+            return
+        if "id" in data:  # answered InvalidParams; this is the log line
+            self.log(f"bt-lsp: Invalid params for the request {method}: {_why(exc)}")
+            return
+        params = data.get("params")
+        doc = params.get("textDocument") if isinstance(params, dict) else None
+        uri = doc.get("uri") if isinstance(doc, dict) else None
+        if method == types.TEXT_DOCUMENT_DID_CHANGE and isinstance(uri, str):
+            self.log(
+                f"bt-lsp: Invalid params for textDocument/didChange of {uri}: {_why(exc)}; "
+                "the change is refused: the server's copy of the document stays as it was, "
+                "and no longer follows the editor's until the document is opened again"
+            )
+            return
+        self.log(f"bt-lsp: Invalid params for the notification {method}, ignored: {_why(exc)}")
 
     def log(self, message: str) -> None:
         self.notify(
@@ -146,26 +292,37 @@ class BtProtocol(LanguageServerProtocol):
         )
 
     def structure_message(self, data: dict[str, Any]) -> Any:
-        """A request whose params do not have its method's shape is answered with an
-        InvalidParams error; pygls only logs it, and the client would wait forever.  One
-        that the lifecycle refuses (:meth:`_refusal`) gets that error whatever its params."""
+        """The message as lsprotocol's type for its method.  A request whose params do not
+        have its method's shape is answered with an InvalidParams error (pygls only
+        logged it, and the client would wait forever); one that the lifecycle refuses
+        (:meth:`_refusal`) gets that error whatever its params.  Nothing is logged here
+        (pygls wrote a traceback to stderr): :meth:`refused` says why in one line."""
         try:
-            return super().structure_message(data)
-        except JsonRpcException as exc:
+            return self._structure(data)
+        except Exception as exc:
             if isinstance(data, dict) and "id" in data and "method" in data:
                 refusal = self._refusal(data["method"])
                 if refusal is not None:
                     self._send_error(data["id"], *refusal)
                     raise
-                cause = exc.__cause__
-                detail = (
-                    "; ".join(transform_error(cause))
-                    if isinstance(cause, ClassValidationError)
-                    else repr(cause)
-                )
-                error = JsonRpcInvalidParams(f"Invalid params for {data['method']}: {detail}")
+                error = JsonRpcInvalidParams(f"Invalid params for {data['method']}: {_why(exc)}")
                 self._send_response(data["id"], error=error.to_response_error())
             raise
+
+    def _structure(self, data: dict[str, Any]) -> Any:
+        """pygls's ``structure_message`` without its logging."""
+        if "jsonrpc" not in data:
+            return data
+        if "id" in data:
+            if "error" in data:
+                return self._converter.structure(data, ResponseErrorMessage)
+            if "method" in data:
+                kind = self.get_message_type(data["method"]) or JsonRPCRequestMessage
+                return self._converter.structure(data, kind)
+            kind = self._result_types.pop(data["id"], None) or JsonRPCResponseMessage
+            return self._converter.structure(data, kind)
+        kind = self.get_message_type(data.get("method", "")) or JsonRPCNotification
+        return self._converter.structure(data, kind)
 
     @lsp_method(types.EXIT)
     def lsp_exit(self, *args: Any) -> Generator[Any, Any, None]:

@@ -38,6 +38,10 @@ async def read_loop(
         if body is None:
             return
         protocol.receive(body)
+        # Let the tasks of coroutine handlers it started take their first step (read the
+        # document) before the next message, an edit sent right after, is handled: with
+        # that message already read, nothing above waits, and the edit came first.
+        await asyncio.sleep(0)
 
 
 def start_io(server: BtServer, stdin: BinaryIO | None, stdout: BinaryIO | None) -> None:

@@ -16,15 +16,17 @@ short lock, and kept only if no edit came in meanwhile.
 
 from __future__ import annotations
 
-import re
 import threading
 from typing import Any
 
 from bt_lsp.syntax.builder import build
 from bt_lsp.syntax.gcpause import gc_paused, with_gc_paused
+from bt_lsp.syntax.kind import HEAD_CHARS, bt_evidence_end, looks_like_bt
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
 from bt_lsp.syntax.text import LineIndex
+
+__all__ = ["Document", "History", "looks_like_bt"]
 
 
 class History:
@@ -147,16 +149,10 @@ class Document:
 
     def _kind_after(self, start: int, inserted: int) -> None:
         """:attr:`is_bt` after an edit at ``start`` that wrote ``inserted`` characters,
-        without searching the whole text (a document that is not BT XML would be, at
-        every keystroke): a marker before the edit stays the first; a text without one
-        gains one only around the edit."""
-        if self._is_bt and self._bt_end <= start:
-            return
-        if self._is_bt is False:
-            lo = max(0, start - _MARKER_REACH)
-            m = _BT_MARKERS.search(self.text, lo, start + inserted + _MARKER_REACH)
-            if m is not None:
-                self._is_bt, self._bt_end = True, m.end()
+        without looking at the text again when it cannot have changed: the decision reads
+        the head of the text only (an edit past it changes nothing), and evidence that
+        ends before the edit stays."""
+        if start >= HEAD_CHARS or (self._is_bt and self._bt_end <= start):
             return
         self._is_bt = None
 
@@ -193,10 +189,11 @@ class Document:
 
     @property
     def is_bt(self) -> bool:
-        """Whether the text :func:`looks_like_bt` (remembered until the next edit)."""
+        """Whether the text :func:`~bt_lsp.syntax.kind.looks_like_bt` (remembered until
+        an edit that may change it)."""
         if self._is_bt is None:
-            m = _BT_MARKERS.search(self.text)
-            self._is_bt, self._bt_end = m is not None, m.end() if m is not None else -1
+            end = bt_evidence_end(self.text)
+            self._is_bt, self._bt_end = end >= 0, end
         return self._is_bt
 
     @property
@@ -208,13 +205,3 @@ class Document:
                 len(text) if text.isascii() else len(text.encode("utf-8", "surrogatepass"))
             )
         return self._utf8_size
-
-
-_BT_MARKERS = re.compile(r"<(?:BehaviorTree|TreeNodesModel)[\s/>]|<root[\s/>]")
-_MARKER_REACH = len("<TreeNodesModel>")  # the longest match
-
-
-def looks_like_bt(text: str) -> bool:
-    """Whether a text is BT XML (a ``<root>``, ``<BehaviorTree>`` or ``<TreeNodesModel>``
-    element), so that other XML files (launch files, package.xml) get no diagnostics."""
-    return _BT_MARKERS.search(text) is not None

@@ -437,7 +437,9 @@ class ElementTable(Sequence[Element]):
     ) -> None:
         self._place = _placement(cols, origin, tok_origin, base)
         self._lo = lo
-        self._hi = len(cols.tags) if hi < 0 else hi
+        # Columns without a row 0 (a section or head with no root: the text before a
+        # ``<root>`` that a stray ``<!`` swallowed) have no rows from 1 on: empty, not -1.
+        self._hi = max(lo, len(cols.tags) if hi < 0 else hi)
         self._keep = keep
         self._items: list[Element] | None = None
 

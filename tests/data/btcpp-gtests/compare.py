@@ -61,6 +61,15 @@ def run_case(exe: str, folder: str, models: str | None = None) -> list[dict[str,
     return run_command(exe, folder, catalog_of(folder, models))
 
 
+def case_files(folder: str) -> list[str]:
+    """The XML files of a case that BehaviorTree.CPP is fed (all but its models.xml)."""
+    return sorted(
+        os.path.join(folder, f)
+        for f in os.listdir(folder)
+        if f.endswith(".xml") and f != "models.xml"
+    )
+
+
 def catalog_of(folder: str, models: str | None) -> str | None:
     """The catalog to give a case: its models.xml, else ``models`` (with ``--models``)."""
     catalog = os.path.join(folder, "models.xml")
@@ -71,7 +80,10 @@ def catalog_of(folder: str, models: str | None) -> str | None:
 
 def run_command(exe: str, folder: str, catalog: str | None) -> list[dict[str, Any]] | str:
     """``bt-lsp check folder --format json [--models catalog]`` in a process of its own."""
-    argv = [*shlex.split(exe), "check", folder, "--format", "json", "--no-progress"]
+    # Each file is named too: the test feeds it to BehaviorTree.CPP, which loads it as BT
+    # XML whatever it looks like (a walk of the folder would skip an empty file).
+    argv = [*shlex.split(exe), "check", folder, *case_files(folder), "--format", "json"]
+    argv.append("--no-progress")
     if catalog is not None:
         argv += ["--models", catalog]
     try:

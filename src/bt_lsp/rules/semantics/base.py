@@ -42,6 +42,7 @@ VERSION_4_RULES: Final[frozenset[str]] = frozenset(
         "reactive-async-children",
         "parallel-threshold",
         "blackboard-type-mismatch",
+        "port-name-reserved",
     }
 )
 

@@ -42,7 +42,35 @@ from bt_lsp.rules.semantics.base import State, quoted
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
 # The codes of these rules (see bt_lsp.rules.registry).
-ROOT_ELEMENT: Final = define("root-element", Severity.ERROR, "the top element is not `<root>`", BT)
+ROOT_ELEMENT: Final = define(
+    "root-element",
+    Severity.ERROR,
+    "the top element is not `<root>`",
+    BT,
+    doc="""
+        A BehaviorTree.CPP document's top element must be `<root>`: otherwise loading fails with
+        `The XML must have a root node called <root>`. `bt-lsp check` skips other XML it
+        recognizes when walking a folder (`package.xml`, launch files, URDF), but a file named on
+        the command line or opened as a tree is checked.
+        """,
+    why="""
+        The file does not load. Most often the tree was pasted without its `<root>` wrapper.
+        """,
+    bad="""
+        <?xml version="1.0" encoding="UTF-8"?>
+        <BehaviorTree ID="Main">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
+)
 MISSING_FORMAT: Final = define(
     "missing-format",
     Severity.WARNING,

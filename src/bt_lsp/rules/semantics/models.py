@@ -9,16 +9,30 @@
   but does not start with an ASCII letter (``_goal``, ``检查``, ``-x``): BehaviorTree.CPP
   accepts it in a ``<SubTree>`` model, but an attribute of that name is never passed as a
   remapping, and a C++ node cannot declare it at all.  Range: the name value.
+* A declared port name the name rules reserve (``port-name-reserved``,
+  ``port-name-reserved-groot2``, ``port-name-groot1``): what it is worth depends on the
+  entry and on the project's BehaviorTree.CPP version, which the document's own name rules
+  do not know (:func:`bt_lsp.rules.names.reserved_port_declaration`).  Range: the name
+  value, as the name rules' own (so that their rename fixes apply).
 """
 
 from __future__ import annotations
 
 from typing import Final
 
-from bt_lsp.rules.codes import BT, Severity, define
-from bt_lsp.rules.names import NameKind, check_name, is_allowed_port_name
+from bt_lsp.rules.codes import BT, NAMES, Severity, define, defined
+from bt_lsp.rules.context import Context
+from bt_lsp.rules.names import (
+    NameData,
+    NameKind,
+    Violation,
+    check_name,
+    is_allowed_port_name,
+    reserved_port_declaration,
+)
 from bt_lsp.rules.semantics.base import State, quoted
-from bt_lsp.syntax.elements import Element
+from bt_lsp.syntax.elements import Element, NameRef, Role
+from bt_lsp.syntax.model import Model
 
 # The codes of these rules (see bt_lsp.rules.registry).
 MISSING_PORT_NAME: Final = define(
@@ -49,13 +63,16 @@ def check_port_decl(st: State, el: Element) -> None:
             )
         return
     name = a.value
-    if (
-        name is None
-        or is_allowed_port_name(name)
-        or check_name(name, NameKind.PORT, declaration=True)
-    ):
+    if name is None or is_allowed_port_name(name) or check_name(name, NameKind.PORT):
         return
     s, e = el.span_of_value(a)
+    reserved = reserved_port_declaration(name, entry.name, btcpp_of(st))
+    if reserved is not None:
+        # A name-rule code carries what its rename fixes read; the hint has no fix.
+        named = defined(reserved.code).family == NAMES
+        data = NameData(name, NameKind.PORT, Role.PORT_DECL) if named else None
+        st.add(s, e, reserved.code, reserved.message, data=data)
+        return
     if entry.name == "SubTree":
         why = (
             "a <SubTree> attribute of that name is never passed on as a remapping, so the port "
@@ -69,3 +86,26 @@ def check_port_decl(st: State, el: Element) -> None:
         "port-name-not-remappable",
         f"Port name {quoted(name)} does not start with an ASCII letter; {why}",
     )
+
+
+def btcpp_of(st: State) -> str | None:
+    """The BehaviorTree.CPP major version the document is checked against: ``"3"`` or
+    ``"4"`` when its build or ``BTCPP_format`` says so, ``None`` when it is checked as 4
+    for want of either."""
+    return "3" if st.v3 else "4" if st.v4 else None
+
+
+def reserved_declaration_at(model: Model, ref: NameRef, ctx: Context | None) -> Violation | None:
+    """What :func:`check_port_decl` reports for the reserved name of the declared port
+    ``ref`` (``None`` if nothing), for hover, which has no check's state: the version is
+    read as :func:`bt_lsp.rules.semantics.document.check_root` reads it."""
+    if ref.role is not Role.PORT_DECL or ref.element < 0:
+        return None
+    el = model.elements[ref.element]
+    if el.parent < 0:
+        return None
+    root = model.root
+    declared = root is not None and root.attr("BTCPP_format") is not None
+    version = ctx.btcpp_version if ctx is not None else None
+    btcpp = "3" if version == "3" else "4" if declared or version == "4" else None
+    return reserved_port_declaration(ref.text, model.elements[el.parent].name, btcpp)

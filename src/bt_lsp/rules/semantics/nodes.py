@@ -91,9 +91,60 @@ UNKNOWN_NODE: Final = define(
         "subtree": "Call tree '{type}' with <SubTree>",
         "declare": "Declare '{type}' in <TreeNodesModel>",
     },
+    doc="""
+        Every node type must be registered with the factory (a built-in, or a custom node
+        registered in C++): BehaviorTree.CPP fails to load the XML with `Node not recognized:
+        MoveBse`. bt-lsp knows the built-ins, the node catalogs named in the configuration, the
+        nodes registered in the project's C++ and the `<TreeNodesModel>` entries. When it knows
+        every registration (a catalog, or all of the C++ read) an unknown type is an error;
+        otherwise a type one edit away from a known one is a warning (a typo), and any other a
+        hint, since it is most likely registered in C++ that bt-lsp did not see.
+        """,
+    why="""
+        The file does not load. A typo in a node type is the most common reason a tree that
+        looked right fails on the robot.
+        """,
+    bad="""
+        <RetryUntilSuccesful num_attempts="3"><Sleep msec="100"/></RetryUntilSuccesful>
+        """,
+    good="""
+        <RetryUntilSuccessful num_attempts="3"><Sleep msec="100"/></RetryUntilSuccessful>
+        """,
+    since="""
+        Every version; the built-ins are those of BehaviorTree.CPP 4.10 (3.8's for a 3.x
+        project: `SequenceStar`, `SubTreePlus` and the `RetryUntilSuccesful` spelling are 3.x
+        names).
+        """,
 )
 CHILD_COUNT: Final = define(
-    "child-count", Severity.ERROR, "a node with the wrong number of children", BT
+    "child-count",
+    Severity.ERROR,
+    "a node with the wrong number of children",
+    BT,
+    doc="""
+        Each kind of node takes a fixed number of children: a decorator exactly one, a control
+        node one or more, an action, a condition and a `<SubTree>` none; `TryCatch` two or more,
+        `IfThenElse` and `WhileDoElse` two or three, `SwitchN` N+1. BehaviorTree.CPP checks most
+        of these when it loads the XML (`The node 'Inverter' must have exactly 1 child`), the
+        last three when the node is ticked. A custom node declared in a `<TreeNodesModel>` follows
+        the rule of its category.
+        """,
+    why="The file does not load, or the node fails the first time it runs.",
+    bad="""
+        <Inverter>
+          <IsBatteryLow/>
+          <Charge/>
+        </Inverter>
+        """,
+    good="""
+        <Inverter>
+          <Sequence>
+            <IsBatteryLow/>
+            <Charge/>
+          </Sequence>
+        </Inverter>
+        """,
+    since="Every version (the node kinds of the detected version).",
 )
 REACTIVE_ASYNC_CHILDREN: Final = define(
     "reactive-async-children",

@@ -18,13 +18,17 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   hint when that model lists none.  Nothing is
   reported when the model is unknown, or for a ``<SubTree>`` call without a model.
   Range: the attribute name.
-* ``missing-required-port``: a port without a default that is not given.  Built-ins:
-  input and inout ports, an error (the node fails when it reads it).  Custom models: a
-  hint at most, since BehaviorTree.CPP never checks ports when it loads or creates a tree
-  and a node's code often reads a port without a default as optional (``getInput``
-  returning an error).  ``<SubTree>`` models: every port whose ``default`` is absent or
-  empty, an error unless ``_autoremap`` is true ("is defining a mandatory port … but you
-  are not remapping it").  Range: the element name.
+* ``missing-required-port`` (error): a port without a default that is not given, where
+  BehaviorTree.CPP fails for it.  Built-ins: input and inout ports (the node fails when it
+  reads it); the ``SwitchN`` ports are a warning (it reads them as optional).
+  ``<SubTree>`` models: every port whose ``default`` is absent or empty, unless
+  ``_autoremap`` is true ("is defining a mandatory port … but you are not remapping it").
+  Range: the element name.
+* ``missing-port-without-default`` (hint): a port of a custom node's model without a
+  default that is not given.  BehaviorTree.CPP never checks ports when it loads or
+  creates a tree, and a node's code often reads a port without a default as optional
+  (``getInput`` returning an error, Nav2's fallbacks to parameters).  Range: the element
+  name.
 * ``invalid-port-value``: a literal that does not convert to the declared type (values in
   ``{…}`` are blackboard references and never checked); an error for an exact model
   (BehaviorTree.CPP converts the literal at tree creation for a strongly typed port with
@@ -86,7 +90,8 @@ from bt_lsp.syntax.tokens import Attr
 
 @dataclass(frozen=True, slots=True)
 class MissingPorts(FixData):
-    """The ports ``missing-required-port`` found missing, in their declared order."""
+    """The ports ``missing-required-port`` or ``missing-port-without-default`` found
+    missing, in their declared order."""
 
     ports: tuple[str, ...]
 
@@ -108,23 +113,134 @@ class AttributeSuggestion(FixData):
 
 # The codes of these rules (see bt_lsp.rules.registry).
 UNDECLARED_PORT: Final = define(
-    "undeclared-port", Severity.ERROR, "an attribute the node's model does not declare", BT
+    "undeclared-port",
+    Severity.ERROR,
+    "an attribute the node's model does not declare",
+    BT,
+    doc="""
+        An attribute whose name is a valid port name is a port, and the node's type must declare
+        it in `providedPorts()`. BehaviorTree.CPP 4 throws when it creates the tree: `a port with
+        name [speed] is found in the XML (<MoveBase>, line 3) but not in the providedPorts() of
+        its registered node type`. bt-lsp knows a node's ports from the built-ins, a node
+        catalog (`models`), the project's C++ or a `<TreeNodesModel>`; against a catalog or the
+        C++ it is an error, against a tree file's own `<TreeNodesModel>` (which BehaviorTree.CPP
+        does not read for nodes) a hint. A `<SubTree>` call passes any attribute on as a
+        remapping, so there it is a warning at most.
+        """,
+    why="""
+        The tree is not created; most often the port is misspelt (`goal_pose` for `goal`), and
+        bt-lsp suggests the closest declared name.
+        """,
+    bad='<Sleep msec="500" duration="1"/>',
+    good='<Sleep msec="500"/>',
+    since="""
+        BehaviorTree.CPP 4 (3.x ignores an attribute that is not a declared port).
+        """,
 )
 MISSING_REQUIRED_PORT: Final = define(
     "missing-required-port",
     Severity.ERROR,
-    "a port without a default that is not given (a hint for custom nodes: "
-    "BehaviorTree.CPP does not check it)",
+    "a built-in's or a `<SubTree>` model's port without a default that is not given "
+    "(BehaviorTree.CPP fails)",
     BT,
+    doc="""
+        BehaviorTree.CPP does not check, when it loads or creates a tree, that a port without a
+        default is given. A built-in node reads it when it is ticked and fails then (`Missing
+        parameter [num_cycles] in RepeatNode`). For a `<SubTree>` whose model declares a port
+        without a default, creating the tree fails unless the call remaps it or sets
+        `_autoremap="true"`. Both are errors. (A custom node's port without a default is
+        `missing-port-without-default`, a hint.)
+        """,
+    why="""
+        The node fails on its first tick, on the robot, long after the tree loaded without
+        complaint.
+        """,
+    bad="<Repeat><AlwaysSuccess/></Repeat>",
+    good='<Repeat num_cycles="3"><AlwaysSuccess/></Repeat>',
+    since="""
+        Every version (the built-ins' ports are those of the detected version).
+        """,
+)
+MISSING_PORT_WITHOUT_DEFAULT: Final = define(
+    "missing-port-without-default",
+    Severity.HINT,
+    "a custom node's port without a default that is not given (BehaviorTree.CPP does not "
+    "check it; the node's code may read it as optional)",
+    BT,
+    doc="""
+        A custom node's model (its C++ `providedPorts()`, a catalog or a `<TreeNodesModel>`)
+        declares a port without a default, and the node is used without it. BehaviorTree.CPP
+        checks nothing here: the node's code decides, and code often reads such a port as
+        optional (`getInput` returns an error the node handles, as Nav2's nodes do), so this is
+        a hint. Silence it with `severity = { missing-port-without-default = "off" }` without
+        losing the built-ins' `missing-required-port` errors.
+        """,
+    why="""
+        When the node's code does need the port, the node fails at its first tick.
+        """,
+    since="""
+        Every version.
+        """,
 )
 INVALID_PORT_VALUE: Final = define(
-    "invalid-port-value", Severity.ERROR, "a literal that does not convert to the port's type", BT
+    "invalid-port-value",
+    Severity.ERROR,
+    "a literal that does not convert to the port's type",
+    BT,
+    doc="""
+        A literal value (not a `{blackboard}` reference) of a strongly typed port must convert to
+        the port's type. BehaviorTree.CPP 4 converts it when it creates the tree and throws: `The
+        port with name "msec" and value "abc" can not be converted to unsigned int`. bt-lsp
+        converts numbers, booleans, enums it knows and the built-in types as BehaviorTree.CPP's
+        `convertFromString` does: like `std::from_chars`, an integer only needs a leading number
+        (`"12abc"` reads as 12). Against a model from a tree file's `<TreeNodesModel>` it is a
+        warning.
+        """,
+    why="""
+        The tree is not created; a wrong unit or a typo in a number is caught before the robot runs.
+        """,
+    bad='<Sleep msec="half"/>',
+    good='<Sleep msec="500"/>',
+    since="""
+        BehaviorTree.CPP 4. Version 3 converts a literal only when the node reads the port, so
+        for a 3.x project it is a warning for a built-in and a hint for a custom node.
+        """,
 )
 BLACKBOARD_TYPE_MISMATCH: Final = define(
     "blackboard-type-mismatch",
     Severity.ERROR,
     "one blackboard key used by ports of different types",
     BT,
+    doc="""
+        Within one tree, a blackboard entry gets its type from the first port that uses it; a
+        port of another type using the same `{key}` makes BehaviorTree.CPP throw when it creates
+        the tree: `The creation of the tree failed because the port [count] was initially
+        created with type [int] and, later type [unsigned int] was used somewhere else`. A
+        `std::string` entry accepts anything, and two shared pointers of different classes are
+        accepted when the application registers a polymorphic cast (a hint then, since only
+        the C++ knows).
+        """,
+    why="""
+        The tree is not created; when it is (an untyped port in between), the node reading the
+        key gets a value it cannot use.
+        """,
+    bad="""
+        <Sequence>
+          <Repeat num_cycles="{count}">  <!-- num_cycles: int -->
+            <AlwaysSuccess/>
+          </Repeat>
+          <Sleep msec="{count}"/>        <!-- msec: unsigned int -->
+        </Sequence>
+        """,
+    good="""
+        <Sequence>
+          <Repeat num_cycles="{count}">
+            <AlwaysSuccess/>
+          </Repeat>
+          <Sleep msec="{wait_ms}"/>
+        </Sequence>
+        """,
+    since="BehaviorTree.CPP 4 (and 3.8, whose ports are typed the same way).",
 )
 PORT_NAME_NOT_REMAPPABLE: Final = define(
     "port-name-not-remappable",
@@ -359,7 +475,7 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         # node really declares is not known, so this is a hint.
         message += (
             "; BehaviorTree.CPP rejects it unless the C++ node declares it (its port list "
-            "could not all be read statically)"
+            "could not all be read statically: the hover on the node says what was not)"
             if res.where
             else "; BehaviorTree.CPP rejects it only if the C++ node does not declare it "
             "(BehaviorTree.CPP reads the C++ registration, not this model)"
@@ -411,7 +527,15 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
             "check ports when it loads or creates the tree, and a port without a default may "
             "be optional in the node's code"
         )
-        severity = Severity.HINT
+        st.add(
+            el.name_start,
+            el.name_end,
+            "missing-port-without-default",
+            message,
+            None,
+            MissingPorts(tuple(missing)),
+        )
+        return
     st.add(
         el.name_start,
         el.name_end,

@@ -24,7 +24,26 @@ from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.values import raw_span
 
 # The codes of these rules (see bt_lsp.rules.registry).
-SCRIPT_SYNTAX: Final = define("script-syntax", Severity.ERROR, "a script that does not parse", BT)
+SCRIPT_SYNTAX: Final = define(
+    "script-syntax",
+    Severity.ERROR,
+    "a script that does not parse",
+    BT,
+    doc="""
+        Scripts (`code` of `Script` and `ScriptCondition`, `if` of `Precondition`, and the
+        `_skipIf` … `_post` attributes of any node) are parsed when the tree is created; a syntax
+        error throws: `Error in the script "x == "` followed by the parser's message (`Expected
+        operand at position 5`). bt-lsp parses them as BehaviorTree.CPP 4.10 does; what only the
+        4.0-4.9 parser accepted (double-quoted strings, non-ASCII identifiers) is a warning.
+        Remember that XML needs `&amp;&amp;` for `&&` and `&lt;` for `<`.
+        """,
+    why="""
+        The tree is not created, or a 4.9 tree stops loading after an upgrade to 4.10.
+        """,
+    bad='<Script code="count = = 1"/>',
+    good='<Script code="count := 1"/>',
+    since="BehaviorTree.CPP 4 (3.x has no scripts).",
+)
 
 
 @lru_cache(maxsize=16384)

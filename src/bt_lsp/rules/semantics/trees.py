@@ -5,10 +5,13 @@
   empty ``ID=""`` is reported by the name rule ``model-name-empty``.)
 * ``tree-child-count`` (error): a ``<BehaviorTree>`` without exactly one child element.
   Range: ``BehaviorTree``.
-* ``registered-name-as-tree-id``: a ``<BehaviorTree ID>`` or ``<SubTree ID>`` that is the
-  name of a built-in node or of a node in an authoritative catalog (error: BehaviorTree.CPP
-  refuses it when it loads the file) or of a node only an advisory ``<TreeNodesModel>``
-  declares (warning: refused if that node is registered).  Range: the value.
+* ``registered-name-as-tree-id``: a ``<BehaviorTree ID>``, or a ``<SubTree ID>`` naming a
+  tree that exists, that is the name of a built-in node or of a node in an authoritative
+  catalog (error: BehaviorTree.CPP refuses it when it loads the file) or of a node only an
+  advisory ``<TreeNodesModel>`` declares (warning: refused if that node is registered).
+  A ``<SubTree ID>`` naming no tree is ``unknown-subtree`` whatever a catalog declares, so
+  that a file gets the same diagnostic whether the catalog is in the workspace or not.
+  Range: the value.
 * ``duplicate-tree-id`` (warning): a tree ID defined again, in this document or in a
   document of its include closure (BehaviorTree.CPP silently keeps the last one loaded).
   Range: the ID value of every definition in this document except the first one of it.
@@ -58,7 +61,37 @@ TREE_CHILD_COUNT: Final = define(
     BT,
 )
 UNKNOWN_SUBTREE: Final = define(
-    "unknown-subtree", Severity.ERROR, "a `<SubTree ID>` that names no tree", BT
+    "unknown-subtree",
+    Severity.ERROR,
+    "a `<SubTree ID>` that names no tree",
+    BT,
+    doc="""
+        `<SubTree ID="X">` calls the tree `X`, which must be loaded by the time the tree is
+        created: otherwise BehaviorTree.CPP throws `Can't find a tree with name: X`. bt-lsp looks
+        in the document, the files it includes and the other BehaviorTree.CPP files of the
+        workspace; a tree defined in a file that is not included is a hint (the application must
+        register that file too).
+        """,
+    why="""
+        The tree is not created; a renamed or misspelt tree ID breaks every call to it.
+        """,
+    bad="""
+        <BehaviorTree ID="Main">
+          <SubTree ID="Dokc"/>
+        </BehaviorTree>
+        <BehaviorTree ID="Dock">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="Main">
+          <SubTree ID="Dock"/>
+        </BehaviorTree>
+        <BehaviorTree ID="Dock">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    since="Every version.",
 )
 UNKNOWN_MAIN_TREE: Final = define(
     "unknown-main-tree", Severity.ERROR, "`main_tree_to_execute` names no tree", BT
@@ -198,11 +231,13 @@ def check_call(st: State, el: Element, scope: TreeScope) -> None:
         )
     elif a.value:
         s, e = el.span_of_value(a)
-        if not _registered_name(st, "SubTree", a.value, s, e) and not (
-            a.value not in st.ctx.trees
-            and a.value not in st.ctx.workspace_trees
-            and check_name(a.value, NameKind.MODEL)
-        ):  # an ID that breaks a name rule is one problem: the name rules report it
+        if a.value in st.ctx.trees or a.value in st.ctx.workspace_trees:
+            # A tree that exists: its ID must not be a registered node's name.
+            if not _registered_name(st, "SubTree", a.value, s, e):
+                _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
+        elif not check_name(a.value, NameKind.MODEL):
+            # No such tree, whatever a catalog says of the name (an ID that breaks a name
+            # rule is one problem: the name rules report it).
             _unknown_tree(st, a.value, s, e, "unknown-subtree", "<SubTree> calls")
     name = el.attr("name")
     if name is not None and name.value is not None:

@@ -41,6 +41,13 @@ public:
   static BT::PortsList providedPorts() { return {}; }
 };
 
+// Another class under the same ID: which one a program registers is not known.
+class OtherTwin : public BT::SyncActionNode
+{
+public:
+  static BT::PortsList providedPorts() { return {}; }
+};
+
 template <class T>
 void registerLater(BT::BehaviorTreeFactory& factory, const std::string& name)
 {
@@ -54,6 +61,23 @@ BT_REGISTER_NODES(factory)
   factory.registerNodeType<Built>("Built");
   factory.registerNodeType<Spin>("Spin");
   factory.registerNodeType<Twin>("Twin");
-  factory.registerNodeType<Twin>("Twin");
+  factory.registerNodeType<OtherTwin>("Twin");
   factory.registerNodeType<Missing>("Missing");
+  registerLater<Wait>(factory, computed_name);
+}
+
+// A helper that merges port lists with a loop: its result is not read, the lists given
+// to it are kept (the list stays incomplete).
+class Merged : public BT::SyncActionNode
+{
+public:
+  static BT::PortsList providedPorts()
+  {
+    return appendPorts(Wait::providedPorts(), { BT::InputPort<int>("goal_x") });
+  }
+};
+
+void registerMore(BT::BehaviorTreeFactory& factory)
+{
+  factory.registerNodeType<Merged>("Merged");
 }
