@@ -434,7 +434,7 @@ CASES: list[tuple[str, str, Expected]] = [
         '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree><TreeNodesModel>'
         '<SubTree ID="Sub"><input_port name="⟦__shared_blackboard⟧" default="true"/>'
         "</SubTree></TreeNodesModel></root>",
-        [("missing-format", W), ("unknown-attribute", W), ("port-name-groot1", H)],
+        [("missing-format", H), ("unknown-attribute", W), ("port-name-groot1", H)],
     ),
     ("hyphenated undeclared port", T('<Sleep msec="10" ⟦foo-bar⟧="1"/>'), [("undeclared-port", E)]),
     (
