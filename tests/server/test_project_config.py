@@ -78,6 +78,8 @@ async def test_broken_config_is_one_diagnostic_on_it_then_fixed(
 ) -> None:
     config = tmp_path / "bt-lsp.toml"
     config.write_text('btcpp = "4"\n[severity]\nmissing-format = "eror"\n', encoding="utf-8")
+    # The build says version 4, so the format advice is a warning without the configuration.
+    (tmp_path / "CMakeLists.txt").write_text("find_package(behaviortree_cpp)\n", encoding="utf-8")
     doc = open_file(client, tmp_path / "tree.xml", TREE)
     [d] = await config_diagnostics(client, uri_of(config), 1)
     assert d.code == "config-error"
@@ -100,6 +102,7 @@ async def test_syntax_error_position_and_edits_of_the_open_file(
 ) -> None:
     config = tmp_path / "bt-lsp.toml"
     config.write_text("[severity]\n", encoding="utf-8")
+    (tmp_path / "CMakeLists.txt").write_text("find_package(behaviortree_cpp)\n", encoding="utf-8")
     doc = open_file(client, tmp_path / "tree.xml", TREE)
     await severity_of(client, doc, "missing-format", types.DiagnosticSeverity.Warning)
     cfg_uri = open_file(client, config, "[severity]\n", language="toml")

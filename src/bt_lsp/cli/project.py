@@ -169,7 +169,9 @@ def version_lines(workspace: ProjectIndex, files: Sequence[str]) -> list[str]:
     counts: Counter[tuple[str, str]] = Counter()
     for f in files:
         found = workspace.btcpp_for(normalize(f))
-        if found.version is None:
+        if found.conflict:
+            counts["version unclear", f"{found.source}; checked as version 4"] += 1
+        elif found.version is None:
             counts["4", "not detected; checked as version 4"] += 1
         else:
             counts[found.version, found.source] += 1

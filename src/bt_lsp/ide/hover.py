@@ -375,14 +375,30 @@ def _raw_offset(doc: Document, ref: NameRef, index: int) -> int:
 
 
 def root_hover(
-    doc: Document, offset: int, version: str | None, source: str, markdown: bool = True
+    doc: Document,
+    offset: int,
+    version: str | None,
+    source: str,
+    markdown: bool = True,
+    unclear: bool = False,
 ) -> HoverText | None:
     """On the ``root`` of ``<root>``: the BehaviorTree.CPP version the document is checked
-    against and where that was read (``source``), so that a wrong guess is visible."""
+    against and where that was read (``source``), so that a wrong guess is visible;
+    ``unclear``: the project's build names both versions (``source`` says where)."""
     root = doc.model.root
     if root is None or root.name != "root" or not root.name_start <= offset <= root.name_end:
         return None
-    if version is None:
+    if version is None and unclear:
+        lines = [
+            "**BehaviorTree.CPP version: unclear**",
+            "",
+            f"The build names both versions: {source}.",
+            "",
+            "Checked as BehaviorTree.CPP 4, with what depends on the version a warning at "
+            "most. Set `btcpp` in `bt-lsp.toml` to say which version the project builds "
+            "against.",
+        ]
+    elif version is None:
         lines = [
             "**BehaviorTree.CPP version: not detected**",
             "",

@@ -380,7 +380,10 @@ class CppModels:
         dependencies that are not in the workspace).
 
         A node read completely (authoritative) wins over a ``<TreeNodesModel>``
-        declaration of the same ID; one with flags only fills a gap.
+        declaration of the same ID; one with flags only fills a gap.  The catalog a
+        workspace package ships is what its author wrote next to the C++ that is read
+        here: for a node that C++ does not register where it was read, it is advisory (a
+        hand-kept catalog may lag behind the code BehaviorTree.CPP registers).
         """
         files = self.files_for(path, settings.sources, settings.exclude)
         if self.mode == "sync":
@@ -392,11 +395,18 @@ class CppModels:
         if cat is None:
             return ctx
         known = self.completeness(path, files, cat, resolve)
+        own = self._catalogs_with_cpp(ctx, files)
+        merged = dict(ctx.models)
+        _demote_own_catalogs(merged, own, cat)
         if not cat.nodes and not known.complete:
-            return ctx  # no C++ nodes: the messages need not say what was not read
+            # No C++ nodes: the messages need not say what was not read.
+            if not own:
+                return ctx
+            return replace(
+                ctx, models=MappingProxyType(merged), sources=(*ctx.sources, ("cpp", own))
+            )
         builtins = builtins_for(ctx.btcpp_version)
         decls = self.decls(cat, ctx.btcpp_version)
-        merged = dict(ctx.models)
         for id_, d in decls.items():
             if id_ not in merged:
                 merged[id_] = d
@@ -416,6 +426,16 @@ class CppModels:
             incomplete=known.why,
             sources=(*ctx.sources, ("cpp", id(decls), known)),
         )
+
+    def _catalogs_with_cpp(self, ctx: Context, files: tuple[Path, ...]) -> frozenset[str]:
+        """The shipped ROS catalogs among ``ctx``'s models whose package's C++ is among
+        ``files`` (a workspace package, not an installed one)."""
+        out: set[str] = set()
+        for p in {d.path for d in ctx.models.values() if d.source == "ros" and d.path}:
+            m = self.packages.package_of(Path(p).parent)
+            if m is not None and any(_under(f, m.folder) for f in files):
+                out.add(p)
+        return frozenset(out)
 
     def completeness(
         self, path: Path, files: tuple[Path, ...], cat: Catalog, resolve: Resolve | None = None
@@ -647,6 +667,19 @@ def _under(f: Path, folder: Path) -> bool:
     except ValueError:
         return False
     return True
+
+
+def _demote_own_catalogs(
+    models: dict[str, ModelDecl], catalogs: frozenset[str], cat: Catalog
+) -> None:
+    """Make the models of ``catalogs`` (shipped by packages whose C++ was read) advisory
+    for the nodes the C++ read does not register: what BehaviorTree.CPP registers is that
+    C++, in a form or a place not read, and the catalog may not match it."""
+    if not catalogs:
+        return
+    for id_, d in models.items():
+        if d.source == "ros" and d.path in catalogs and id_ not in cat.by_id:
+            models[id_] = d._replace(source="ros-workspace")
 
 
 def _glob(patterns: Iterable[str]) -> list[Path]:

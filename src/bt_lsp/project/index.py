@@ -295,13 +295,15 @@ class ProjectIndex:
 
     def btcpp_for(self, path: Path, doc: Document | None = None) -> Detected:
         """The BehaviorTree.CPP major version the file at ``path`` is built for: the
-        ``btcpp`` setting if not ``auto``, else its package's ``package.xml`` or
-        ``CMakeLists.txt``, else the document's ``BTCPP_format``."""
+        ``btcpp`` setting if not ``auto``, else what its package's build uses
+        (``CMakeLists.txt`` and C++ includes, then ``package.xml``: see
+        :meth:`Packages.package_btcpp`; unclear when they name both versions), else its
+        dependencies' ``package.xml``, else the document's ``BTCPP_format``."""
         chosen = self.settings_for(path).btcpp
         if chosen in ("3", "4"):
             return Detected(chosen, "the btcpp setting")
         found = self.packages.btcpp_of(path.parent)
-        if found.version is not None:
+        if found.version is not None or found.conflict:
             return found
         # A package that does not name BehaviorTree.CPP builds against the version of the
         # packages it depends on (a tutorial package over its library package).
@@ -496,6 +498,7 @@ class ProjectIndex:
                 foreign.add(str(p))
             if any(inc.target == path for inc in self.includes(p, d)):
                 included_by.append(str(p))
+        detected = self.btcpp_for(path, doc)
         ctx = Context.combine(
             doc,
             others,
@@ -504,8 +507,9 @@ class ProjectIndex:
             model_files=model_files,
             ros_models=ros_models,
             included_by=included_by,
-            btcpp_version=self.btcpp_for(path, doc).version,
+            btcpp_version=detected.version,
             foreign=foreign,
+            btcpp_unclear=detected.conflict,
         )
         if self.cpp is not None:
             ctx = self.cpp.context_with_models(

@@ -1,8 +1,16 @@
-"""ROS package manifests (``package.xml``) and CMake files, read for what bt-lsp needs:
-a package's name, what it depends on, and which BehaviorTree.CPP it builds against.
+"""ROS package manifests (``package.xml``), CMake files and C++ includes, read for what
+bt-lsp needs: a package's name, what it depends on, and which BehaviorTree.CPP it builds
+against.
 
 Manifests are parsed with lxml without entities, DTDs or network access, and bounded in
 size; a manifest that cannot be read or parsed counts as a package without dependencies.
+
+Which BehaviorTree.CPP a package builds against is read from what its build really uses
+first: its ``CMakeLists.txt`` (``find_package``) and the ``#include`` lines of its C++
+(``<behaviortree_cpp_v3/…>`` or ``<behaviortree_cpp/…>``), which beat a ``package.xml``
+dependency left over from a migration; the ``package.xml`` decides when the build says
+nothing.  When the build names both versions, the version is unclear: no guess is made
+(:attr:`Detected.conflict`).
 """
 
 from __future__ import annotations
@@ -22,6 +30,8 @@ __all__ = [
     "Manifest",
     "Packages",
     "cmake_btcpp",
+    "cmake_versions",
+    "cpp_includes",
     "read_manifest",
 ]
 
@@ -52,6 +62,15 @@ _FIND_PACKAGE: Final = re.compile(
     r"find_package\s*\(\s*(behaviortree_cpp_v3|behaviortree_cpp)\b", re.IGNORECASE
 )
 _CMAKE_COMMENT: Final = re.compile(r"#[^\n]*")
+# An #include of a BehaviorTree.CPP header, at the start of a line (a // comment is not).
+_INCLUDE: Final = re.compile(
+    rb"^[ \t]*#[ \t]*include[ \t]*[<\"](behaviortree_cpp_v3|behaviortree_cpp)/", re.MULTILINE
+)
+_CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp"})
+_SKIP_DIRS: Final = frozenset({"build", "install", "log", "node_modules", "__pycache__"})
+# Bounds of the include scan of one package: includes sit at the top of a file.
+MAX_INCLUDE_FILES: Final = 5000
+MAX_INCLUDE_BYTES: Final = 64 * 1024
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,14 +126,53 @@ def read_manifest(path: Path) -> Manifest | None:
     return Manifest(name or folder.name, folder, frozenset(depends))
 
 
-def cmake_btcpp(path: Path) -> str | None:
-    """The BehaviorTree.CPP version a ``CMakeLists.txt`` finds with ``find_package``."""
+def cmake_versions(path: Path) -> frozenset[str]:
+    """The BehaviorTree.CPP versions a ``CMakeLists.txt`` finds with ``find_package``."""
     data = _read_bytes(path, MAX_MANIFEST_BYTES)
     if data is None:
-        return None
+        return frozenset()
     text = _CMAKE_COMMENT.sub("", data.decode("utf-8", "replace"))
-    found = {BTCPP_PACKAGES[m.group(1).lower()] for m in _FIND_PACKAGE.finditer(text)}
+    return frozenset(BTCPP_PACKAGES[m.group(1).lower()] for m in _FIND_PACKAGE.finditer(text))
+
+
+def cmake_btcpp(path: Path) -> str | None:
+    """The BehaviorTree.CPP version a ``CMakeLists.txt`` finds with ``find_package`` (both:
+    4)."""
+    found = cmake_versions(path)
     return max(found) if found else None
+
+
+def cpp_includes(folder: Path) -> dict[str, Path]:
+    """The BehaviorTree.CPP versions whose headers the C++ of the package at ``folder``
+    includes, each with the first file that does (in sorted order; build folders, hidden
+    folders and nested packages are skipped, and the scan is bounded)."""
+    found: dict[str, Path] = {}
+    seen = 0
+    for dirpath, dirnames, filenames in os.walk(folder):
+        here = Path(dirpath)
+        dirnames[:] = sorted(
+            d
+            for d in dirnames
+            if d not in _SKIP_DIRS
+            and not d.startswith(".")
+            and not is_file(here / d / "package.xml")
+        )
+        for name in sorted(filenames):
+            if os.path.splitext(name)[1] not in _CPP_SUFFIXES:
+                continue
+            seen += 1
+            if seen > MAX_INCLUDE_FILES:
+                return found
+            try:
+                with open(here / name, "rb") as f:
+                    data = f.read(MAX_INCLUDE_BYTES)
+            except OSError:
+                continue
+            for m in _INCLUDE.finditer(data):
+                found.setdefault(BTCPP_PACKAGES[m.group(1).decode()], here / name)
+            if len(found) == len(BTCPP_PACKAGES):
+                return found
+    return found
 
 
 def is_file(path: Path) -> bool:
@@ -129,10 +187,13 @@ MAX_DEPTH: Final = 64
 
 @dataclass(frozen=True, slots=True)
 class Detected:
-    """A BehaviorTree.CPP major version and what it was read from, for the user."""
+    """A BehaviorTree.CPP major version and what it was read from, for the user.
+    ``conflict``: the build names both versions, so the version is unclear (``version``
+    is ``None`` and ``source`` says what disagrees)."""
 
     version: str | None
     source: str
+    conflict: bool = False
 
 
 NOT_DETECTED: Final = Detected(None, "not detected")
@@ -146,6 +207,7 @@ class Packages:
         self._package: dict[Path, Manifest | None] = {}
         self._version: dict[Path, Detected] = {}
         self._manifests: dict[Path, Manifest | None] = {}
+        self._includes: dict[Path, dict[str, Path]] = {}
 
     def manifest(self, path: Path) -> Manifest | None:
         if path not in self._manifests:
@@ -170,27 +232,20 @@ class Packages:
         return found
 
     def btcpp_of(self, folder: Path) -> Detected:
-        """The version the build of ``folder`` uses: its package's ``package.xml``
-        dependency, else that package's ``CMakeLists.txt``; outside a package, the nearest
-        ``CMakeLists.txt`` above that finds BehaviorTree.CPP."""
+        """The version the build of ``folder`` uses: its package's (see
+        :meth:`package_btcpp`); outside a package, the nearest ``CMakeLists.txt`` above
+        that finds BehaviorTree.CPP."""
         if folder in self._version:
             return self._version[folder]
         found = NOT_DETECTED
         f = folder
         for _ in range(MAX_DEPTH):
-            manifest_path = f / "package.xml"
-            cmake = f / "CMakeLists.txt"
-            if is_file(manifest_path):
-                m = self.manifest(manifest_path)
-                if m is not None and m.btcpp is not None:
-                    found = Detected(
-                        m.btcpp, f"{manifest_path} depends on {_package_name(m.btcpp)}"
-                    )
-                elif is_file(cmake) and (v := cmake_btcpp(cmake)) is not None:
-                    found = Detected(v, f"{cmake} finds {_package_name(v)}")
+            if is_file(f / "package.xml"):
+                found = self.package_btcpp(f)
                 break  # a package's own files decide, never a folder above it
-            if is_file(cmake) and (v := cmake_btcpp(cmake)) is not None:
-                found = Detected(v, f"{cmake} finds {_package_name(v)}")
+            cmake = f / "CMakeLists.txt"
+            if is_file(cmake) and (versions := cmake_versions(cmake)):
+                found = _decide({v: [f"{cmake} finds {_package_name(v)}"] for v in versions})
                 break
             if f.parent == f:
                 break
@@ -198,15 +253,64 @@ class Packages:
         self._version[folder] = found
         return found
 
+    def package_btcpp(self, folder: Path) -> Detected:
+        """The version the package at ``folder`` builds against.  What the build uses
+        decides: the ``find_package`` of its ``CMakeLists.txt`` and the BehaviorTree.CPP
+        headers its C++ includes; when they name one version, that one (a ``package.xml``
+        that says otherwise is out of date), when both, the version is unclear.  Else its
+        ``package.xml`` dependency."""
+        build: dict[str, list[str]] = {}
+        cmake = folder / "CMakeLists.txt"
+        if is_file(cmake):
+            for v in sorted(cmake_versions(cmake)):
+                build.setdefault(v, []).append(f"{cmake} finds {_package_name(v)}")
+        if folder not in self._includes:
+            self._includes[folder] = cpp_includes(folder)
+        for v, path in sorted(self._includes[folder].items()):
+            build.setdefault(v, []).append(f"{path} includes <{_package_name(v)}/…>")
+        manifest_path = folder / "package.xml"
+        m = self.manifest(manifest_path)
+        said = m.btcpp if m is not None else None
+        if build:
+            found = _decide(build)
+            if found.version is not None and said is not None and said != found.version:
+                found = Detected(
+                    found.version,
+                    f"{found.source}; the dependency on {_package_name(said)} in "
+                    f"{manifest_path} is not what the build uses",
+                )
+            return found
+        if said is not None:
+            return Detected(said, f"{manifest_path} depends on {_package_name(said)}")
+        return NOT_DETECTED
+
     def changed(self, path: Path) -> bool:
         """``path`` changed on disk: true (and the caches cleared) if it is a manifest or
-        a CMake file."""
+        a CMake file.  A C++ file may include other headers now: the versions are read
+        again (false: nothing else depends on it)."""
+        if path.suffix in _CPP_SUFFIXES:
+            self._includes.clear()
+            self._version.clear()
+            return False
         if path.name not in ("package.xml", "CMakeLists.txt"):
             return False
         self._package.clear()
         self._version.clear()
         self._manifests.clear()
+        self._includes.clear()
         return True
+
+
+def _decide(build: dict[str, list[str]]) -> Detected:
+    """The version the build evidence names (``build``: version -> what says so), or,
+    when it names both, a conflict that says which file says what."""
+    if len(build) == 1:
+        ((version, why),) = build.items()
+        return Detected(version, " and ".join(why))
+    said = "; ".join(
+        f"{' and '.join(why)} (BehaviorTree.CPP {v})" for v, why in sorted(build.items())
+    )
+    return Detected(None, said, conflict=True)
 
 
 def _package_name(version: str) -> str:

@@ -74,7 +74,9 @@ class Context:
     * ``path``: this document's path; declarations with this path are its own.
     * ``btcpp_version``: the BehaviorTree.CPP major version the document is built for,
       ``"3"`` or ``"4"``, as the project layer detected or configured it (``None`` when
-      unknown: the document's own ``BTCPP_format`` is all there is).
+      unknown: the document's own ``BTCPP_format`` is all there is), and
+      ``btcpp_unclear`` whether it is unknown because the project's build names both
+      versions (then no finding that depends on the version is more than a warning).
     * ``registered``: when every package that can register nodes for this document was
       read (its C++ catalog is complete), the custom node IDs the application registers;
       ``None`` when that is not known, and ``incomplete`` then says why, for messages.
@@ -99,6 +101,7 @@ class Context:
     )
     included_by: tuple[str, ...] = ()
     btcpp_version: str | None = None
+    btcpp_unclear: bool = False
     included: tuple[str, ...] = ()  # the paths of this document's include closure
     workspace_files: int = 0  # how many other workspace documents were looked at
     registered: frozenset[str] | None = None
@@ -144,6 +147,7 @@ class Context:
         workspace_has_custom_models: bool | None = None,
         btcpp_version: str | None = None,
         foreign: Collection[str] = (),
+        btcpp_unclear: bool = False,
     ) -> Context:
         """The context of ``own`` among ``others``: ``(path, document, included)`` triples.
 
@@ -226,9 +230,10 @@ class Context:
             ros_pkg_paths=MappingProxyType(dict(ros_pkg_paths or {})),
             included_by=tuple(included_by),
             btcpp_version=btcpp_version,
+            btcpp_unclear=btcpp_unclear,
             included=tuple(included),
             workspace_files=workspace_files,
-            sources=(*sources, workspace_has_custom_models, btcpp_version),
+            sources=(*sources, workspace_has_custom_models, btcpp_version, btcpp_unclear),
         )
 
 

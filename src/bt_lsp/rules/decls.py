@@ -22,8 +22,12 @@ from bt_lsp.syntax.sections import Section
 #: shipped model of a ROS package the document depends on) and ``cpp`` (the project's C++
 #: registrations).  Advisory ones say what an author or an editor wrote: ``tree`` (a
 #: ``<TreeNodesModel>`` inside a tree file), ``palette`` (a Groot2 ``.btproj``) and
-#: ``cpp-partial`` (a C++ registration whose kind, ports or defaults could not all be read).
-ModelSource = Literal["tree", "palette", "generated", "catalog", "ros", "cpp", "cpp-partial"]
+#: ``cpp-partial`` (a C++ registration whose kind, ports or defaults could not all be read)
+#: and ``ros-workspace`` (the shipped model of a workspace package whose C++ is read but
+#: does not register this node where it was read).
+ModelSource = Literal[
+    "tree", "palette", "generated", "catalog", "ros", "ros-workspace", "cpp", "cpp-partial"
+]
 AUTHORITATIVE: Final[frozenset[str]] = frozenset({"generated", "catalog", "ros", "cpp"})
 _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
     {
@@ -32,6 +36,9 @@ _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
         "generated": "a catalog exported by BehaviorTree.CPP (authoritative)",
         "catalog": "a node catalog named in the settings (authoritative)",
         "ros": "the node catalog a ROS package ships (authoritative)",
+        "ros-workspace": "the node catalog a workspace ROS package ships (advisory: "
+        "BehaviorTree.CPP registers the package's C++, and no registration of this node "
+        "was found in it)",
         "cpp": "the project's C++ registration (authoritative)",
         "cpp-partial": "the project's C++ registration (advisory: a static reading could not "
         "know all of it)",

@@ -45,7 +45,9 @@ def register(server: BtServer) -> None:
         found = hover_at(od.doc, offset, req.context(), others, markdown=markdown)
         if found is None and od.path is not None:
             detected = ls.project.btcpp_for(od.path, od.doc)
-            found = root_hover(od.doc, offset, detected.version, detected.source, markdown)
+            found = root_hover(
+                od.doc, offset, detected.version, detected.source, markdown, detected.conflict
+            )
         if found is None:
             return None
         learned = ls.cpp.hover_markdown(od, offset, found.markdown)  # where the C++ declares it

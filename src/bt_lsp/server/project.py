@@ -103,6 +103,7 @@ def log_version(ls: BtServer, path: Path) -> None:
     of_project = (
         project.settings_for(path).btcpp in ("3", "4")
         or project.packages.btcpp_of(path.parent).version is not None
+        or found.conflict
     )
     key = folder if of_project or found.version is None else path
     value = (found.version, found.source)
@@ -111,6 +112,8 @@ def log_version(ls: BtServer, path: Path) -> None:
     ls.versions_logged[key] = value
     version = f"BehaviorTree.CPP {found.version}" if found.version else "BehaviorTree.CPP 4"
     why = found.source if found.version else "not detected; checked as version 4"
+    if found.conflict:
+        version, why = "BehaviorTree.CPP version unclear", f"{found.source}; checked as 4"
     ls.log_message(f"bt-lsp: {key}: {version} ({why})", types.MessageType.Info)
 
 

@@ -211,6 +211,11 @@ class State:
             sev = Severity.WARNING
             if self.v3:
                 message += " (a check BehaviorTree.CPP 4 makes; this project builds against 3)"
+            elif self.ctx.btcpp_unclear:
+                message += (
+                    " (a check BehaviorTree.CPP 4 makes; the project's build names both "
+                    "BehaviorTree.CPP 3 and 4, so its version is unclear)"
+                )
             else:
                 message += (
                     " (checked against BehaviorTree.CPP 4; this document has no BTCPP_format)"

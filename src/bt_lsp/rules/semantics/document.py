@@ -7,7 +7,9 @@
   loads the file and prints "Warnings: The first tag of the XML (<root>) should contain
   the attribute [BTCPP_format="4"]".  Range: ``root``.  Fix: add ``BTCPP_format="4"``.
   Not reported when the project builds against BehaviorTree.CPP 3, which has no such
-  attribute (``Context.btcpp_version``); with no version detected the message says so.
+  attribute (``Context.btcpp_version``), nor for a document that is nothing but a
+  ``<TreeNodesModel>`` (a palette, which BehaviorTree.CPP never loads as a tree file); a
+  hint when the version is not detected or unclear, and the message says so.
 * ``duplicate-model-section`` (error): every ``<TreeNodesModel>`` after the first.
 * ``missing-id`` (error) for ``<Action|Condition|Control|Decorator|SubTree>`` written
   directly under ``<root>`` without ``ID`` while a ``<TreeNodesModel>`` exists (a check
@@ -130,16 +132,20 @@ def check_root(st: State) -> None:
     else:
         declared = root.attr("BTCPP_format") is not None
         version = st.ctx.btcpp_version
-        # A BTCPP_format in a version 3 project is a note for a later move to 4.
-        st.v4 = (declared and version != "3") or version == "4"
+        unclear = st.ctx.btcpp_unclear
+        # A BTCPP_format in a version 3 project is a note for a later move to 4; in a
+        # project whose build names both versions it settles nothing.
+        st.v4 = not unclear and ((declared and version != "3") or version == "4")
         st.v3 = version == "3"
-        # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only.
-        if not declared and version != "3":
+        # BehaviorTree.CPP 3 has no BTCPP_format to add: the advice is for version 4 only,
+        # and only for a document BehaviorTree.CPP loads (a palette is read by Groot).
+        if not declared and version != "3" and not _palette_only(st):
             st.add(
                 root.name_start,
                 root.name_end,
                 "missing-format",
-                _missing_format_message(version),
+                _missing_format_message(version, unclear),
+                None if version == "4" else Severity.HINT,
             )
     # Only the children that a rule looks at closely are made (a large document has
     # thousands of trees).
@@ -236,14 +242,27 @@ def check_depth(st: State, el: Element, tree_flagged: list[bool]) -> None:
         )
 
 
-def _missing_format_message(version: str | None) -> str:
+def _palette_only(st: State) -> bool:
+    """Whether the document is nothing but a ``<TreeNodesModel>`` (a Groot palette or a
+    node catalog): BehaviorTree.CPP never loads it as a tree file, so it never prints its
+    format warning for it."""
+    names = set(st.model.root_child_names())
+    return "TreeNodesModel" in names and not names & {"BehaviorTree", "include"}
+
+
+def _missing_format_message(version: str | None, unclear: bool = False) -> str:
     """What BehaviorTree.CPP 4 does with a ``<root>`` without ``BTCPP_format``, for the
-    project's version (4, or not detected)."""
+    project's version (4, unclear, or not detected)."""
     said = 'BehaviorTree.CPP 4 loads the file and prints a warning asking for BTCPP_format="4"'
     if version == "4":
         return f'<root> has no BTCPP_format attribute; {said}: add BTCPP_format="4"'
+    why = (
+        "the project's build names both BehaviorTree.CPP 3 and 4, so its version is unclear"
+        if unclear
+        else "the project's version was not detected"
+    )
     return (
         f"<root> has no BTCPP_format attribute; {said}; BehaviorTree.CPP 3 has no such "
-        "attribute, and the project's version was not detected (set btcpp to 3 or 4): add "
+        f"attribute, and {why} (set btcpp to 3 or 4): add "
         'BTCPP_format="4" if the file is written for version 4'
     )

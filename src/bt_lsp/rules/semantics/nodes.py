@@ -29,7 +29,8 @@
   ``ReactiveSequence`` element name.
 * ``reactive-explicit-child`` (error): a child of a ``ReactiveSequence`` written in
   explicit form: BehaviorTree.CPP looks the child's element name up as a node type and
-  fails with "Unknown node type: Action".  Range: the child's element name.
+  fails with "Unknown node type: Action".  Not reported in a BehaviorTree.CPP 3 project:
+  3.8's parser does not look the children up.  Range: the child's element name.
 * ``parallel-threshold`` (error): a literal ``success_count``/``failure_count`` of a
   ``Parallel`` larger than its number of children (negative values count from the end and
   never exceed it).  Range: the value.
@@ -260,16 +261,25 @@ def _unknown_finding(st: State, type_id: str, explicit: bool) -> _Finding | None
     if type_id in V3_RENAMES:
         new = V3_RENAMES[type_id]
         data = UnknownNodeData(type_id, explicit, new, preferred=True)
-        why = (
-            "a misspelling that BehaviorTree.CPP does not register"
-            if type_id in _MISSPELLINGS
-            else "the BehaviorTree.CPP 3 name of a node"
-        )
-        return (
-            f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}",
-            Severity.ERROR if st.v4 else Severity.WARNING,
-            data,
-        )
+        if st.v3:  # only the misspelling: 3.8 registers the other version 3 names
+            message = (
+                f"{quoted(type_id)} is a misspelling that BehaviorTree.CPP 3.8 does not "
+                f"register (its factory's registration of it is commented out); the node is "
+                f"{quoted(new)}"
+            )
+        else:
+            why = (
+                "a misspelling that BehaviorTree.CPP does not register"
+                if type_id in _MISSPELLINGS
+                else "the BehaviorTree.CPP 3 name of a node"
+            )
+            message = f"{quoted(type_id)} is {why}; BehaviorTree.CPP 4 calls it {quoted(new)}"
+            if ctx.btcpp_unclear:
+                message += (
+                    " (the project's build names both BehaviorTree.CPP 3 and 4, so its "
+                    "version is unclear)"
+                )
+        return message, Severity.ERROR if st.v4 else Severity.WARNING, data
     if st.v3 and type_id in BUILTINS:
         return (
             f"{quoted(type_id)} is a built-in node of BehaviorTree.CPP 4; this project builds "
@@ -434,7 +444,8 @@ def _reactive(st: State, el: Element) -> None:
         child = elements[ci]
         if child.name == "AsyncSequence":
             asyncs += 1
-        elif child.name in EXPLICIT_TAGS:
+        elif child.name in EXPLICIT_TAGS and not st.v3:
+            # Version 4's VerifyXML looks each child's element name up; 3.8 does not.
             st.add(
                 child.name_start,
                 child.name_end,

@@ -461,7 +461,11 @@ def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
         )
         # A model without any port (an editor's bare <SubTree ID="X"/>) says nothing of
         # the tree's ports: only a model that lists some makes another one suspicious.
-        st.add(s, e, "undeclared-port", message, Severity.WARNING if names else Severity.HINT)
+        # BehaviorTree.CPP 3 reads no <SubTree> model at all: an editor's note only.
+        if st.v3:
+            message += " (BehaviorTree.CPP 3 does not read <SubTree> models)"
+        loud = names and not st.v3
+        st.add(s, e, "undeclared-port", message, Severity.WARNING if loud else Severity.HINT)
         return
     if res.where:
         message = (
