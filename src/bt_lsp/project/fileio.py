@@ -35,6 +35,8 @@ __all__ = [
     "Stamp",
     "decode_bytes",
     "encode_text",
+    "read_bytes",
+    "read_head",
     "read_text",
     "write_text_atomic",
 ]
@@ -68,10 +70,11 @@ _DECLARATION: Final = re.compile(
 class FileError(Exception):
     """A file that cannot be read, decoded or written; the message names the file."""
 
-    def __init__(self, path: str, message: str) -> None:
+    def __init__(self, path: str, message: str, reason: str | None = None) -> None:
         super().__init__(message)
         self.path = path
         self.message = message
+        self.reason = reason if reason is not None else message  # without the file's name
 
     def __str__(self) -> str:
         return self.message
@@ -204,28 +207,89 @@ def _kind(st: os.stat_result) -> str:
     return "not a file"
 
 
-def read_bytes(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[bytes, Stamp]:
-    """The bytes of ``path``, refusing anything larger than ``max_bytes``."""
+def _cannot(path: str, why: str) -> FileError:
+    return FileError(path, f"cannot read {path}: {why}", why)
+
+
+def _not_regular(path: str, st: os.stat_result) -> FileError:
+    why = f"not a regular file ({_kind(st)})"
+    return FileError(path, f"skipping {path}: {why}", why)
+
+
+def _open_regular(path: str) -> tuple[int, os.stat_result]:
+    """A descriptor of ``path`` opened for reading, and its status: only a regular file is
+    opened (a FIFO would block the open, a device may act on it), and without blocking (a
+    regular file of a pseudo file system such as ``/proc/kmsg`` may block a read)."""
     try:
-        # Opened without blocking, so that a FIFO with no writer does not hang the open;
-        # anything but a regular file is then refused.
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-        with open(fd, "rb") as f:
-            st = os.fstat(f.fileno())
-            if stat.S_ISDIR(st.st_mode):
-                raise FileError(path, f"cannot read {path}: Is a directory")
-            if not stat.S_ISREG(st.st_mode):
-                raise FileError(path, f"skipping {path}: not a regular file ({_kind(st)})")
-            if hasattr(os, "set_blocking"):
-                os.set_blocking(fd, True)
-            if st.st_size > max_bytes:
-                raise _too_large(path, st.st_size, max_bytes)
-            # A pipe or device reports no size: read one byte past the limit to notice.
-            data = f.read(max_bytes + 1)
-    except FileError:
-        raise
+        st = os.stat(path)
     except OSError as e:
-        raise FileError(path, f"cannot read {path}: {_reason(e)}") from None
+        raise _cannot(path, _reason(e)) from None
+    except ValueError as e:  # a path the OS cannot look up ("embedded null byte")
+        raise _cannot(path, str(e)) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise _cannot(path, "Is a directory")
+    if not stat.S_ISREG(st.st_mode):
+        raise _not_regular(path, st)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(path, flags | getattr(os, "O_BINARY", 0))
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    try:
+        st = os.fstat(fd)  # the name may lead elsewhere by now
+    except OSError as e:
+        os.close(fd)
+        raise _cannot(path, _reason(e)) from None
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise _not_regular(path, st)
+    return fd, st
+
+
+def _read_fd(fd: int, path: str, limit: int, hint: int) -> bytes:
+    """Up to ``limit`` bytes of the open file ``fd``; ``hint`` is its reported size.  A
+    read that would block (a pseudo file that waits for data) is an error."""
+    chunks: list[bytes] = []
+    total = 0
+    while total < limit:
+        want = min(limit - total, max(hint + 1 - total, 64 * 1024))
+        try:
+            chunk = os.read(fd, want)
+        except BlockingIOError:
+            why = "reading it would block (not an ordinary file)"
+            raise FileError(path, f"skipping {path}: {why}", why) from None
+        if not chunk:
+            break
+        chunks.append(chunk)
+        total += len(chunk)
+    return b"".join(chunks)
+
+
+def read_head(path: str, size: int) -> bytes:
+    """The first ``size`` bytes of ``path`` (fewer if it is shorter), read as
+    :func:`read_bytes` reads: never from anything but a regular file, never blocking."""
+    fd, st = _open_regular(path)
+    try:
+        return _read_fd(fd, path, size, min(st.st_size, size))
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    finally:
+        os.close(fd)
+
+
+def read_bytes(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[bytes, Stamp]:
+    """The bytes of ``path``, refusing anything larger than ``max_bytes``, anything but a
+    regular file, and a file whose read would block."""
+    fd, st = _open_regular(path)
+    try:
+        if st.st_size > max_bytes:
+            raise _too_large(path, st.st_size, max_bytes)
+        # A pseudo file reports no size: read one byte past the limit to notice.
+        data = _read_fd(fd, path, max_bytes + 1, st.st_size)
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    finally:
+        os.close(fd)
     if len(data) > max_bytes:
         raise _too_large(path, None, max_bytes)
     return data, Stamp.of(st)
