@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import errno
 import fcntl
+import json
 import os
 import signal
 from collections.abc import Iterator
@@ -13,9 +14,12 @@ from typing import Any
 
 import pytest
 
-from bt_lsp.cli.main import main
-from bt_lsp.project.fileio import FileError, read_bytes
+from bt_lsp.cli.main import build_parser, main
+from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_bytes
+from bt_lsp.project.index import ProjectIndex, normalize
+from bt_lsp.project.settings import Settings
 from bt_lsp.project.sniff import head_of
+from bt_lsp.syntax.document import Document
 from tests.test_cli import FIXABLE, _fixed, _put
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
@@ -101,3 +105,48 @@ def test_a_regular_file_whose_read_blocks_is_skipped(
     err = capsys.readouterr().err
     assert "bt-lsp: skipping d/kmsg.xml: reading it would block" in err
     assert seen and all(seen)
+
+
+# -- 8. one size limit for the server and the command line ------------------------------------
+
+BIG_INCLUDER = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <include path="big.xml"/>\n'
+    '  <BehaviorTree ID="Main"><SubTree ID="Big"/></BehaviorTree>\n'
+    "</root>\n"
+)
+
+
+def _big_include(folder: Path) -> Path:
+    """``main.xml`` including ``big.xml``, one byte above the default limit."""
+    head = '<root BTCPP_format="4"><BehaviorTree ID="Big"><AlwaysSuccess/></BehaviorTree>'
+    tail = "</root>\n"
+    pad = DEFAULT_MAX_BYTES + 1 - len(head) - len(tail) - len("<!---->")
+    (folder / "big.xml").write_text(head + "<!--" + " " * pad + "-->" + tail)
+    assert (folder / "big.xml").stat().st_size == DEFAULT_MAX_BYTES + 1
+    return _put(folder / "main.xml", BIG_INCLUDER)
+
+
+def test_the_server_and_the_command_line_share_one_size_limit() -> None:
+    parser = build_parser()
+    args = parser.parse_args(["check", "x.xml"])
+    assert Settings().max_document_bytes == DEFAULT_MAX_BYTES == args.max_file_size
+
+
+def test_an_included_file_above_the_limit_reads_the_same_in_both(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    main_xml = _big_include(work)
+    # The command line.
+    assert main(["check", "--format", "json", "main.xml"]) == 1
+    cli = [(d["code"], d["message"]) for d in json.loads(capsys.readouterr().out)]
+    # The server reads the includes of an open document through its ProjectIndex.
+    index = ProjectIndex([work], Settings())
+    path = normalize(main_xml)
+    doc = Document(main_xml.read_text(), str(path))
+    index.open(path, doc)
+    server = [(d.code, d.message) for d in index.diagnostics(path, doc)]
+    assert [c for c, _ in cli] == ["include-not-found", "unknown-subtree"]
+    assert cli == server
+    assert "too large" in cli[0][1] and "the limit is 8 MB" in cli[0][1]
+

@@ -41,7 +41,10 @@ __all__ = [
     "write_text_atomic",
 ]
 
-DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
+# The one size limit of a document, for the server (``maxDocumentBytes``: an open document
+# above it gets the XML and name checks only, a file above it is not read) and for
+# ``bt-lsp check`` (``--max-file-size``): an include above it is not found in either.
+DEFAULT_MAX_BYTES: Final = 8 * 1024 * 1024
 # In the name of write_text_atomic's temporary files, so that the ones a killed run left
 # can be told from anyone else's (see stale_temporaries).
 TEMP_MARK: Final = ".bt-lsp-"
