@@ -150,3 +150,65 @@ def test_an_included_file_above_the_limit_reads_the_same_in_both(
     assert cli == server
     assert "too large" in cli[0][1] and "the limit is 8 MB" in cli[0][1]
 
+
+# -- 9. a broken configuration: reported in every format, the files still checked -------------
+
+BROKEN = 'btcpp = "4"\nexclude = "gen"\n[severity]\nmodel-name-forbidden-char = "off"\n'
+
+
+def _broken_config(folder: Path) -> Path:
+    _put(folder / "t.xml", FIXABLE)
+    return _put(folder / "bt-lsp.toml", BROKEN)
+
+
+def test_a_broken_configuration_is_a_json_entry(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = _broken_config(work)
+    assert main(["check", "--format", "json", "."]) == 2
+    entries = json.loads(capsys.readouterr().out)
+    assert entries[0] == {
+        "path": str(cfg),
+        "line": 2,
+        "column": 1,
+        "endLine": 2,
+        "endColumn": 16,
+        "severity": "error",
+        "code": "config-error",
+        "message": "'exclude' must be a list of strings",
+    }
+    # The file is checked with the defaults: the broken file's severity is not applied.
+    checked = {e["code"] for e in entries if e["path"] == "t.xml"}
+    assert "model-name-forbidden-char" in checked
+
+
+def test_a_broken_configuration_is_a_sarif_result_and_notification(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _broken_config(work)
+    assert main(["check", "--format", "sarif", "."]) == 2
+    (run,) = json.loads(capsys.readouterr().out)["runs"]
+    first = run["results"][0]
+    assert first["ruleId"] == "config-error"
+    where = first["locations"][0]["physicalLocation"]
+    assert where["artifactLocation"]["uri"] == "bt-lsp.toml"
+    assert where["region"]["startLine"] == 2
+    assert any(
+        r["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "t.xml"
+        for r in run["results"][1:]
+    )
+    (note,) = run["invocations"][0]["toolExecutionNotifications"]
+    assert note["descriptor"]["id"] == "config-error"
+    assert run["invocations"][0]["executionSuccessful"] is False
+
+
+def test_a_broken_configuration_in_text_and_under_fix(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = _broken_config(work)
+    assert main(["check", "--fix", "."]) == 2
+    out, err = capsys.readouterr()
+    assert f"{cfg}:2:1: error config-error 'exclude' must be a list of strings\n" in err
+    assert "t.xml:" in out  # checked
+    assert "not fixing any file: a configuration file cannot be used" in err
+    assert (work / "t.xml").read_text(encoding="utf-8") == FIXABLE  # its excludes unknown
