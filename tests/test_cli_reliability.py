@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from bt_lsp.cli.main import build_parser, main
-from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_bytes
+from bt_lsp.project.fileio import DEFAULT_MAX_BYTES, FileError, read_bytes, write_text_atomic
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.sniff import head_of
@@ -71,6 +71,17 @@ def test_fifos_among_configuration_and_manifests_are_not_opened(
     err = capsys.readouterr().err
     assert "config-error cannot read the file: not a regular file (a FIFO)" in err
     assert head_of(work / "d" / "package.xml") is None
+
+
+def test_a_fifo_among_the_cpp_sources_is_not_read(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The C++ catalog of a folder reads its ``*.cpp`` files: a FIFO is left out."""
+    _put(work / "d" / "a.xml", FIXABLE)
+    _put(work / "d" / "nodes.cpp", '#include "x.h"\n')
+    os.mkfifo(work / "d" / "pipe.cpp")
+    assert main(["check", "--format", "json", "d"]) == 1
+    assert "pipe.cpp" not in capsys.readouterr().out
 
 
 def _blocking_read(target: Path, seen: list[bool]) -> Any:
@@ -212,3 +223,76 @@ def test_a_broken_configuration_in_text_and_under_fix(
     assert "t.xml:" in out  # checked
     assert "not fixing any file: a configuration file cannot be used" in err
     assert (work / "t.xml").read_text(encoding="utf-8") == FIXABLE  # its excludes unknown
+
+
+# -- 10. --fix keeps a file's identity: read-only files and hard links are not rewritten -----
+
+DOCK = (
+    '<root BTCPP_format="4">\n'
+    '  <BehaviorTree ID="Dock Robot">\n'
+    "    <AlwaysSuccess/>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+CALLS = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main"><SubTree ID="Dock Robot"/></BehaviorTree>\n'
+    "</root>\n"
+)
+
+
+def test_fix_does_not_rewrite_a_read_only_file(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _put(work / "d" / "a.xml", FIXABLE)
+    path.chmod(0o444)
+    try:
+        assert main(["check", "--fix", "d"]) == 1
+        assert path.read_text(encoding="utf-8") == FIXABLE
+        assert oct(path.stat().st_mode & 0o777) == "0o444"
+        err = capsys.readouterr().err
+        assert "bt-lsp: not fixing d/a.xml: it is read-only (mode 0444)" in err
+        path.chmod(0o644)  # made writable, it is fixed
+        assert main(["check", "--fix", "d"]) == 0
+        assert path.read_text(encoding="utf-8") == _fixed(FIXABLE)
+    finally:
+        path.chmod(0o644)
+
+
+def test_a_rename_needing_a_read_only_file_is_made_in_none(
+    work: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    dock = _put(work / "d" / "dock.xml", DOCK)
+    calls = _put(work / "d" / "main.xml", CALLS)
+    calls.chmod(0o444)
+    try:
+        assert main(["check", "--fix", "d"]) == 1
+    finally:
+        calls.chmod(0o644)
+    assert dock.read_text(encoding="utf-8") == DOCK
+    assert calls.read_text(encoding="utf-8") == CALLS
+    err = capsys.readouterr().err
+    assert (
+        "bt-lsp: d/dock.xml: left 'Dock Robot' as it is (not renamed to 'Dock_Robot' in any "
+        "file): its rename changes d/main.xml too, which is not fixed: it is read-only"
+    ) in err
+
+
+def test_fix_keeps_hard_links_whole(work: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _put(work / "d" / "a.xml", FIXABLE)
+    os.link(path, work / "elsewhere.xml")
+    assert main(["check", "--fix", "d"]) == 1
+    err = capsys.readouterr().err
+    assert "bt-lsp: not fixing d/a.xml: it has 2 hard links" in err
+    assert path.read_text(encoding="utf-8") == FIXABLE
+    assert path.stat().st_ino == (work / "elsewhere.xml").stat().st_ino  # still one file
+
+
+def test_the_write_itself_refuses_a_split(tmp_path: Path) -> None:
+    """The check before the write is repeated by the write (the file may have been
+    linked meanwhile)."""
+    path = _put(tmp_path / "a.xml", "<a/>")
+    os.link(path, tmp_path / "b.xml")
+    with pytest.raises(FileError, match="2 hard links"):
+        write_text_atomic(str(path), "<b/>", "utf-8", False)
+    assert (tmp_path / "b.xml").read_text() == "<a/>" == path.read_text()

@@ -21,7 +21,9 @@ checked without it; ``--fix`` then fixes nothing).
 
 ``--fix`` removes the temporary files an interrupted ``--fix`` left
 (``.NAME.bt-lsp-XXXXXXXX.tmp``, older than the run), and does not rewrite a file that a
-checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``.
+checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``,
+nor a read-only file or one with hard links (a fixed file is a new file: it would ignore
+the mode, and split the links); a rename that needs such a file is made in none.
 """
 
 from __future__ import annotations
@@ -66,6 +68,7 @@ from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import (
     DEFAULT_MAX_BYTES,
     FileError,
+    not_replaceable,
     read_head,
     read_text,
     stale_temporaries,
@@ -363,7 +366,8 @@ def run(
             say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
 
     def keep_of(path: str) -> str | None:
-        return None if options.follow_symlinks else _linked_from_outside(path, roots)
+        linked = None if options.follow_symlinks else _linked_from_outside(path, roots)
+        return linked or not_replaceable(path)  # read-only, hard links
 
     # Every rename of --fix in all the files it touches, or in none (see fix_workspace).
     planned = fix_files(files, project, options.max_bytes, keep_of) if options.fix else {}

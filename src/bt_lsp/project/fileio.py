@@ -12,7 +12,9 @@ Reading opens the file in binary and decodes it here, so line ends (``\\r\\n``, 
 
 Writing goes to a temporary file in the same directory, which is flushed to disk, given the
 original file's mode (and owner, where allowed) and then renamed over the original, so a
-reader sees either the old or the new file, never a half-written one. A write encodes
+reader sees either the old or the new file, never a half-written one.  A new file is not
+the same file: one that is read-only or has hard links is not written at all
+(:func:`not_replaceable`). A write encodes
 with the same codec and byte-order mark, so every byte outside the changed text stays as
 it was.
 """
@@ -35,6 +37,7 @@ __all__ = [
     "Stamp",
     "decode_bytes",
     "encode_text",
+    "not_replaceable",
     "read_bytes",
     "read_head",
     "read_text",
@@ -309,6 +312,29 @@ def read_text(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> Decoded:
     return Decoded(decoded.text, decoded.encoding, decoded.bom, decoded.lossless, st)
 
 
+def not_replaceable(path: str) -> str | None:
+    """Why :func:`write_text_atomic` must not put a new file in place of ``path``
+    (``None``: it may): a read-only file would be rewritten all the same (the folder is
+    what a rename needs), and a file with hard links would be split (its other names
+    keep the old text).  Said in words for a note; a missing file is the write's to
+    report."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    mode = stat.S_IMODE(st.st_mode)
+    if not mode & 0o222:
+        return f"it is read-only (mode {mode:04o}); make it writable to have it fixed"
+    if not os.access(path, os.W_OK):
+        return f"this user may not write it (mode {mode:04o})"
+    if st.st_nlink > 1:
+        return (
+            f"it has {st.st_nlink} hard links; a fixed copy would leave the other "
+            "names with the old text"
+        )
+    return None
+
+
 def write_text_atomic(
     path: str, text: str, encoding: str, bom: bool, *, expect: Stamp | None = None
 ) -> None:
@@ -336,6 +362,9 @@ def write_text_atomic(
         raise FileError(path, f"cannot write {path}: {_reason(e)}") from None
     if expect is not None and Stamp.of(st) != expect:
         raise FileError(path, f"cannot write {path}: it changed on disk while being checked")
+    why = not_replaceable(target)
+    if why is not None:
+        raise FileError(path, f"cannot write {path}: {why}")
     try:
         fd, tmp = tempfile.mkstemp(
             prefix=f".{os.path.basename(target)}{TEMP_MARK}", suffix=".tmp", dir=directory
