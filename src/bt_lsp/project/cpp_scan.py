@@ -58,7 +58,8 @@ def find_cpp_files(paths: Iterable[str | Path], exclude: Sequence[str] = ()) -> 
             dirs[:] = sorted(d for d in dirs if d not in SKIP_DIRS and not d.startswith("."))
             for name in sorted(files):
                 f = Path(root) / name
-                if f.suffix in CPP_SUFFIXES and not _excluded(f, p, exclude):
+                # is_file: a FIFO named *.cpp would block the read of the catalog.
+                if f.suffix in CPP_SUFFIXES and f.is_file() and not _excluded(f, p, exclude):
                     out.append(f)
     return sorted(dict.fromkeys(out))
 
