@@ -147,3 +147,16 @@ def test_a_folder_check_does_bounded_work_per_file(
     large = _work_per_file(tmp_path, 120, monkeypatch)
     # Linear: the same work per file whatever the number of files (it was 4x here).
     assert large <= small * 1.25, (small, large)
+
+
+def test_a_folder_above_the_servers_cap_knows_every_tree(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The server's workspace holds at most MAX_WORKSPACE_FILES files; check reads every
+    file it checks, so a tree defined in any of them is known (it was an error beyond)."""
+    monkeypatch.setattr(index_module, "MAX_WORKSPACE_FILES", 10)
+    folder = tmp_path / "many"
+    _folder(folder, 30)
+    assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
+    assert "error" not in capsys.readouterr().out
+    assert len(ProjectIndex([folder]).files()) == 10  # the server's cap is unchanged

@@ -127,8 +127,12 @@ class ProjectIndex:
         configs: Configs | None = None,
         overrides: Layer | None = None,
         ament_prefix_path: Sequence[str] | None = None,
+        all_files: bool = False,
     ) -> None:
         self.roots = [normalize(r) for r in roots]
+        # Every file of the folders, not the first MAX_WORKSPACE_FILES: the command line
+        # reads every file it checks anyway, and a tree in a file left out is unknown.
+        self.all_files = all_files
         self.settings = settings or Settings()
         self.configs = configs if configs is not None else Configs()
         self.overrides = overrides
@@ -324,14 +328,15 @@ class ProjectIndex:
 
     def files(self) -> list[Path]:
         """Every BT XML file under the workspace folders and the model files from the
-        settings (sorted; a bounded number, skipping build and VCS folders)."""
+        settings (sorted; skipping build and VCS folders; at most MAX_WORKSPACE_FILES
+        unless ``all_files``)."""
         if self._files is None:
             found: set[Path] = set()
             self._folders = {}
             for root in self.roots:
                 for p in _walk_xml(root, self.is_excluded, self._folders):
                     found.add(p)
-                    if len(found) >= MAX_WORKSPACE_FILES:
+                    if len(found) >= MAX_WORKSPACE_FILES and not self.all_files:
                         break
             found.update(self.model_files())
             self._files = sorted(found)
