@@ -8,9 +8,10 @@ For each count a temporary folder gets that many small BehaviorTree.CPP files
 custom nodes with ports and calls trees defined in other files by ``<SubTree>``, some
 include another file, and one file holds the ``<TreeNodesModel>`` of the custom nodes.
 Then ``bt-lsp check --no-cpp --format json FOLDER`` runs in a fresh process (``nice``) and
-its wall time, the findings and the exit status are printed.  With Nav2's sources at
-``--nav2`` (default ``/work/shared/projects/ros-navigation__navigation2``), its whole
-tree is checked too (with the C++ read).  Not part of the test suite
+its wall time, CPU time (user + system), the findings and the exit status are printed.
+With Nav2's sources at ``--nav2`` (default
+``/work/shared/projects/ros-navigation__navigation2``), its whole tree is checked too
+(with the C++ read).  Not part of the test suite
 (``tests/test_benchmarks_smoke.py`` checks the generator only).
 """
 
@@ -21,6 +22,7 @@ import json
 import os
 import platform
 import random
+import resource
 import subprocess
 import sys
 import tempfile
@@ -114,6 +116,7 @@ def check(target: str, *, cpp: bool, timeout: float) -> dict[str, Any]:
         cmd.append("--no-cpp")
     env = dict(os.environ)
     env["PYTHONPATH"] = str(ROOT / "src") + os.pathsep + env.get("PYTHONPATH", "")
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     try:
         proc = subprocess.run(
@@ -122,8 +125,15 @@ def check(target: str, *, cpp: bool, timeout: float) -> dict[str, Any]:
     except subprocess.TimeoutExpired:
         return {"seconds": None, "timeout": timeout}
     seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
     findings = json.loads(proc.stdout) if proc.stdout.strip() else []
-    return {"seconds": round(seconds, 2), "exit": proc.returncode, "findings": len(findings)}
+    return {
+        "seconds": round(seconds, 2),
+        "cpu_seconds": round(cpu, 2),  # the wall time's share of a loaded machine aside
+        "exit": proc.returncode,
+        "findings": len(findings),
+    }
 
 
 def machine() -> dict[str, Any]:
