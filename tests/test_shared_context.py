@@ -160,3 +160,21 @@ def test_a_folder_above_the_servers_cap_knows_every_tree(
     assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
     assert "error" not in capsys.readouterr().out
     assert len(ProjectIndex([folder]).files()) == 10  # the server's cap is unchanged
+
+
+def test_a_folder_check_parses_each_file_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The file checked is the document the workspace read for the others' sake."""
+    folder = tmp_path / "f"
+    _folder(folder, 20)
+    made = itertools.count()
+    real = Document.__init__
+
+    def init(self: Document, *args: object, **kw: object) -> None:
+        next(made)
+        real(self, *args, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Document, "__init__", init)
+    assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
+    assert next(made) <= 21 + 1  # 21 files; the first one checked is read before the rest

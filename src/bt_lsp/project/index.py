@@ -183,6 +183,13 @@ class ProjectIndex:
             return doc
         return self._read(path)[0]
 
+    def read_document(self, path: Path, text: str) -> Document | None:
+        """The document already read from disk at ``path`` if its text is ``text`` (never
+        reads): a caller that read the file itself parses it once."""
+        hit = self._disk.get(path)
+        doc = hit[1] if hit is not None else None
+        return doc if doc is not None and doc.text == text else None
+
     def read_error(self, path: Path) -> str | None:
         if path in self._open:
             return None
