@@ -257,3 +257,19 @@ def test_hostile_measures_an_input() -> None:
     result = asyncio.run(bench_hostile.measure("small", text))
     assert result["size"] == len(text)
     assert result["diagnostics_s"] > 0 and result["hover_s"] > 0 and result["rss_peak_mib"] > 0
+
+
+def test_folder_check_writes_small_trees_that_call_each_other(tmp_path: Path) -> None:
+    folder_check = _bench_module("folder_check")
+    folder_check.write_folder(tmp_path, 20)
+    files = sorted(tmp_path.glob("tree_*.xml"))
+    assert len(files) == 20
+    called = set()
+    for f in files:
+        root = etree.fromstring(f.read_bytes())
+        assert root.tag == "root" and root.findall("BehaviorTree")
+        called |= {s.get("ID", "") for s in root.iter("SubTree")}
+    assert called and all(re.fullmatch(r"Task\d+_0", c) for c in called)
+    assert (
+        etree.fromstring((tmp_path / "models.xml").read_bytes()).find("TreeNodesModel") is not None
+    )

@@ -15,11 +15,15 @@ Output formats:
 
 Exit status: 0 without errors, 1 with at least one error-severity diagnostic, 2 when a file
 cannot be read or decoded, is not a regular file (a FIFO would block), or its fix cannot be
-written (the others are still checked).
+written (the others are still checked), or a configuration file cannot be used (it is
+reported as a ``config-error`` at its position, in every format, and the files are
+checked without it; ``--fix`` then fixes nothing).
 
 ``--fix`` removes the temporary files an interrupted ``--fix`` left
 (``.NAME.bt-lsp-XXXXXXXX.tmp``, older than the run), and does not rewrite a file that a
-checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``.
+checked folder reaches through a symbolic link to outside it unless ``--follow-symlinks``,
+nor a read-only file or one with hard links (a fixed file is a new file: it would ignore
+the mode, and split the links); a rename that needs such a file is made in none.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ import time
 import traceback
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Final, TextIO
 
@@ -54,17 +58,21 @@ from bt_lsp.cli.project import (
 )
 from bt_lsp.cli.results import (
     FileResult,
+    config_result,
     exit_code,
     file_diagnostics,
     findings_of,
     plural,
     summary,
 )
+from bt_lsp.project.config import MAX_CONFIG_BYTES
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, find_cpp_files
 from bt_lsp.project.fileio import (
     DEFAULT_MAX_BYTES,
     FileError,
+    not_replaceable,
+    read_head,
     read_text,
     stale_temporaries,
     write_text_atomic,
@@ -145,7 +153,9 @@ def check_file(
         result.error = e
         return result
     try:
-        doc = Document(decoded.text, path)
+        # The workspace has usually read the file already (for the other files' sake).
+        shared = project.read_document(normalize(path), decoded.text) if project else None
+        doc = shared if shared is not None else Document(decoded.text, path)
         if Path(path).suffix in CPP_SUFFIXES:  # the name rules where names are born
             facts = Scanner().facts(path, decoded.text.encode("utf-8", "surrogatepass"))
             diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
@@ -347,15 +357,18 @@ def run(
         write(stream, text)
         stream.flush()
 
-    broken = config_errors(project, files)
-    if broken:
-        for ce in broken:
-            where = f"{visible(str(ce.path))}:{ce.line}:{ce.column}"
-            say(err, f"{where}: error config-error {ce.message}\n")
-        return 2
+    # A configuration file that cannot be used is reported (exit status 2) and the files
+    # are checked without it; none is fixed, as its excludes and settings are not known.
+    configs = [config_result(ce, _config_text(ce.path)) for ce in config_errors(project, files)]
+    for ce in configs:
+        f = ce.findings[0]
+        say(err, f"{visible(f.path)}:{f.line}:{f.column}: error config-error {f.message}\n")
+    if configs and options.fix:
+        say(err, "bt-lsp: not fixing any file: a configuration file cannot be used\n")
+        options = replace(options, fix=False)
     for e in walk_errors:
         say(err, f"bt-lsp: {e.message}\n")
-    if not files:
+    if not files and not configs:
         none = "no BehaviorTree.CPP XML files" if skipped else "no XML files"
         if not options.quiet:
             say(err, f"bt-lsp: {none} to check\n")
@@ -371,7 +384,7 @@ def run(
             say(err, line + "\n")
         for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
-    results: list[FileResult] = [FileResult(e.path, error=e) for e in walk_errors]
+    results: list[FileResult] = [*configs, *(FileResult(e.path, error=e) for e in walk_errors)]
     # What fixes see of the other files: the workspace before any file is fixed.
     before = dict(project.bt_documents()) if options.fix else None
     roots = [p for p in paths if os.path.isdir(p)]
@@ -381,7 +394,8 @@ def run(
                 say(err, f"bt-lsp: removed {visible(tmp)}, left by an interrupted --fix\n")
 
     def keep_of(path: str) -> str | None:
-        return None if options.follow_symlinks else _linked_from_outside(path, roots)
+        linked = None if options.follow_symlinks else _linked_from_outside(path, roots)
+        return linked or not_replaceable(path)  # read-only, hard links
 
     # Every rename of --fix in all the files it touches, or in none (see fix_workspace).
     planned = fix_files(files, project, options.max_bytes, keep_of) if options.fix else {}
@@ -406,7 +420,10 @@ def run(
     if options.format != "text":
         _report(out, options.format, results)
     elif not options.quiet:
-        say(err, summary(results) + "\n")
+        text = summary([r for r in results if not r.config])
+        if configs:
+            text += f"; {plural(len(configs), 'configuration file')} could not be used"
+        say(err, text + "\n")
     return exit_code(results)
 
 
@@ -415,3 +432,11 @@ def _report(out: TextIO, format: Format, results: Sequence[FileResult]) -> None:
     document = to_json(results) if format == "json" else to_sarif(results)
     write(out, json.dumps(document, indent=2) + "\n")
     out.flush()
+
+
+def _config_text(path: Path) -> str | None:
+    """A configuration file's text, to place its error (``None`` if it cannot be read)."""
+    try:
+        return read_head(str(path), MAX_CONFIG_BYTES).decode("utf-8", "replace")
+    except FileError:
+        return None

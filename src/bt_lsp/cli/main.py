@@ -102,7 +102,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_size,
         default=DEFAULT_MAX_BYTES,
         metavar="SIZE",
-        help="refuse files larger than this (e.g. 64M; default: 64M)",
+        help="refuse files larger than this, and take included files larger than this as "
+        f"not found, as the server does (e.g. 64M; default: {DEFAULT_MAX_BYTES // 2**20}M)",
     )
     check.add_argument(
         "--config",

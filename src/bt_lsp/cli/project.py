@@ -149,6 +149,7 @@ def project_index(paths: Sequence[str], options: ProjectOptions) -> ProjectIndex
         Settings(max_document_bytes=options.max_bytes),
         configs=Configs(normalize(options.config) if options.config else None),
         overrides=overrides,
+        all_files=True,  # every file checked is read: its trees are known to the others
     )
 
 

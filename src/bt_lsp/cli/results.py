@@ -10,11 +10,13 @@ from pathlib import Path
 from typing import Final
 
 from bt_lsp.ide.name_targets import with_targets
+from bt_lsp.project.config import ConfigError
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.fileio import FileError
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules import analysis
 from bt_lsp.rules.codes import Severity
+from bt_lsp.rules.configuration import CONFIG_ERROR
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 
@@ -53,6 +55,7 @@ class FileResult:
     notes: list[str] = field(default_factory=list)  # what the applied fixes left as it was
     detail: str = ""  # the traceback of an internal error
     unwritten: bool = False  # --fix could not write the fixed file (exit status 2)
+    config: bool = False  # a configuration file that cannot be used (exit status 2)
 
 
 def file_diagnostics(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
@@ -89,6 +92,34 @@ def findings_of(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[F
     return out
 
 
+def config_result(error: ConfigError, text: str | None) -> FileResult:
+    """A configuration file that cannot be used, as a result with one ``config-error``
+    finding at the error (``text``: the file's text, if it could be read, for the span
+    and the UTF-16 columns)."""
+    line, column, end_column = error.line, error.column, error.column
+    utf16_column, utf16_end = column, end_column
+    if text is not None:
+        row, start, end = error.span(text)
+        source = [part.removesuffix("\r") for part in text.split("\n")][row]
+        line, column, end_column = row + 1, start + 1, end + 1
+        utf16_column = len(source[:start].encode("utf-16-le")) // 2 + 1
+        utf16_end = len(source[:end].encode("utf-16-le")) // 2 + 1
+    path = str(error.path)
+    finding = Finding(
+        path,
+        line,
+        column,
+        line,
+        end_column,
+        utf16_column,
+        utf16_end,
+        Severity.ERROR,
+        CONFIG_ERROR.code,
+        error.message,
+    )
+    return FileResult(path, findings=[finding], config=True)
+
+
 def plural(n: int, word: str, plural: str | None = None) -> str:
     return f"{n} {word if n == 1 else (plural or word + 's')}"
 
@@ -116,7 +147,7 @@ def summary(results: Sequence[FileResult]) -> str:
 def exit_code(results: Iterable[FileResult]) -> int:
     code = 0
     for r in results:
-        if r.error is not None or r.unwritten:
+        if r.error is not None or r.unwritten or r.config:
             return 2
         if any(f.severity == Severity.ERROR for f in r.findings):
             code = 1

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Final
 
+from bt_lsp.project.fileio import FileError, read_head
 from bt_lsp.project.schema import FILE_KEYS
 from bt_lsp.project.settings import BTCPP_CHOICES, Settings
 from bt_lsp.rules.codes import Severity
@@ -144,9 +145,10 @@ def find_config(start: Path, searched: dict[Path, Stamp] | None = None) -> Path 
                 continue
             if name == PYPROJECT:
                 try:
-                    text = candidate.read_bytes()[:MAX_CONFIG_BYTES].decode("utf-8", "replace")
-                except OSError:
+                    head = read_head(str(candidate), MAX_CONFIG_BYTES)
+                except FileError:
                     continue
+                text = head.decode("utf-8", "replace")
                 if not _mentions_table(text):
                     continue
             return candidate
@@ -175,11 +177,10 @@ def load_config(path: Path, data: bytes | None = None) -> Config | None:
     :class:`ConfigError` when it cannot be used."""
     if data is None:
         try:
-            with open(path, "rb") as f:
-                data = f.read(MAX_CONFIG_BYTES + 1)
-        except (OSError, ValueError) as e:
-            why = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
-            raise ConfigError(path, 1, 1, f"cannot read the file: {why}") from None
+            # Never from a FIFO or a device, and without blocking (see read_head).
+            data = read_head(str(path), MAX_CONFIG_BYTES + 1)
+        except FileError as e:
+            raise ConfigError(path, 1, 1, f"cannot read the file: {e.reason}") from None
     if len(data) > MAX_CONFIG_BYTES:
         raise ConfigError(path, 1, 1, f"larger than {MAX_CONFIG_BYTES} bytes")
     try:

@@ -100,7 +100,8 @@ def _walk(base: Path, exclude: Sequence[str], skip_packages: bool, skip_tests: b
         )
         for name in sorted(files):
             f = here / name
-            if f.suffix in CPP_SUFFIXES and not _excluded(f, base, exclude):
+            # is_file: a FIFO named *.cpp would block the read of the catalog.
+            if f.suffix in CPP_SUFFIXES and f.is_file() and not _excluded(f, base, exclude):
                 out.append(f)
     return out
 

@@ -12,7 +12,9 @@ Reading opens the file in binary and decodes it here, so line ends (``\\r\\n``, 
 
 Writing goes to a temporary file in the same directory, which is flushed to disk, given the
 original file's mode (and owner, where allowed) and then renamed over the original, so a
-reader sees either the old or the new file, never a half-written one. A write encodes
+reader sees either the old or the new file, never a half-written one.  A new file is not
+the same file: one that is read-only or has hard links is not written at all
+(:func:`not_replaceable`). A write encodes
 with the same codec and byte-order mark, so every byte outside the changed text stays as
 it was.
 """
@@ -35,11 +37,17 @@ __all__ = [
     "Stamp",
     "decode_bytes",
     "encode_text",
+    "not_replaceable",
+    "read_bytes",
+    "read_head",
     "read_text",
     "write_text_atomic",
 ]
 
-DEFAULT_MAX_BYTES: Final = 64 * 1024 * 1024
+# The one size limit of a document, for the server (``maxDocumentBytes``: an open document
+# above it gets the XML and name checks only, a file above it is not read) and for
+# ``bt-lsp check`` (``--max-file-size``): an include above it is not found in either.
+DEFAULT_MAX_BYTES: Final = 8 * 1024 * 1024
 # In the name of write_text_atomic's temporary files, so that the ones a killed run left
 # can be told from anyone else's (see stale_temporaries).
 TEMP_MARK: Final = ".bt-lsp-"
@@ -68,10 +76,11 @@ _DECLARATION: Final = re.compile(
 class FileError(Exception):
     """A file that cannot be read, decoded or written; the message names the file."""
 
-    def __init__(self, path: str, message: str) -> None:
+    def __init__(self, path: str, message: str, reason: str | None = None) -> None:
         super().__init__(message)
         self.path = path
         self.message = message
+        self.reason = reason if reason is not None else message  # without the file's name
 
     def __str__(self) -> str:
         return self.message
@@ -204,28 +213,89 @@ def _kind(st: os.stat_result) -> str:
     return "not a file"
 
 
-def read_bytes(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[bytes, Stamp]:
-    """The bytes of ``path``, refusing anything larger than ``max_bytes``."""
+def _cannot(path: str, why: str) -> FileError:
+    return FileError(path, f"cannot read {path}: {why}", why)
+
+
+def _not_regular(path: str, st: os.stat_result) -> FileError:
+    why = f"not a regular file ({_kind(st)})"
+    return FileError(path, f"skipping {path}: {why}", why)
+
+
+def _open_regular(path: str) -> tuple[int, os.stat_result]:
+    """A descriptor of ``path`` opened for reading, and its status: only a regular file is
+    opened (a FIFO would block the open, a device may act on it), and without blocking (a
+    regular file of a pseudo file system such as ``/proc/kmsg`` may block a read)."""
     try:
-        # Opened without blocking, so that a FIFO with no writer does not hang the open;
-        # anything but a regular file is then refused.
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-        with open(fd, "rb") as f:
-            st = os.fstat(f.fileno())
-            if stat.S_ISDIR(st.st_mode):
-                raise FileError(path, f"cannot read {path}: Is a directory")
-            if not stat.S_ISREG(st.st_mode):
-                raise FileError(path, f"skipping {path}: not a regular file ({_kind(st)})")
-            if hasattr(os, "set_blocking"):
-                os.set_blocking(fd, True)
-            if st.st_size > max_bytes:
-                raise _too_large(path, st.st_size, max_bytes)
-            # A pipe or device reports no size: read one byte past the limit to notice.
-            data = f.read(max_bytes + 1)
-    except FileError:
-        raise
+        st = os.stat(path)
     except OSError as e:
-        raise FileError(path, f"cannot read {path}: {_reason(e)}") from None
+        raise _cannot(path, _reason(e)) from None
+    except ValueError as e:  # a path the OS cannot look up ("embedded null byte")
+        raise _cannot(path, str(e)) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise _cannot(path, "Is a directory")
+    if not stat.S_ISREG(st.st_mode):
+        raise _not_regular(path, st)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(path, flags | getattr(os, "O_BINARY", 0))
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    try:
+        st = os.fstat(fd)  # the name may lead elsewhere by now
+    except OSError as e:
+        os.close(fd)
+        raise _cannot(path, _reason(e)) from None
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise _not_regular(path, st)
+    return fd, st
+
+
+def _read_fd(fd: int, path: str, limit: int, hint: int) -> bytes:
+    """Up to ``limit`` bytes of the open file ``fd``; ``hint`` is its reported size.  A
+    read that would block (a pseudo file that waits for data) is an error."""
+    chunks: list[bytes] = []
+    total = 0
+    while total < limit:
+        want = min(limit - total, max(hint + 1 - total, 64 * 1024))
+        try:
+            chunk = os.read(fd, want)
+        except BlockingIOError:
+            why = "reading it would block (not an ordinary file)"
+            raise FileError(path, f"skipping {path}: {why}", why) from None
+        if not chunk:
+            break
+        chunks.append(chunk)
+        total += len(chunk)
+    return b"".join(chunks)
+
+
+def read_head(path: str, size: int) -> bytes:
+    """The first ``size`` bytes of ``path`` (fewer if it is shorter), read as
+    :func:`read_bytes` reads: never from anything but a regular file, never blocking."""
+    fd, st = _open_regular(path)
+    try:
+        return _read_fd(fd, path, size, min(st.st_size, size))
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    finally:
+        os.close(fd)
+
+
+def read_bytes(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> tuple[bytes, Stamp]:
+    """The bytes of ``path``, refusing anything larger than ``max_bytes``, anything but a
+    regular file, and a file whose read would block."""
+    fd, st = _open_regular(path)
+    try:
+        if st.st_size > max_bytes:
+            raise _too_large(path, st.st_size, max_bytes)
+        # A pseudo file reports no size: read one byte past the limit to notice.
+        data = _read_fd(fd, path, max_bytes + 1, st.st_size)
+    except OSError as e:
+        raise _cannot(path, _reason(e)) from None
+    finally:
+        os.close(fd)
     if len(data) > max_bytes:
         raise _too_large(path, None, max_bytes)
     return data, Stamp.of(st)
@@ -240,6 +310,29 @@ def read_text(path: str, max_bytes: int = DEFAULT_MAX_BYTES) -> Decoded:
     data, st = read_bytes(path, max_bytes)
     decoded = decode_bytes(data, path)
     return Decoded(decoded.text, decoded.encoding, decoded.bom, decoded.lossless, st)
+
+
+def not_replaceable(path: str) -> str | None:
+    """Why :func:`write_text_atomic` must not put a new file in place of ``path``
+    (``None``: it may): a read-only file would be rewritten all the same (the folder is
+    what a rename needs), and a file with hard links would be split (its other names
+    keep the old text).  Said in words for a note; a missing file is the write's to
+    report."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    mode = stat.S_IMODE(st.st_mode)
+    if not mode & 0o222:
+        return f"it is read-only (mode {mode:04o}); make it writable to have it fixed"
+    if not os.access(path, os.W_OK):
+        return f"this user may not write it (mode {mode:04o})"
+    if st.st_nlink > 1:
+        return (
+            f"it has {st.st_nlink} hard links; a fixed copy would leave the other "
+            "names with the old text"
+        )
+    return None
 
 
 def write_text_atomic(
@@ -269,6 +362,9 @@ def write_text_atomic(
         raise FileError(path, f"cannot write {path}: {_reason(e)}") from None
     if expect is not None and Stamp.of(st) != expect:
         raise FileError(path, f"cannot write {path}: it changed on disk while being checked")
+    why = not_replaceable(target)
+    if why is not None:
+        raise FileError(path, f"cannot write {path}: {why}")
     try:
         fd, tmp = tempfile.mkstemp(
             prefix=f".{os.path.basename(target)}{TEMP_MARK}", suffix=".tmp", dir=directory

@@ -4,7 +4,6 @@ in a stable order, and the folders that could not be searched."""
 from __future__ import annotations
 
 import os
-import stat
 from collections.abc import Callable, Iterable
 from typing import Final
 
@@ -22,9 +21,9 @@ Skip = Callable[[str, bool], bool]
 
 
 def _search(root: str, errors: list[FileError], skip: Skip | None = None) -> list[str]:
-    """Every ``*.xml`` file under ``root`` (regular files or links to them; hidden
-    files and folders and ``node_modules`` skipped, and what ``skip`` leaves out), sorted
-    by path components."""
+    """Every ``*.xml`` file under ``root`` (hidden files and folders and ``node_modules``
+    skipped, and the regular files ``skip`` leaves out), sorted by path components.  A
+    FIFO, socket or device named ``*.xml`` is kept, never opened: reading it reports it."""
 
     def onerror(e: OSError) -> None:
         where = e.filename if isinstance(e.filename, str) else root
@@ -45,15 +44,12 @@ def _search(root: str, errors: list[FileError], skip: Skip | None = None) -> lis
             path = os.path.join(dirpath, name)
             if root == os.curdir:
                 path = os.path.relpath(path)
+            # ``skip`` may sniff the file's first bytes: it never opens anything but a
+            # regular file (a FIFO would block the walk).  A FIFO, a socket, a device or a
+            # broken link is kept: reading it reports it.
             if skip is not None and skip(path, False):
                 continue
-            try:
-                st = os.stat(path)
-            except OSError:
-                found.append(path)  # a broken link: reported when it is read
-                continue
-            if stat.S_ISREG(st.st_mode):
-                found.append(path)
+            found.append(path)
     found.sort(key=lambda p: _part_key(p, root))
     return found
 

@@ -11,7 +11,7 @@ Nothing here ever fetches a URL or follows a DOCTYPE.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -34,6 +34,7 @@ from bt_lsp.rules.includes import (
     includes_itself,
     not_found,
 )
+from bt_lsp.rules.shared_context import SharedDecls
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
@@ -126,8 +127,12 @@ class ProjectIndex:
         configs: Configs | None = None,
         overrides: Layer | None = None,
         ament_prefix_path: Sequence[str] | None = None,
+        all_files: bool = False,
     ) -> None:
         self.roots = [normalize(r) for r in roots]
+        # Every file of the folders, not the first MAX_WORKSPACE_FILES: the command line
+        # reads every file it checks anyway, and a tree in a file left out is unknown.
+        self.all_files = all_files
         self.settings = settings or Settings()
         self.configs = configs if configs is not None else Configs()
         self.overrides = overrides
@@ -148,6 +153,13 @@ class ProjectIndex:
         self._includes: dict[Path, tuple[Model, Settings, list[Include]]] = {}
         self._paths: tuple[tuple[int, tuple[Path, ...]], list[Path]] | None = None
         self.generation = 0  # bumps whenever a file other than an edited open one changes
+        # The other documents combined once per set of catalogs left out (see _shared).
+        self._shared_stamp: tuple[object, ...] | None = None
+        self._shared_by_skip: dict[
+            frozenset[Path], tuple[SharedDecls, Mapping[Path, list[Path]]]
+        ] = {}
+        self._documents_by_name: dict[str, Document] | None = None
+        self._foreign_by_packages: dict[frozenset[Path], frozenset[str]] = {}
         # The C++ node catalogs (bt_lsp.project.cpp_models), when the caller reads C++.
         self.cpp: CppModels | None = None
 
@@ -171,6 +183,13 @@ class ProjectIndex:
         if doc is not None:
             return doc
         return self._read(path)[0]
+
+    def read_document(self, path: Path, text: str) -> Document | None:
+        """The document already read from disk at ``path`` if its text is ``text`` (never
+        reads): a caller that read the file itself parses it once."""
+        hit = self._disk.get(path)
+        doc = hit[1] if hit is not None else None
+        return doc if doc is not None and doc.text == text else None
 
     def read_error(self, path: Path) -> str | None:
         if path in self._open:
@@ -333,14 +352,15 @@ class ProjectIndex:
 
     def files(self) -> list[Path]:
         """Every BT XML file under the workspace folders and the model files from the
-        settings (sorted; a bounded number, skipping build and VCS folders)."""
+        settings (sorted; skipping build and VCS folders; at most MAX_WORKSPACE_FILES
+        unless ``all_files``)."""
         if self._files is None:
             found: set[Path] = set()
             self._folders = {}
             for root in self.roots:
                 for p in _walk_xml(root, self.is_excluded, self._folders):
                     found.add(p)
-                    if len(found) >= MAX_WORKSPACE_FILES:
+                    if len(found) >= MAX_WORKSPACE_FILES and not self.all_files:
                         break
             found.update(self.model_files())
             self._files = sorted(found)
@@ -458,16 +478,17 @@ class ProjectIndex:
 
     def context_for(self, path: Path, doc: Document) -> Context:
         """The rest of the workspace as ``doc`` (at ``path``) sees it: its include closure
-        (trees join its namespace) and every other BT file (models count)."""
+        (trees join its namespace) and every other BT file (models count).  The other
+        files are combined once for all the files that leave out the same catalogs
+        (:meth:`_shared`), so that a folder's check grows with its number of files."""
         closure = self.include_closure(path, doc)
         in_closure = set(closure)
-        others: list[tuple[str, Document, bool]] = []
         # BehaviorTree.CPP loads included documents depth-first before the includer.
+        included: list[tuple[str, Document]] = []
         for p in reversed(closure):
             d = self.document(p)
             if d is not None:
-                others.append((str(p), d, True))
-        included_by: list[str] = []
+                included.append((str(p), d))
         settings = self.settings_for(path)
         model_paths = self.model_catalogs(path)
         model_files: list[tuple[str, Document]] = []
@@ -488,27 +509,19 @@ class ProjectIndex:
         # Another workspace package's catalogs are not this document's unless it depends
         # on that package.
         skip.update(self.unrelated_catalogs(path))
-        mine = set(self.package_folders(path))
-        foreign: set[str] = set()
-        for p, d in self.bt_documents():
-            if p == path or p in in_closure or p in skip:
-                continue
-            others.append((str(p), d, False))
-            if mine and self._unrelated(p, mine):
-                foreign.add(str(p))
-            if any(inc.target == path for inc in self.includes(p, d)):
-                included_by.append(str(p))
+        shared, includers = self._shared(frozenset(skip))
+        included_by = [str(p) for p in includers.get(path, ()) if p not in in_closure]
         detected = self.btcpp_for(path, doc)
-        ctx = Context.combine(
+        ctx = shared.context(
             doc,
-            others,
+            included,
             path=str(path),
             ros_pkg_paths=self._ros_paths(path, doc, settings),
             model_files=model_files,
             ros_models=ros_models,
             included_by=included_by,
             btcpp_version=detected.version,
-            foreign=foreign,
+            foreign=self._foreign(path),
             btcpp_unclear=detected.conflict,
         )
         if self.cpp is not None:
@@ -516,6 +529,33 @@ class ProjectIndex:
                 ctx, path, settings, lambda name: self._dependency(name, settings)
             )
         return ctx
+
+    def _check_shared(self) -> None:
+        """Forget what :meth:`_shared` and :meth:`other_documents` made once a file
+        changed or an open document was edited."""
+        stamp = (self.generation, tuple(self._open), tuple(d.model for d in self._open.values()))
+        if self._shared_stamp is None or not _same(self._shared_stamp, stamp):
+            self._shared_by_skip.clear()
+            self._foreign_by_packages.clear()
+            self._documents_by_name = None
+            self._shared_stamp = stamp
+
+    def _shared(self, skip: frozenset[Path]) -> tuple[SharedDecls, Mapping[Path, list[Path]]]:
+        """The workspace's BT documents but ``skip``, combined once while none of them
+        changes, and who includes whom among them (the includers of each path, in order)."""
+        self._check_shared()
+        hit = self._shared_by_skip.get(skip)
+        if hit is not None:
+            return hit
+        docs = [(p, d) for p, d in self.bt_documents() if p not in skip]
+        includers: dict[Path, list[Path]] = {}
+        for p, d in docs:
+            for target in dict.fromkeys(i.target for i in self.includes(p, d)):
+                if target is not None and target != p:
+                    includers.setdefault(target, []).append(p)
+        made = (SharedDecls([(str(p), d) for p, d in docs]), includers)
+        self._shared_by_skip[skip] = made
+        return made
 
     def _dependency(self, name: str, settings: Settings) -> tuple[Manifest | None, list[Path]]:
         """A ROS package outside the workspace C++: its manifest and shipped catalogs."""
@@ -597,7 +637,22 @@ class ProjectIndex:
                 out.update(normalize(p) for p in self.ros.catalogs(folder))
         return out
 
-    def _unrelated(self, p: Path, mine: set[Path]) -> bool:
+    def _foreign(self, path: Path) -> frozenset[str]:
+        """The workspace's BT files whose models do not count for the file at ``path``:
+        those of packages its package neither is nor depends on (see :meth:`_unrelated`);
+        made once per package while no file changes, so that a folder's check stays
+        linear."""
+        mine = frozenset(self.package_folders(path))
+        if not mine:
+            return frozenset()
+        self._check_shared()
+        hit = self._foreign_by_packages.get(mine)
+        if hit is None:
+            hit = frozenset(str(p) for p, _ in self.bt_documents() if self._unrelated(p, mine))
+            self._foreign_by_packages[mine] = hit
+        return hit
+
+    def _unrelated(self, p: Path, mine: Collection[Path]) -> bool:
         """Whether the BT file ``p`` (its ``<TreeNodesModel>``, a Groot2 palette) belongs
         to a package outside ``mine`` (a package and its dependencies): its models then
         describe another package's nodes.  A file outside any package sees every model
@@ -658,7 +713,12 @@ class ProjectIndex:
     def other_documents(self, path: Path) -> dict[str, Document]:
         """The other BT documents of the workspace (open ones as edited), by path: what a
         rename or a name fix of the document at ``path`` reaches and checks."""
-        return {str(p): d for p, d in self.bt_documents() if p != path}
+        self._check_shared()
+        if self._documents_by_name is None:
+            self._documents_by_name = {str(p): d for p, d in self.bt_documents()}
+        out = dict(self._documents_by_name)  # copied whole (in C), then less one
+        out.pop(str(path), None)
+        return out
 
     def dependents(self, path: Path) -> list[Path]:
         """Open documents whose include closure contains ``path``."""
@@ -672,6 +732,14 @@ def _stamp(path: Path) -> tuple[int, int]:
     except (OSError, ValueError):
         return (0, 0)
     return (st.st_mtime_ns, st.st_size)
+
+
+def _same(a: tuple[object, ...], b: tuple[object, ...]) -> bool:
+    """Whether two stamps of :meth:`ProjectIndex._shared` are the same: equal generations
+    and open paths, and the same model objects (compared by identity)."""
+    return (
+        a[0] == b[0] and a[1] == b[1] and all(x is y for x, y in zip(a[2], b[2], strict=True))  # type: ignore[call-overload]
+    )
 
 
 def _short(p: Path, base: Path) -> str:

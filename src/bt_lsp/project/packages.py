@@ -23,6 +23,8 @@ from typing import Final
 
 from lxml import etree
 
+from bt_lsp.project.fileio import FileError, read_head
+
 __all__ = [
     "BTCPP_PACKAGES",
     "NOT_DETECTED",
@@ -93,9 +95,8 @@ class Manifest:
 
 def _read_bytes(path: Path, limit: int) -> bytes | None:
     try:
-        with open(path, "rb") as f:
-            data = f.read(limit + 1)
-    except (OSError, ValueError):
+        data = read_head(str(path), limit + 1)  # a FIFO or a device is never opened
+    except FileError:
         return None
     return data if len(data) <= limit else None
 

@@ -8,10 +8,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final, Protocol, TypeVar
 
+from bt_lsp.project.fileio import DEFAULT_MAX_BYTES
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.registry import CODES
 
-DEFAULT_MAX_DOCUMENT_BYTES = 8 * 1024 * 1024
+# The same limit as the command line's (see fileio.DEFAULT_MAX_BYTES).
+DEFAULT_MAX_DOCUMENT_BYTES: Final = DEFAULT_MAX_BYTES
 MAX_DEBOUNCE_MS = 60_000
 # What ``btcpp`` may be: detect the version, or BehaviorTree.CPP 3.x / 4.x.
 BTCPP_CHOICES: Final = ("auto", "3", "4")

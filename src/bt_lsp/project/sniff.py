@@ -8,6 +8,7 @@ import codecs
 from pathlib import Path
 from typing import Final
 
+from bt_lsp.project.fileio import FileError, read_head
 from bt_lsp.syntax.kind import HEAD_CHARS, looks_like_bt, top_element
 
 __all__ = ["SNIFF_BYTES", "head_of", "is_bt_file", "top_element"]
@@ -24,11 +25,11 @@ _BOMS: Final = (
 
 
 def head_of(path: Path | str, size: int = SNIFF_BYTES) -> str | None:
-    """The first ``size`` bytes of a file as text (``None`` if it cannot be read)."""
+    """The first ``size`` bytes of a file as text (``None`` if it cannot be read, or is
+    not a regular file: a FIFO or a device is never opened, and no read blocks)."""
     try:
-        with open(path, "rb") as f:
-            data = f.read(size)
-    except (OSError, ValueError):
+        data = read_head(str(path), size)
+    except FileError:
         return None
     for bom, enc in _BOMS:
         if data.startswith(bom):

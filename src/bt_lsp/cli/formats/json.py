@@ -1,5 +1,6 @@
 """The ``json`` format: one array of ``{path, line, column, endLine, endColumn, severity,
-code, message}``."""
+code, message}``; a configuration file that cannot be used is a ``config-error`` entry
+at its position."""
 
 from __future__ import annotations
 

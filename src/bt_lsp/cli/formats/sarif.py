@@ -74,6 +74,16 @@ def to_sarif(results: Sequence[FileResult], root: str | None = None) -> dict[str
                     "locations": [{"physicalLocation": {"artifactLocation": location}}],
                 }
             )
+        if r.config:  # the run went on without that configuration: say so
+            notifications.extend(
+                {
+                    "level": "error",
+                    "message": {"text": f"{f.message} (the file's settings were not used)"},
+                    "descriptor": {"id": f.code},
+                    "locations": [{"physicalLocation": {"artifactLocation": location}}],
+                }
+                for f in r.findings
+            )
         seen: Counter[tuple[str, str]] = Counter()
         for f in r.findings:
             nth = seen[(f.code, f.token)]
