@@ -160,7 +160,10 @@ def test_whole_run_on_a_fake_projects_dir(tmp_path: Path) -> None:
     """A project whose only finding is triaged passes; the JSON summary says so."""
     project = tmp_path / "projects" / "demo"
     project.mkdir(parents=True)
-    (project / "config.xml").write_text("<profiles><a/></profiles>\n", encoding="utf-8")
+    (project / "config.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Sleepy"><Sleep/></BehaviorTree></root>\n',
+        encoding="utf-8",
+    )
     (project / "tree.xml").write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="Main"><AlwaysSuccess/></BehaviorTree></root>\n',
         encoding="utf-8",
@@ -168,7 +171,7 @@ def test_whole_run_on_a_fake_projects_dir(tmp_path: Path) -> None:
     triage = tmp_path / "triage.tsv"
     triage.write_text(
         HEADER
-        + "demo\tconfig.xml\t1\troot-element\tfalse\tclass: non-BT XML\n"
+        + "demo\tconfig.xml\t1\tmissing-required-port\tfalse\tclass: a test of the script\n"
         + "demo\tgone.xml\t1\tunknown-node\ttrue\tstale\n",
         encoding="utf-8",
     )
@@ -182,4 +185,6 @@ def test_whole_run_on_a_fake_projects_dir(tmp_path: Path) -> None:
     triage.write_text(HEADER, encoding="utf-8")
     template = tmp_path / "todo.tsv"
     assert eco.main([*args, "--write-template", str(template)]) == 1
-    assert "demo\tconfig.xml\t1\troot-element\tTODO" in template.read_text(encoding="utf-8")
+    assert "demo\tconfig.xml\t1\tmissing-required-port\tTODO" in template.read_text(
+        encoding="utf-8"
+    )
