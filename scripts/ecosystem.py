@@ -176,13 +176,18 @@ _REGISTER = re.compile(
 _LITERAL = re.compile(r'"([A-Za-z_][\w.:/-]*)"')
 
 
+# A C++ comment (a string holding // is rare in registration code; the count errs towards
+# "registered" anyway).
+_COMMENT = re.compile(r"//[^\n]*|/\*.*?\*/", re.DOTALL)
+
+
 def registered_literals(root: Path) -> set[str]:
     """String literals that appear in a registration call of the project's C++.
 
     A grep, not a parse: after every ``register*`` / ``BT_REGISTER*`` /
     ``CreateRosNodePlugin`` token, the literals up to the next ``;`` (at most 400
-    characters). It errs towards "registered": it serves only to count the unknown-node
-    hints whose node the project itself registers.
+    characters), comments left out. It errs towards "registered": it serves only to count
+    the unknown-node hints whose node the project itself registers.
     """
     names: set[str] = set()
     for dirpath, _dirs, files in os.walk(root):
@@ -193,6 +198,7 @@ def registered_literals(root: Path) -> set[str]:
                 text = (Path(dirpath) / name).read_text(encoding="utf-8", errors="replace")
             except OSError:
                 continue
+            text = _COMMENT.sub(" ", text)
             for m in _REGISTER.finditer(text):
                 window = text[m.end() : m.end() + 400]
                 window = window.split(";", 1)[0]
