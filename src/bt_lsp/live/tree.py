@@ -165,5 +165,7 @@ def _node(
             _node(blocks, c, prefix, nodes, used, depth + 1) for c in el if isinstance(c.tag, str)
         )
         node = LiveNode(uid, tag, name, f"{prefix}/{name}" if prefix else name, None, kids)
+    if uid in nodes:  # a descendant had it
+        raise ProtocolError(f"two nodes have _uid {uid}")
     nodes[uid] = node
     return node
