@@ -15,6 +15,7 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -30,8 +31,10 @@ from bt_lsp.live.protocol import (
     ExecutorError,
     Hook,
     HookMode,
+    NodeState,
     NodeStatus,
     Position,
+    ProtocolError,
     RequestType,
     Resume,
     hook_insert_payload,
@@ -330,11 +333,15 @@ def test_every_payload_the_client_builds_is_accepted(client: Groot2Client) -> No
             payload = unlock_payload(value[0], value[1], Position.PRE, value[2])
         # "Node ID not found" is an answer too: parsed, and refused.
         with contextlib.suppress(ExecutorError):
-            client.request(kind, payload)
+            client._request(kind, payload)
         client.remove_all_hooks()
 
     send()
     assert len(client.status()) == len(tree.nodes)
+    with pytest.raises(ValueError):
+        client._request(RequestType.BREAKPOINT_UNLOCK)  # never without its payload
+    with pytest.raises(ValueError):
+        client._request(RequestType.STATUS, b"x")
 
 
 def test_monitor_once_prints_the_tree_with_statuses(
@@ -402,3 +409,64 @@ def test_figures(port: int) -> None:
             print(f"executor CPU: {100 * idle:.2f}% unpolled, {100 * busy:.2f}% polled")
     finally:
         ex.kill()
+
+
+class FakeExecutor:
+    """A hostile Groot2 server on 127.0.0.1: each request gets the next canned answer,
+    built from the request's own header (so only the body is wrong)."""
+
+    def __init__(self, port: int, answers: list[Any]) -> None:
+        import threading
+
+        import zmq
+
+        self.ctx = zmq.Context()
+        self.sock = self.ctx.socket(zmq.REP)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.bind(f"tcp://127.0.0.1:{port}")
+        self.answers = answers
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        import zmq
+
+        for answer in self.answers:
+            if not self.sock.poll(5000):
+                return
+            [head, *_] = self.sock.recv_multipart()
+            try:
+                self.sock.send_multipart(answer(head))
+            except zmq.ZMQError:
+                return
+
+    def close(self) -> None:
+        self.thread.join(6)
+        self.sock.close(0)
+        self.ctx.term()
+
+
+def test_hostile_replies_are_errors_and_the_client_goes_on(port: int) -> None:
+    uuid = b"u" * 16
+    good_status = b"\x01\x00\x02"
+    answers = [
+        lambda h: [h + uuid, b"\x01\x00"],  # a status buffer cut short
+        lambda h: [h[:2] + b"\x00\x00\x00\x00" + uuid, good_status],  # another request's id
+        lambda h: [h + uuid, b"a", b"b", b"c"],  # too many parts
+        lambda h: [h + uuid, b"<root><BehaviorTree"],  # FULLTREE: broken XML
+        lambda h: [h + uuid, b"x" * 5000],  # over the client's size cap: dropped by ZeroMQ
+        lambda h: [h + uuid, good_status],
+    ]
+    fake = FakeExecutor(port, answers)
+    try:
+        with Groot2Client("127.0.0.1", port, timeout=1.0, max_message_bytes=4096) as c:
+            for _ in range(3):
+                with pytest.raises(ProtocolError):
+                    c.status()
+            with pytest.raises(ProtocolError):
+                c.read_tree()
+            with pytest.raises((ConnectionLost, Timeout)):
+                c.status()
+            assert c.status() == {1: NodeState(NodeStatus.SUCCESS)}
+    finally:
+        fake.close()

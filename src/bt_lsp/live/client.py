@@ -58,6 +58,17 @@ from bt_lsp.live.tree import LiveTree, parse_tree_xml
 DEFAULT_TIMEOUT: Final = 1.0
 MAX_MESSAGE_BYTES: Final = 64 * 1024 * 1024
 _EVENTS: Final = zmq.EVENT_CONNECTED | zmq.EVENT_DISCONNECTED
+# The requests sent as a header alone (the executor ignores extra parts of these).
+_BARE: Final = frozenset(
+    {
+        RequestType.FULLTREE,
+        RequestType.STATUS,
+        RequestType.HOOKS_DUMP,
+        RequestType.REMOVE_ALL_HOOKS,
+        RequestType.DISABLE_ALL_HOOKS,
+        RequestType.GET_TRANSITIONS,
+    }
+)
 
 
 class Timeout(LiveError):
@@ -159,11 +170,12 @@ class Groot2Client:
 
     # ------------------------------------------------------------------ requests
 
-    def request(self, kind: RequestType, payload: bytes | None = None) -> Reply:
+    def _request(self, kind: RequestType, payload: bytes | None = None) -> Reply:
         """Send one request and wait for its checked reply (Timeout, ConnectionLost,
-        ExecutorError, ProtocolError).  Payloads come from ``protocol``'s builders."""
-        if kind is RequestType.BREAKPOINT_REACHED:
-            raise ValueError("BREAKPOINT_REACHED is the executor's notification")
+        ExecutorError, ProtocolError).  Private: payloads come only from ``protocol``'s
+        builders, through the typed methods below."""
+        if kind is RequestType.BREAKPOINT_REACHED or (payload is None) != (kind in _BARE):
+            raise ValueError(f"{kind.name} {'takes no' if kind in _BARE else 'needs a'} payload")
         if self._req is None:
             self._open_req()
         assert self._req is not None and self._monitor is not None
@@ -218,22 +230,22 @@ class Groot2Client:
 
     def read_tree(self) -> LiveTree:
         """FULLTREE: the running tree with every node's uid."""
-        reply = self.request(RequestType.FULLTREE)
+        reply = self._request(RequestType.FULLTREE)
         return parse_tree_xml(self._body(reply, RequestType.FULLTREE))
 
     def status(self) -> dict[int, NodeState]:
         """STATUS: every node's current status, by uid."""
-        return decode_status(self._body(self.request(RequestType.STATUS), RequestType.STATUS))
+        return decode_status(self._body(self._request(RequestType.STATUS), RequestType.STATUS))
 
     def blackboards(self, names: Sequence[str]) -> dict[str, Any]:
         """BLACKBOARD: the entries of the named blackboards (``LiveTree.blackboards``);
         unknown names are left out of the answer."""
-        reply = self.request(RequestType.BLACKBOARD, blackboard_payload(names))
+        reply = self._request(RequestType.BLACKBOARD, blackboard_payload(names))
         return decode_blackboards(self._body(reply, RequestType.BLACKBOARD))
 
     def insert_hooks(self, hooks: Hook | Sequence[Hook]) -> None:
         """HOOK_INSERT (a hook on an unknown uid is silently dropped by the executor)."""
-        self.request(RequestType.HOOK_INSERT, hook_insert_payload(hooks))
+        self._request(RequestType.HOOK_INSERT, hook_insert_payload(hooks))
 
     def set_breakpoint(self, uid: int, *, once: bool = False) -> None:
         """A PRE breakpoint: the tree stops before ticking node ``uid`` until unlocked."""
@@ -245,19 +257,19 @@ class Groot2Client:
 
     def remove_hook(self, uid: int, position: Position = Position.PRE) -> None:
         """HOOK_REMOVE (releases the tree if it waits there); ExecutorError if none."""
-        self.request(RequestType.HOOK_REMOVE, hook_remove_payload(uid, position))
+        self._request(RequestType.HOOK_REMOVE, hook_remove_payload(uid, position))
 
     def hooks(self) -> list[Hook]:
         """HOOKS_DUMP: the hooks in place."""
         return decode_hooks(
-            self._body(self.request(RequestType.HOOKS_DUMP), RequestType.HOOKS_DUMP)
+            self._body(self._request(RequestType.HOOKS_DUMP), RequestType.HOOKS_DUMP)
         )
 
     def remove_all_hooks(self) -> None:
-        self.request(RequestType.REMOVE_ALL_HOOKS)
+        self._request(RequestType.REMOVE_ALL_HOOKS)
 
     def disable_all_hooks(self) -> None:
-        self.request(RequestType.DISABLE_ALL_HOOKS)
+        self._request(RequestType.DISABLE_ALL_HOOKS)
 
     def unlock(
         self,
@@ -269,19 +281,19 @@ class Groot2Client:
     ) -> None:
         """BREAKPOINT_UNLOCK: let the tree go on from node ``uid``'s breakpoint: tick the
         node (CONTINUE) or make it return SUCCESS or FAILURE without ticking."""
-        self.request(RequestType.BREAKPOINT_UNLOCK, unlock_payload(uid, result, position, remove))
+        self._request(RequestType.BREAKPOINT_UNLOCK, unlock_payload(uid, result, position, remove))
 
     def start_recording(self) -> int:
         """TOGGLE_RECORDING start: the executor's clock (microseconds since the epoch)."""
-        reply = self.request(RequestType.TOGGLE_RECORDING, recording_payload(True))
+        reply = self._request(RequestType.TOGGLE_RECORDING, recording_payload(True))
         return decode_timestamp(self._body(reply, RequestType.TOGGLE_RECORDING))
 
     def stop_recording(self) -> None:
-        self.request(RequestType.TOGGLE_RECORDING, recording_payload(False))
+        self._request(RequestType.TOGGLE_RECORDING, recording_payload(False))
 
     def transitions(self) -> list[Transition]:
         """GET_TRANSITIONS: what changed since the last call (the executor keeps 1000)."""
-        reply = self.request(RequestType.GET_TRANSITIONS)
+        reply = self._request(RequestType.GET_TRANSITIONS)
         return decode_transitions(self._body(reply, RequestType.GET_TRANSITIONS))
 
     # ------------------------------------------------------------------ notifications
