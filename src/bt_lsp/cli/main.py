@@ -13,6 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from bt_lsp import __version__
+from bt_lsp.cli import live
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES
 
 _UNITS = {"": 1, "k": 1024, "m": 1024**2, "g": 1024**3}
@@ -188,6 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="DIR",
         help="the folder whose files count as the workspace (default: the file's folder)",
     )
+    live.add_parsers(sub)
     return parser
 
 
@@ -255,6 +257,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
         if args.command == "render":
             return _render(args)
+        if args.command == "replay":
+            return live.replay(args.file, format=args.format, node=args.node)
+        if args.command == "monitor":
+            return live.monitor(
+                args.address,
+                rate=args.rate,
+                once=args.once,
+                plain=args.plain,
+                blackboard=args.blackboard,
+                timeout=args.timeout,
+                duration=args.duration,
+            )
         parser.print_help(sys.stderr)
         return 2
     except SystemExit as e:
