@@ -80,8 +80,9 @@ XML = "xml"
 BT = "behaviortree"
 PROJECT = "project"
 
-# Every code defined so far, by name (the registry imports every module that defines one).
-_DEFINED: dict[str, Code] = {}
+# Every code defined so far, by name (the registry imports every module that defines one,
+# then calls freeze(): a read-only view from then on).
+_DEFINED: Mapping[str, Code] = {}
 
 
 def define(
@@ -92,13 +93,26 @@ def define(
     *,
     fixes: Mapping[str, str] | None = None,
 ) -> Code:
-    """Define (and register) a code; a name defined twice is a programming error."""
-    if code in _DEFINED:
+    """Define (and register) a code; a name defined twice is a programming error, and so
+    is a code defined once the registry is complete (after :func:`freeze`)."""
+    table = _DEFINED
+    if not isinstance(table, dict):
+        raise RuntimeError(
+            f"diagnostic code {code!r} is defined after the registry was complete:"
+            " import its module from bt_lsp.rules.registry"
+        )
+    if code in table:
         raise ValueError(f"diagnostic code {code!r} is defined twice")
-    found = _DEFINED[code] = Code(
-        code, severity, summary, family, MappingProxyType(dict(fixes or {}))
-    )
+    found = table[code] = Code(code, severity, summary, family, MappingProxyType(dict(fixes or {})))
     return found
+
+
+def freeze() -> None:
+    """Make the registry read-only: every module that defines a code was imported
+    (:mod:`bt_lsp.rules.registry` calls it once it imported them all)."""
+    global _DEFINED
+    if isinstance(_DEFINED, dict):
+        _DEFINED = MappingProxyType(dict(_DEFINED))
 
 
 def defined(code: str) -> Code:
@@ -108,4 +122,5 @@ def defined(code: str) -> Code:
 
 def all_defined() -> Mapping[str, Code]:
     """Every code defined so far (see :mod:`bt_lsp.rules.registry` for all of them)."""
-    return MappingProxyType(_DEFINED)
+    table = _DEFINED
+    return MappingProxyType(table) if isinstance(table, dict) else table

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Final, Literal
 
 from bt_lsp.rules.builtins import BUILTINS, Category, NodeModel, PortModel
@@ -97,9 +98,9 @@ def resolve_builtin(type_id: str) -> Resolved | None:
     )
 
 
-_BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
-    k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None
-}
+_BUILTIN_RESOLVED: Final[Mapping[str, Resolved]] = MappingProxyType(
+    {k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None}
+)
 
 
 def _resolve_v3(m: NodeModel) -> Resolved:
@@ -113,9 +114,9 @@ def _resolve_v3(m: NodeModel) -> Resolved:
 
 
 #: The built-ins of a BehaviorTree.CPP 3.8 factory (see :mod:`bt_lsp.rules.builtins_v3`).
-_BUILTIN_RESOLVED_V3: Final[dict[str, Resolved]] = {
-    k: _resolve_v3(m) for k, m in V3_BUILTINS.items()
-}
+_BUILTIN_RESOLVED_V3: Final[Mapping[str, Resolved]] = MappingProxyType(
+    {k: _resolve_v3(m) for k, m in V3_BUILTINS.items()}
+)
 
 
 # When ``State.out`` holds this many diagnostics, it is cut to the first MAX_DIAGNOSTICS.
