@@ -18,7 +18,7 @@ from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.syntax.elements import Element, NameRef, Role, Symbol, Zone
 from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.nametokens import name_refs
+from bt_lsp.syntax.nametokens import SymbolPool, name_refs
 from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
 from bt_lsp.syntax.tokens import Token
@@ -152,13 +152,15 @@ class NameMemo:
     type or port), and a dict keyed by the text alone is the cheapest lookup.  Instance
     names rarely repeat and their rule is quick: they are not kept (they would cost memory
     in proportion to the documents).  ``tags``: what the name rules find in a start tag
-    (:data:`_TagNames`), by tag and zone.  Both bounded."""
+    (:data:`_TagNames`), by tag and zone; ``symbols``: the symbols of their names.  All
+    bounded."""
 
-    __slots__ = ("tags", "violations")
+    __slots__ = ("symbols", "tags", "violations")
 
     def __init__(self) -> None:
         self.violations: dict[Role, dict[str, tuple[Violation, ...]]] = {r: {} for r in Role}
         self.tags: dict[int, tuple[Token, _TagNames]] = {}
+        self.symbols = SymbolPool()
 
 
 _MAX_CACHED = 4096
@@ -266,7 +268,7 @@ _NAMELESS: Final = frozenset({Zone.MODELS, Zone.INCLUDE, Zone.OTHER, Zone.OUTSID
 def _tag_names(el: Element, parent: Element | None, memo: NameMemo) -> _TagNames:
     """What the name rules find in ``el``'s start tag (see :data:`_TagNames`)."""
     refs: list[NameRef] = []
-    name_refs(el, 0, parent, refs)
+    name_refs(el, 0, parent, refs, memo.symbols)
     ts = el.token_start
     found: list[tuple[int, int, str, str, Severity, NameData]] = []
     symbols: dict[Symbol, None] = {}
