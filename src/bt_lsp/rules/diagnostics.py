@@ -69,7 +69,7 @@ TOO_MANY_ATTRIBUTES: Final = define(
 TOO_MANY_PROBLEMS: Final = define(
     "too-many-problems",
     Severity.INFORMATION,
-    "more problems than a client can usefully show; only the first are reported",
+    "more problems than a client can usefully show; only the most severe are reported",
     XML,
 )
 
@@ -98,8 +98,9 @@ MAX_DIAGNOSTICS = 2000
 
 
 class Capped(list[Diagnostic]):
-    """Diagnostics sorted by position, at most :data:`MAX_DIAGNOSTICS` of them (the first),
-    and in ``more`` how many others were found and not kept.  What lies beyond the
+    """Diagnostics sorted by position, at most :data:`MAX_DIAGNOSTICS` of them (the most
+    severe, the first by position among equals: :func:`cap_key`), and in ``more`` how many
+    others were found and not kept.  What lies beyond the
     publication cap is never published, so it is not kept either: a hostile document has
     hundreds of thousands of findings, each costing more memory than its text."""
 
@@ -110,8 +111,6 @@ class Capped(list[Diagnostic]):
         self.more = more
 
 
-#: What a source without findings keeps: one object for them all (most sections of a large
-#: document have none).  Results of :func:`capped` are read, never changed.
 class _NoDiagnostics(Capped):
     """The empty result, shared: it refuses to grow (it is read, never changed)."""
 
@@ -123,6 +122,8 @@ class _NoDiagnostics(Capped):
     append = extend = insert = __setitem__ = __iadd__ = __imul__ = _refuse
 
 
+#: What a source without findings keeps: one object for them all (most sections of a large
+#: document have none).  Results of :func:`capped` are read, never changed.
 NO_DIAGNOSTICS: Final = _NoDiagnostics()
 
 
@@ -132,14 +133,16 @@ def more_of(diags: Iterable[Diagnostic]) -> int:
 
 
 def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTICS) -> Capped:
-    """``diags`` sorted by position (stable), the first ``maximum`` kept; ``more``: how
-    many were already left out before."""
+    """``diags`` sorted by position (stable), the ``maximum`` first by :func:`cap_key`
+    kept (errors before warnings before hints); ``more``: how many were already left out
+    before."""
     if not diags and not more:
         return NO_DIAGNOSTICS
-    diags.sort(key=sort_key)
     if len(diags) > maximum:
+        diags.sort(key=cap_key)
         more += len(diags) - maximum
         del diags[maximum:]
+    diags.sort(key=sort_key)
     return Capped(diags, more)
 
 
@@ -243,6 +246,13 @@ def sort_key(d: Diagnostic) -> tuple[int, int, str]:
     return d.start, d.end, d.code
 
 
+def cap_key(d: Diagnostic) -> tuple[int, int, int, str]:
+    """Which diagnostics the cap keeps first: by severity (errors, then warnings, then
+    information, then hints), then by position: a thousand hints never push an error
+    out."""
+    return d.severity, d.start, d.end, d.code
+
+
 def _own(section: Section, memo: NameMemo) -> Capped:
     """The diagnostics of one section (in its coordinates), computed once; the first
     :data:`MAX_DIAGNOSTICS` are kept."""
@@ -291,8 +301,8 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic], memo: Nam
     """Add the name-rule diagnostics of ``section`` to ``out`` and note the section's
     symbols (:meth:`Section.symbols`) on the way.  Each distinct start tag is checked once
     (equal tags are one token); once ``out`` holds twice :data:`MAX_DIAGNOSTICS`, only the
-    first by position are kept and later findings past them are counted, not made: the
-    count returned.
+    first by severity, then position, are kept and later findings past them are counted,
+    not made: the count returned.
 
     The section's rows are told apart by tag and zone in C, from its columns, and only
     those whose tag has findings are read one by one (a document may be a million
@@ -352,15 +362,16 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic], memo: Nam
 
 class _Placer:
     """Places a tag's findings (:data:`_TagNames`) at its start into ``out``, keeping the
-    first :data:`MAX_DIAGNOSTICS` by position: once ``out`` holds twice as many, the rest
-    are cut, and later findings past the last kept are counted (``more``), not made."""
+    first :data:`MAX_DIAGNOSTICS` by :func:`cap_key`: once ``out`` holds twice as many, the
+    rest are cut, and later findings past the last kept are counted (``more``), not
+    made."""
 
     __slots__ = ("limit", "more", "out")
 
     def __init__(self, out: list[Diagnostic]) -> None:
         self.out = out
         self.more = 0
-        self.limit: tuple[int, int, str] | None = None
+        self.limit: tuple[int, int, int, str] | None = None
 
     def place(
         self, ts: int, findings: tuple[tuple[int, int, str, str, Severity, NameData], ...]
@@ -369,15 +380,15 @@ class _Placer:
         for rs, re_, code, message, severity, data in findings:
             start, end = ts + rs, ts + re_
             limit = self.limit
-            if limit is not None and (start, end, code) >= limit:
+            if limit is not None and (severity, start, end, code) >= limit:
                 self.more += 1  # past the first MAX_DIAGNOSTICS found: never kept
                 continue
             out.append(Diagnostic(start, end, code, message, severity, data))
             if len(out) >= 2 * MAX_DIAGNOSTICS:
-                out.sort(key=sort_key)  # stable: the first found first among equals
+                out.sort(key=cap_key)  # stable: the first found first among equals
                 self.more += len(out) - MAX_DIAGNOSTICS
                 del out[MAX_DIAGNOSTICS:]
-                self.limit = sort_key(out[-1])
+                self.limit = cap_key(out[-1])
 
 
 _PORT_DECL: Final = int(Zone.PORT_DECL)
@@ -483,19 +494,25 @@ def with_severities(
 def limited(
     diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS, more: int = 0
 ) -> list[Diagnostic]:
-    """At most ``maximum`` diagnostics (the first by position), plus one that says how many
-    were left out (``more`` of them before ``diags`` was made): hostile or binary input
-    must not flood the client."""
+    """At most ``maximum`` diagnostics (the most severe, the first by position among
+    equals: :func:`cap_key`), in the order of ``diags``, plus one that says how many were
+    left out (``more`` of them before ``diags`` was made): hostile or binary input must
+    not flood the client, and hints must not push an error out."""
     left_out = len(diags) + more - maximum
     if left_out <= 0:
         return diags
-    kept = diags[:maximum]
+    if len(diags) > maximum:
+        chosen = set(map(id, sorted(diags, key=cap_key)[:maximum]))
+        kept = [d for d in diags if id(d) in chosen]
+    else:
+        kept = list(diags)
     kept.append(
         make(
             0,
             0,
             TOO_MANY_PROBLEMS.code,
-            f"{left_out} more problems are not shown (only the first {maximum} are reported)",
+            f"{left_out} more problems are not shown (only {maximum} are reported:"
+            " errors first, then warnings, information and hints)",
         )
     )
     return kept
@@ -503,7 +520,8 @@ def limited(
 
 def own_diagnostics(doc: Document) -> Capped:
     """The diagnostics of ``doc`` alone (lexical, XML structure, names), kept on it until
-    its next edit: the first :data:`MAX_DIAGNOSTICS`, with how many more there are."""
+    its next edit: the first :data:`MAX_DIAGNOSTICS` by :func:`cap_key`, with how many
+    more there are."""
     found = doc.own_diagnostics
     if not isinstance(found, Capped):
         found = doc.own_diagnostics = compute(doc)
