@@ -16,7 +16,6 @@ from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.syntax.elements import Element, NameRef, Role, Symbol, Zone
-from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.nametokens import SymbolPool, name_refs
 from bt_lsp.syntax.scanner import Scan
@@ -533,7 +532,7 @@ def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
     names, which stay cheap) and ``document-too-large`` saying the rest does not run.
     Capped like every other path, and found with the cyclic collector paused: hostile
     input has the most problems."""
-    own = with_gc_paused(own_diagnostics)(doc)
+    own = own_diagnostics(doc)
     out = list(limited(own, more=own.more))
     out.append(
         make(

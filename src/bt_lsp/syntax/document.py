@@ -22,7 +22,6 @@ from types import MappingProxyType
 from typing import Any, Final
 
 from bt_lsp.syntax.builder import build
-from bt_lsp.syntax.gcpause import gc_paused, with_gc_paused
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
 from bt_lsp.syntax.text import LineIndex
@@ -73,7 +72,6 @@ class History:
 
 
 class Document:
-    @with_gc_paused
     def __init__(self, text: str, path: str | None = None, *, scanned: bool = True) -> None:
         self.path = path
         self.text = text
@@ -111,8 +109,7 @@ class Document:
         tokens = self._scan
         if tokens is None:
             text = self.text
-            with gc_paused():
-                tokens = scan(text)
+            tokens = scan(text)
             if self.text is text:
                 self._scan = tokens
         return tokens
@@ -215,8 +212,7 @@ class Document:
                 tokens = self.scan
             state = tokens, self.text, self._base, self._change
             edits = self._edits
-        with gc_paused():
-            model = build(*state)
+        model = build(*state)
         with self._lock:
             if self._edits == edits and self._model is None:
                 self._model = model

@@ -25,7 +25,6 @@ from bt_lsp.syntax.elements import (
     Symbol,
     Zone,
 )
-from bt_lsp.syntax.gcpause import gc_paused
 from bt_lsp.syntax.sections import Part, Section, SectionRefs, section_top
 from bt_lsp.syntax.table import ElementTable, Prefixed
 
@@ -196,8 +195,7 @@ class Model:
             self._refs = self.local.refs
         if self._refs is None:
             parts = self.parts()
-            with gc_paused():
-                local = [p.section.refs for p in parts]
+            local = [p.section.refs for p in parts]
             bases = [0, *accumulate(map(len, local))]
             self._refs = _Lazy(bases[-1], bases[:-1], lambda c, j: parts[c].ref(local[c][j]))
         return self._refs
@@ -255,9 +253,8 @@ class Model:
         """Every symbol's references in document order (built once, on first use)."""
         if self._by_symbol is None:
             if self.head is not None:
-                with gc_paused():
-                    chunks = [(p, p.section.symbols()) for p in self.parts()]
-                    self._by_symbol = _SymbolIndex(chunks, self._held)
+                chunks = [(p, p.section.symbols()) for p in self.parts()]
+                self._by_symbol = _SymbolIndex(chunks, self._held)
             else:
                 index: dict[Symbol, list[NameRef]] = {}
                 for r in self.refs:
