@@ -408,11 +408,13 @@ def phase_seconds(text: str, path: Path) -> dict[str, float]:
     from bt_lsp.rules import semantics
     from bt_lsp.rules.diagnostics import own_diagnostics
     from bt_lsp.rules.early_names import early_name_diagnostics
+    from bt_lsp.server import GC_THRESHOLD
     from bt_lsp.syntax.document import Document
 
     ws = ProjectIndex([str(path.parent)])
     gc.collect()
-    gc.disable()  # as the server does for these phases (bt_lsp.syntax.gcpause)
+    threshold = gc.get_threshold()
+    gc.set_threshold(GC_THRESHOLD, 10, 10)  # as the server does (bt_lsp.server.serve)
     try:
         t_early = time.perf_counter()
         early_name_diagnostics(text)
@@ -429,7 +431,7 @@ def phase_seconds(text: str, path: Path) -> dict[str, float]:
         semantics.check(doc, ctx)
         t5 = time.perf_counter()
     finally:
-        gc.enable()
+        gc.set_threshold(*threshold)
     times = (t0 - t_early, t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4)
     return dict(zip(PHASES, times, strict=True))
 

@@ -21,16 +21,17 @@ END = "</Sequence>\n</BehaviorTree>\n</root>\n"
 PAIR = "<Frob/><Fr.ob/>"
 
 
-def test_the_first_diagnostics_by_position_are_kept_from_both_sources() -> None:
+def test_the_most_severe_diagnostics_are_kept_from_both_sources() -> None:
+    """Errors before hints, then the first by position: the bad names (errors, of the
+    document's own diagnostics) push out the unknown node types (hints, semantic)."""
     n = 3000  # 6,000 findings: more than twice the cap in each source
     doc = Document(TREE + PAIR * n + END)
     diags = analyze(doc)
     assert len(diags) == MAX_DIAGNOSTICS + 1
     first = len(TREE)
     expected = []
-    for k in range(MAX_DIAGNOSTICS // 2):
+    for k in range(MAX_DIAGNOSTICS):
         at = first + k * len(PAIR)
-        expected.append((at + 1, at + 5, "unknown-node"))
         expected.append((at + 8, at + 13, "model-name-forbidden-char"))
     assert [(d.start, d.end, d.code) for d in diags[:-1]] == expected
     assert diags[-1].code == "too-many-problems"
@@ -57,7 +58,7 @@ def test_an_edit_keeps_the_count_right() -> None:
     doc.edit(at, at + len(PAIR), "")  # one pair fewer, before the cap
     diags = analyze(doc)
     assert diags[-1].message.startswith(f"{2 * (n - 1) - MAX_DIAGNOSTICS} more problems")
-    assert [d.code for d in diags[:4]] == ["unknown-node", "model-name-forbidden-char"] * 2
+    assert [d.code for d in diags[:4]] == ["model-name-forbidden-char"] * 4
 
 
 def _retained(elements: int) -> tuple[int, int, int]:

@@ -15,6 +15,7 @@ from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import NO_DIAGNOSTICS, own_diagnostics
 from bt_lsp.syntax.document import Document
+from tests.rulecheck import check, marks
 
 HEAD = '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<Sequence>\n'
 TAIL = "</Sequence>\n</BehaviorTree>\n</root>\n"
@@ -36,36 +37,29 @@ def test_equal_tags_are_reported_at_each_place() -> None:
 
 def test_a_tag_whose_findings_depend_on_its_children_is_checked_each_time() -> None:
     two_async = (
-        "<ReactiveSequence><AsyncSequence><AlwaysSuccess/></AsyncSequence>"
+        "<⟦ReactiveSequence⟧><AsyncSequence><AlwaysSuccess/></AsyncSequence>"
         "<AsyncSequence><AlwaysSuccess/></AsyncSequence></ReactiveSequence>"
     )
     plain = "<ReactiveSequence><AlwaysSuccess/><AlwaysSuccess/></ReactiveSequence>"
     text = HEAD + two_async * 3 + plain + two_async + TAIL
-    found = _codes_at(text, "reactive-async-children")
-    k = len(two_async)
-    first = len(HEAD) + 1
-    assert found == [first, first + k, first + 2 * k, first + 3 * k + len(plain)]
+    code = "reactive-async-children"
+    assert check(text, only=code) == marks(text, code)
 
 
 def test_a_tag_with_another_number_of_children_is_checked_again() -> None:
-    two = '<Parallel success_count="3"><Frob/><Frob/></Parallel>'
+    two = '<Parallel success_count="⟦3⟧"><Frob/><Frob/></Parallel>'
     three = '<Parallel success_count="3"><Frob/><Frob/><Frob/></Parallel>'
     text = HEAD + two + two + three + three + two + TAIL
-    first = len(HEAD)
-    at = [first, first + len(two), first + 2 * len(two) + 2 * len(three)]
-    offset = len('<Parallel success_count="')
-    assert _codes_at(text, "parallel-threshold") == [s + offset for s in at]
+    assert check(text, only="parallel-threshold") == marks(text, "parallel-threshold")
 
 
 def test_the_first_use_of_a_key_decides_for_equal_tags() -> None:
     retry = '<RetryUntilSuccessful num_attempts="{k}"><AlwaysSuccess/></RetryUntilSuccessful>'
-    delay = '<Delay delay_msec="{k}"><AlwaysSuccess/></Delay>'
+    delay = '<Delay delay_msec="⟦{k}⟧"><AlwaysSuccess/></Delay>'
     text = HEAD + retry + delay + retry + delay + TAIL
     # The key is an int from its first use on: each Delay (unsigned int) is a mismatch.
-    offset = len('<Delay delay_msec="')
-    first = len(HEAD) + len(retry)
-    at = [first + offset, first + len(delay) + len(retry) + offset]
-    assert _codes_at(text, "blackboard-type-mismatch") == at
+    code = "blackboard-type-mismatch"
+    assert check(text, only=code) == marks(text, code)
 
 
 def test_a_lookup_that_missed_counts_when_another_document_declares_it() -> None:

@@ -8,6 +8,8 @@ these, nothing more.  The rows of bt-xml.md §f that can be checked statically a
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from bt_lsp.rules import semantics
@@ -672,7 +674,15 @@ def test_every_semantic_code_has_a_case() -> None:
     # Codes the workspace layer reports (include resolution) are not ours; nesting-depth
     # has its own test below.
     ours -= {"include-not-found", "include-cycle", "nesting-depth"}
+    # A code whose fixture holds its near miss (CONTRIBUTING.md, "Add a rule") is tested
+    # there alone.
+    ours -= {c for c in ours if _fixture_with_near_miss(c)}
     assert ours - seen == set()
+
+
+def _fixture_with_near_miss(code: str) -> bool:
+    path = Path(__file__).parent / "fixtures" / f"{code}.xml"
+    return path.is_file() and "<!-- near miss -->" in path.read_text(encoding="utf-8")
 
 
 def test_diagnostics_are_sorted_and_analyze_merges() -> None:

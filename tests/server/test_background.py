@@ -372,14 +372,14 @@ def test_the_worker_prepares_what_the_first_requests_read() -> None:
     doc = Document(big_document("Frobnicate"), "big.xml", scanned=False)
     _prepare(doc, True)
     assert doc._model is not None and doc._model._by_symbol is None  # nobody asked
-    cached = facts._CACHE.get(doc.history)
+    cached = doc.history.memo.get("facts")
     assert cached is not None and cached[0] is doc._model
     asked = Document(big_document("Frobnicate"), "big.xml", scanned=False)
     _prepare(asked, True, [hover(BIG_URI, 7)])
     assert asked._model is not None and asked._model._by_symbol is not None
     other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
     _prepare(other, False)  # not BT: the line index only
-    assert not other.scanned and facts._CACHE.get(other.history) is None
+    assert not other.scanned and other.history.memo.get("facts") is None
 
 
 def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:

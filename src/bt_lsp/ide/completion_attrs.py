@@ -4,7 +4,8 @@ of ``bool`` and ``NodeStatus`` ports, blackboard keys after ``{``)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
 
 from bt_lsp.ide.blackboard import KeyForm, enclosing_tree, key_names
 from bt_lsp.ide.completion_items import (
@@ -32,27 +33,29 @@ _NODE_RESERVED: tuple[tuple[str, str], ...] = (
     *((p, "Postcondition: a script run after the node completes.") for p in POSTCONDITIONS),
     ("_description", "A description of the node (ignored by BehaviorTree.CPP)."),
 )
-_STRUCTURAL_ATTRS: dict[Zone, tuple[tuple[str, str, str], ...]] = {
-    Zone.ROOT: (
-        ("BTCPP_format", "4", "The format version; BehaviorTree.CPP 4.x expects 4."),
-        ("main_tree_to_execute", "", "The tree to run when several are loaded."),
-    ),
-    Zone.TREE: (
-        ("ID", "", "The tree's ID, used by <SubTree ID> and main_tree_to_execute."),
-        ("_description", "", "A description of the tree."),
-    ),
-    Zone.INCLUDE: (
-        ("path", "", "The file to include, relative to this one (or to ros_pkg)."),
-        ("ros_pkg", "", "A ROS package whose share directory the path is relative to."),
-    ),
-    Zone.MODEL_ENTRY: (("ID", "", "The node type (or tree) this entry describes."),),
-    Zone.PORT_DECL: (
-        ("name", "", "The port's name."),
-        ("type", "", "The port's C++ type, e.g. std::string."),
-        ("default", "", "The value used when the port is not set."),
-        ("description", "", "What the port is for."),
-    ),
-}
+_STRUCTURAL_ATTRS: Mapping[Zone, tuple[tuple[str, str, str], ...]] = MappingProxyType(
+    {
+        Zone.ROOT: (
+            ("BTCPP_format", "4", "The format version; BehaviorTree.CPP 4.x expects 4."),
+            ("main_tree_to_execute", "", "The tree to run when several are loaded."),
+        ),
+        Zone.TREE: (
+            ("ID", "", "The tree's ID, used by <SubTree ID> and main_tree_to_execute."),
+            ("_description", "", "A description of the tree."),
+        ),
+        Zone.INCLUDE: (
+            ("path", "", "The file to include, relative to this one (or to ros_pkg)."),
+            ("ros_pkg", "", "A ROS package whose share directory the path is relative to."),
+        ),
+        Zone.MODEL_ENTRY: (("ID", "", "The node type (or tree) this entry describes."),),
+        Zone.PORT_DECL: (
+            ("name", "", "The port's name."),
+            ("type", "", "The port's C++ type, e.g. std::string."),
+            ("default", "", "The value used when the port is not set."),
+            ("description", "", "What the port is for."),
+        ),
+    }
+)
 
 
 def attribute_names(

@@ -11,6 +11,7 @@ import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from types import MappingProxyType
 
 from bt_lsp.ide.blackboard import KeyForm, KeyRef, key_at, tree_keys
 from bt_lsp.ide.name_edits import elsewhere
@@ -39,7 +40,9 @@ class HoverText:
     markdown: bool = True
 
 
-_KIND_TITLE = {"model": "Model name", "port": "Port name", "instance": "Instance name"}
+_KIND_TITLE = MappingProxyType(
+    {"model": "Model name", "port": "Port name", "instance": "Instance name"}
+)
 
 
 def _visible(text: str) -> str:

@@ -25,21 +25,23 @@ from bt_lsp.syntax.elements import NameSymbol, Symbol
 
 __all__ = ["with_targets"]
 
-# Amended diagnostics by the identity of the original (kept with it, so that the identity
-# stays valid): an unchanged section keeps its diagnostic objects, and the server writes
-# a diagnostic's JSON once per object.  Bounded.
-_AMENDED: dict[int, tuple[Diagnostic, str, Diagnostic]] = {}
 _MAX_AMENDED: Final = 4096
 
 
-def _amended(d: Diagnostic, clause: str) -> Diagnostic:
-    hit = _AMENDED.get(id(d))
+def _amended(
+    d: Diagnostic, clause: str, kept: dict[int, tuple[Diagnostic, str, Diagnostic]]
+) -> Diagnostic:
+    """``d`` with ``clause`` added, the same object as last time: amended diagnostics are
+    ``kept`` by the identity of the original (with it, so that the identity stays
+    valid), for the document: an unchanged section keeps its diagnostic objects, and the
+    server writes a diagnostic's JSON once per object.  Bounded."""
+    hit = kept.get(id(d))
     if hit is not None and hit[0] is d and hit[1] == clause:
         return hit[2]
     new = replace(d, message=f"{d.message}; {clause}")
-    if len(_AMENDED) >= _MAX_AMENDED:
-        _AMENDED.clear()
-    _AMENDED[id(d)] = (d, clause, new)
+    if len(kept) >= _MAX_AMENDED:
+        kept.clear()
+    kept[id(d)] = (d, clause, new)
     return new
 
 
@@ -77,5 +79,15 @@ def with_targets(
             found[sym] = elsewhere(sym, (), registered, defined)
         away = found[sym]
         if away is not None and away.first:
-            out[i] = _amended(d, away.first)
+            out[i] = _amended(d, away.first, _kept_amended(doc))
     return out
+
+
+def _kept_amended(doc: Document) -> dict[int, tuple[Diagnostic, str, Diagnostic]]:
+    """The amended diagnostics kept for ``doc`` (its history; written by the analysis
+    that holds its lock)."""
+    kept: dict[int, tuple[Diagnostic, str, Diagnostic]] | None = doc.history.memo.get("amended")
+    if kept is None:
+        kept = {}
+        doc.history.memo["amended"] = kept
+    return kept

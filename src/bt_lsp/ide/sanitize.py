@@ -43,8 +43,9 @@ The result is plain text: escaping it for an attribute value is the writer's job
 from __future__ import annotations
 
 import re
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from collections.abc import Set as AbstractSet
+from types import MappingProxyType
 from typing import Final
 
 from bt_lsp.rules.names import (
@@ -77,7 +78,9 @@ _INSTANCE_BAD_RE: Final = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f\ud800-\ud
 _ASCII_LETTERS: Final = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz")
 _JOINERS: Final = ("_", "-")
 
-_RESERVED_MODEL_REPLACEMENTS: Final[dict[str, str]] = {"Root": "RootTree", "root": "root_tree"}
+_RESERVED_MODEL_REPLACEMENTS: Final[Mapping[str, str]] = MappingProxyType(
+    {"Root": "RootTree", "root": "root_tree"}
+)
 _EMPTY_MODEL: Final = "Unnamed"
 _EMPTY_PORT: Final = "port"
 _PORT_PREFIX: Final = "p_"

@@ -16,7 +16,8 @@ Pure: they return edits.  Each fix leaves the document well-formed.
 from __future__ import annotations
 
 from bisect import bisect_right
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from bt_lsp.ide.fix import Fix
@@ -35,7 +36,7 @@ if TYPE_CHECKING:
 
 __all__ = ["fixes_for_rule"]
 
-_ESCAPES = {"&": "&amp;", "<": "&lt;"}
+_ESCAPES = MappingProxyType({"&": "&amp;", "<": "&lt;"})
 
 
 def fixes_for_rule(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
@@ -83,13 +84,15 @@ def _unknown_node_fixes(doc: Document, ctx: Context, diag: Diagnostic) -> list[F
 
 
 # The fixes of each code that has some (their titles are defined with the code).
-_FIXERS: dict[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = {
-    XML_UNESCAPED_CHAR.code: _escape,
-    MISSING_FORMAT.code: _add_format,
-    ID_ON_COMPACT_NODE.code: _remove_id_fix,
-    UNKNOWN_ATTRIBUTE.code: _suggested_attribute,
-    UNKNOWN_NODE.code: _unknown_node_fixes,
-}
+_FIXERS: Mapping[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = MappingProxyType(
+    {
+        XML_UNESCAPED_CHAR.code: _escape,
+        MISSING_FORMAT.code: _add_format,
+        ID_ON_COMPACT_NODE.code: _remove_id_fix,
+        UNKNOWN_ATTRIBUTE.code: _suggested_attribute,
+        UNKNOWN_NODE.code: _unknown_node_fixes,
+    }
+)
 
 
 def _element_at(doc: Document, model: Model, offset: int) -> Element | None:

@@ -36,7 +36,6 @@ from bt_lsp.rules.includes import (
 )
 from bt_lsp.rules.shared_context import SharedDecls
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
 
 # Folders that never hold a project's own trees (build outputs, VCS, dependencies).
@@ -696,7 +695,6 @@ class ProjectIndex:
                 out[name] = str(folder)
         return out
 
-    @with_gc_paused
     def diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
         """Every diagnostic of ``doc`` in this workspace."""
         if path.suffix in CPP_SUFFIXES:  # a C++ source: the name rules at its literals

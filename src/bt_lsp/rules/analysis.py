@@ -7,10 +7,8 @@ from bt_lsp.rules import semantics
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic, limited, more_of, own_diagnostics
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.gcpause import with_gc_paused
 
 
-@with_gc_paused
 def analyze(doc: Document, ctx: Context | None = None) -> list[Diagnostic]:
     """The document's own diagnostics and the semantic ones, sorted by (start, end, code).
 

@@ -97,8 +97,9 @@ XML = "xml"
 BT = "behaviortree"
 PROJECT = "project"
 
-# Every code defined so far, by name (the registry imports every module that defines one).
-_DEFINED: dict[str, Code] = {}
+# Every code defined so far, by name (the registry imports every module that defines one,
+# then calls freeze(): a read-only view from then on).
+_DEFINED: Mapping[str, Code] = {}
 
 
 def define(
@@ -114,12 +115,19 @@ def define(
     good: str = "",
     since: str = "",
 ) -> Code:
-    """Define (and register) a code; a name defined twice is a programming error.  The
-    prose (``doc`` … ``since``, see :class:`Code`) is optional: without it the code's page
-    says the summary."""
-    if code in _DEFINED:
+    """Define (and register) a code; a name defined twice is a programming error, and so
+    is a code defined once the registry is complete (after :func:`freeze`).  The prose
+    (``doc`` … ``since``, see :class:`Code`) is optional: without it the code's page says
+    the summary."""
+    table = _DEFINED
+    if not isinstance(table, dict):
+        raise RuntimeError(
+            f"diagnostic code {code!r} is defined after the registry was complete:"
+            " import its module from bt_lsp.rules.registry"
+        )
+    if code in table:
         raise ValueError(f"diagnostic code {code!r} is defined twice")
-    found = _DEFINED[code] = Code(
+    found = table[code] = Code(
         code,
         severity,
         summary,
@@ -139,6 +147,14 @@ def _dedent(text: str) -> str:
     return textwrap.dedent(text).strip()
 
 
+def freeze() -> None:
+    """Make the registry read-only: every module that defines a code was imported
+    (:mod:`bt_lsp.rules.registry` calls it once it imported them all)."""
+    global _DEFINED
+    if isinstance(_DEFINED, dict):
+        _DEFINED = MappingProxyType(dict(_DEFINED))
+
+
 def defined(code: str) -> Code:
     """The definition of ``code``; its rule's module is imported wherever it is reported."""
     return _DEFINED[code]
@@ -146,4 +162,5 @@ def defined(code: str) -> Code:
 
 def all_defined() -> Mapping[str, Code]:
     """Every code defined so far (see :mod:`bt_lsp.rules.registry` for all of them)."""
-    return MappingProxyType(_DEFINED)
+    table = _DEFINED
+    return MappingProxyType(table) if isinstance(table, dict) else table

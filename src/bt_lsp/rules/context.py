@@ -15,7 +15,6 @@ declarations, not to the size of the documents.
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, field
 from itertools import chain
@@ -36,7 +35,7 @@ from bt_lsp.rules.facts import facts_of
 from bt_lsp.syntax.model import Model
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document, History
+    from bt_lsp.syntax.document import Document
 
 __all__ = [
     "AUTHORITATIVE",
@@ -195,9 +194,9 @@ class Context:
                 continue
             sources.append((f, in_closure))
             if other_path is not None and other_path.endswith(".btproj"):
-                advisory.append(_tagged(f, "palette"))
+                advisory.append(_tagged(f, "palette", other))
             elif f.models and is_generated_catalog(other):
-                authoritative.append(_tagged(f, "generated"))
+                authoritative.append(_tagged(f, "generated", other))
             else:
                 advisory.append(f.models)
             subtree_models.append(f.subtree_models)
@@ -208,15 +207,15 @@ class Context:
             f = facts_of(model_doc, model_path)
             sources.append(f)
             if model_path.endswith(".btproj"):
-                advisory.append(_tagged(f, "palette"))
+                advisory.append(_tagged(f, "palette", model_doc))
             else:
-                authoritative.append(_tagged(f, "catalog"))
+                authoritative.append(_tagged(f, "catalog", model_doc))
                 catalog = True
             subtree_models.append(f.subtree_models)
         for model_path, model_doc in ros_models:
             f = facts_of(model_doc, model_path)
             sources.append(("ros", f))
-            authoritative.append(_tagged(f, "ros"))
+            authoritative.append(_tagged(f, "ros", model_doc))
         has_custom = catalog if workspace_has_custom_models is None else workspace_has_custom_models
         return cls(
             path=own_path,
@@ -237,26 +236,16 @@ class Context:
         )
 
 
-# The models of a document with another source, kept per facts object (a catalog is read
-# again only when it changes); bounded, oldest first out.
-_TAGGED: dict[tuple[int, str], tuple[DocumentFacts, tuple[ModelDecl, ...]]] = {}
-_TAGGED_MAX: Final = 256
-
-
-def _tagged(facts: DocumentFacts, source: ModelSource) -> tuple[ModelDecl, ...]:
-    """``facts.models`` with ``source`` as their source."""
-    key = (id(facts), source)
-    hit = _TAGGED.get(key)
-    if hit is not None and hit[0] is facts:
-        return hit[1]
+def _tagged(facts: DocumentFacts, source: ModelSource, doc: Document) -> tuple[ModelDecl, ...]:
+    """``facts.models`` (``doc``'s) with ``source`` as their source, kept for the document
+    (its history) while its facts are the same object: a catalog is read again only when
+    it changes."""
+    hit: tuple[DocumentFacts, str, tuple[ModelDecl, ...]] | None = doc.history.memo.get("tagged")
+    if hit is not None and hit[0] is facts and hit[1] == source:
+        return hit[2]
     tagged = tuple([m._replace(source=source) for m in facts.models])
-    if len(_TAGGED) >= _TAGGED_MAX:
-        del _TAGGED[next(iter(_TAGGED))]
-    _TAGGED[key] = (facts, tagged)
+    doc.history.memo["tagged"] = (facts, source, tagged)
     return tagged
-
-
-_GENERATED: weakref.WeakKeyDictionary[History, tuple[Model, bool]] = weakref.WeakKeyDictionary()
 
 
 def is_generated_catalog(doc: Document) -> bool:
@@ -266,7 +255,7 @@ def is_generated_catalog(doc: Document) -> bool:
     writes none; a hand-kept model file usually explains itself in one).  Anything else
     with a ``<TreeNodesModel>`` is what an author or an editor wrote."""
     model = doc.model
-    hit = _GENERATED.get(doc.history)
+    hit: tuple[Model, bool] | None = doc.history.memo.get("generated")  # per model
     if hit is not None and hit[0] is model:
         return hit[1]
     root = model.root
@@ -277,7 +266,7 @@ def is_generated_catalog(doc: Document) -> bool:
         and list(model.root_child_names()) == ["TreeNodesModel"]
         and "<!--" not in doc.text
     )
-    _GENERATED[doc.history] = (model, found)
+    doc.history.memo["generated"] = (model, found)
     return found
 
 

@@ -5,27 +5,25 @@ workspace live in :mod:`bt_lsp.rules.semantics` and are combined in :mod:`bt_lsp
 
 from __future__ import annotations
 
-import weakref
 from array import array
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from itertools import chain, compress, count, islice
 from operator import or_
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING, Any, Final
 
 from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.syntax.elements import Element, NameRef, Role, Symbol, Zone
-from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.model import Model
-from bt_lsp.syntax.nametokens import name_refs
+from bt_lsp.syntax.nametokens import SymbolPool, name_refs
 from bt_lsp.syntax.scanner import Scan
 from bt_lsp.syntax.sections import Section
 from bt_lsp.syntax.tokens import Token
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document, History
+    from bt_lsp.syntax.document import Document
 
 # The codes of these rules (see bt_lsp.rules.registry).
 XML_SYNTAX: Final = define(
@@ -94,7 +92,7 @@ TOO_MANY_ATTRIBUTES: Final = define(
 TOO_MANY_PROBLEMS: Final = define(
     "too-many-problems",
     Severity.INFORMATION,
-    "more problems than a client can usefully show; only the first are reported",
+    "more problems than a client can usefully show; only the most severe are reported",
     XML,
 )
 
@@ -123,8 +121,9 @@ MAX_DIAGNOSTICS = 2000
 
 
 class Capped(list[Diagnostic]):
-    """Diagnostics sorted by position, at most :data:`MAX_DIAGNOSTICS` of them (the first),
-    and in ``more`` how many others were found and not kept.  What lies beyond the
+    """Diagnostics sorted by position, at most :data:`MAX_DIAGNOSTICS` of them (the most
+    severe, the first by position among equals: :func:`cap_key`), and in ``more`` how many
+    others were found and not kept.  What lies beyond the
     publication cap is never published, so it is not kept either: a hostile document has
     hundreds of thousands of findings, each costing more memory than its text."""
 
@@ -135,9 +134,20 @@ class Capped(list[Diagnostic]):
         self.more = more
 
 
+class _NoDiagnostics(Capped):
+    """The empty result, shared: it refuses to grow (it is read, never changed)."""
+
+    __slots__ = ()
+
+    def _refuse(self, *args: object, **kwargs: object) -> Any:
+        raise TypeError("NO_DIAGNOSTICS is shared and never changed: copy it first")
+
+    append = extend = insert = __setitem__ = __iadd__ = __imul__ = _refuse
+
+
 #: What a source without findings keeps: one object for them all (most sections of a large
 #: document have none).  Results of :func:`capped` are read, never changed.
-NO_DIAGNOSTICS: Final = Capped()
+NO_DIAGNOSTICS: Final = _NoDiagnostics()
 
 
 def more_of(diags: Iterable[Diagnostic]) -> int:
@@ -146,32 +156,61 @@ def more_of(diags: Iterable[Diagnostic]) -> int:
 
 
 def capped(diags: list[Diagnostic], more: int = 0, maximum: int = MAX_DIAGNOSTICS) -> Capped:
-    """``diags`` sorted by position (stable), the first ``maximum`` kept; ``more``: how
-    many were already left out before."""
+    """``diags`` sorted by position (stable), the ``maximum`` first by :func:`cap_key`
+    kept (errors before warnings before hints); ``more``: how many were already left out
+    before."""
     if not diags and not more:
         return NO_DIAGNOSTICS
-    diags.sort(key=sort_key)
     if len(diags) > maximum:
+        diags.sort(key=cap_key)
         more += len(diags) - maximum
         del diags[maximum:]
+    diags.sort(key=sort_key)
     return Capped(diags, more)
 
 
-# The violations of each name text, per role (a role decides the kind): model and port
-# names repeat (every use of a node type or port), and
-# a dict keyed by the text alone is the cheapest lookup for the loop below.  Instance
-# names rarely repeat and their rule is quick: they are not kept (they would cost memory
-# in proportion to the documents).  Bounded.
-_VIOLATIONS: dict[Role, dict[str, tuple[Violation, ...]]] = {role: {} for role in Role}
+class NameMemo:
+    """What the name rules found, kept for the analyses of one document (its history:
+    ``names_memo``) or one pass, never shared between threads.
+
+    ``violations``: the violations of each name text, per role (a role decides the kind
+    and whether the name is declared): model and port names repeat (every use of a node
+    type or port), and a dict keyed by the text alone is the cheapest lookup.  Instance
+    names rarely repeat and their rule is quick: they are not kept (they would cost memory
+    in proportion to the documents).  ``tags``: what the name rules find in a start tag
+    (:data:`_TagNames`), by tag and zone; ``symbols``: the symbols of their names.  All
+    bounded."""
+
+    __slots__ = ("symbols", "tags", "violations")
+
+    def __init__(self) -> None:
+        self.violations: dict[Role, dict[str, tuple[Violation, ...]]] = {r: {} for r in Role}
+        self.tags: dict[int, tuple[Token, _TagNames]] = {}
+        self.symbols = SymbolPool()
+
+
 _MAX_CACHED = 4096
 
 
-def violations(text: str, kind: NameKind, role: Role) -> tuple[Violation, ...]:
-    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (cached per role), as
+def names_memo(doc: Document) -> NameMemo:
+    """The name rules' memo of ``doc`` (kept for its history; see :class:`NameMemo`)."""
+    memo: NameMemo | None = doc.history.memo.get("names")
+    if memo is None:
+        memo = NameMemo()
+        doc.history.memo["names"] = memo
+    return memo
+
+
+def violations(
+    text: str, kind: NameKind, role: Role, memo: NameMemo | None = None
+) -> tuple[Violation, ...]:
+    """The rules ``text`` breaks as a ``kind`` of name in ``role`` (kept in ``memo``), as
     the document alone tells: a reserved name of a declared port is reported by the
     semantic checks, which know the model entry and the BehaviorTree.CPP version
     (:func:`bt_lsp.rules.names.reserved_port_declaration`)."""
-    cache = _VIOLATIONS[role]
+    if memo is None:
+        return check_name(text, kind)
+    cache = memo.violations[role]
     found = cache.get(text)
     if found is None:
         found = check_name(text, kind)
@@ -188,21 +227,24 @@ def name_violations(ref: NameRef) -> tuple[Violation, ...]:
     return violations(ref.text, ref.kind, ref.role)
 
 
-def name_diagnostics(model: Model) -> list[Diagnostic]:
-    return ref_diagnostics(model.refs)
+def name_diagnostics(model: Model, memo: NameMemo | None = None) -> list[Diagnostic]:
+    return ref_diagnostics(model.refs, memo)
 
 
-def ref_diagnostics(refs: Iterable[NameRef]) -> list[Diagnostic]:
-    """The name-rule diagnostics of ``refs``."""
+def ref_diagnostics(refs: Iterable[NameRef], memo: NameMemo | None = None) -> list[Diagnostic]:
+    """The name-rule diagnostics of ``refs`` (what they find kept in ``memo``, else for
+    this call only)."""
     out: list[Diagnostic] = []
-    caches = _VIOLATIONS
+    if memo is None:
+        memo = NameMemo()
+    caches = memo.violations
     # Unpacked rather than read by field: this runs for every name of a document.
     for start, end, text, kind, role, _symbol, _element, _quote in refs:
         if kind is None:
             continue
         found = caches[role].get(text)
         if found is None:
-            found = violations(text, kind, role)
+            found = violations(text, kind, role, memo)
         for v in found:
             out.append(
                 make(
@@ -230,20 +272,21 @@ def sort_key(d: Diagnostic) -> tuple[int, int, str]:
     return d.start, d.end, d.code
 
 
-# For each document, the sections of its last model and those of them with diagnostics.
-_SECTIONS_WITH_DIAGNOSTICS: weakref.WeakKeyDictionary[
-    History, tuple[list[Section], set[Section]]
-] = weakref.WeakKeyDictionary()
+def cap_key(d: Diagnostic) -> tuple[int, int, int, str]:
+    """Which diagnostics the cap keeps first: by severity (errors, then warnings, then
+    information, then hints), then by position: a thousand hints never push an error
+    out."""
+    return d.severity, d.start, d.end, d.code
 
 
-def _own(section: Section) -> Capped:
+def _own(section: Section, memo: NameMemo) -> Capped:
     """The diagnostics of one section (in its coordinates), computed once; the first
     :data:`MAX_DIAGNOSTICS` are kept."""
     out: Capped | None = section.cache.get("diagnostics")
     if out is None:
         found = [make(p.start, p.end, p.code, p.message) for p in section.lexical]
         found.extend(make(p.start, p.end, p.code, p.message) for p in section.problems)
-        more = _section_name_diagnostics(section, found)
+        more = _section_name_diagnostics(section, found, memo)
         out = section.cache["diagnostics"] = capped(found, more)
     return out
 
@@ -251,18 +294,17 @@ def _own(section: Section) -> Capped:
 # What the name rules find in one start tag where it sits: each finding's offsets from
 # the tag's start, code, message, severity and data; and the symbols its names denote.
 _TagNames = tuple[tuple[tuple[int, int, str, str, Severity, NameData], ...], tuple[Symbol, ...]]
-# By tag (a token shared by equal tags, kept here so that its id stays its own) and zone,
-# as ``id(tag) << 4 | zone``: a document of a hundred thousand ``<Frob/>`` checks one.
-# Bounded.
-_TAG_NAMES: dict[int, tuple[Token, _TagNames]] = {}
+# Kept by tag (a token shared by equal tags, kept with it so that its id stays its own)
+# and zone, as ``id(tag) << 4 | zone`` (NameMemo.tags): a document of a hundred thousand
+# ``<Frob/>`` checks one.
 # Zones in which no token is a name (see bt_lsp.syntax.nametokens).
 _NAMELESS: Final = frozenset({Zone.MODELS, Zone.INCLUDE, Zone.OTHER, Zone.OUTSIDE})
 
 
-def _tag_names(el: Element, parent: Element | None) -> _TagNames:
+def _tag_names(el: Element, parent: Element | None, memo: NameMemo) -> _TagNames:
     """What the name rules find in ``el``'s start tag (see :data:`_TagNames`)."""
     refs: list[NameRef] = []
-    name_refs(el, 0, parent, refs)
+    name_refs(el, 0, parent, refs, memo.symbols)
     ts = el.token_start
     found: list[tuple[int, int, str, str, Severity, NameData]] = []
     symbols: dict[Symbol, None] = {}
@@ -271,7 +313,7 @@ def _tag_names(el: Element, parent: Element | None) -> _TagNames:
             symbols[symbol] = None
         if kind is None:
             continue
-        vs = violations(text, kind, role)
+        vs = violations(text, kind, role, memo)
         if vs:
             data = NameData(text, kind, role)
             found.extend(
@@ -281,12 +323,12 @@ def _tag_names(el: Element, parent: Element | None) -> _TagNames:
     return tuple(found), tuple(symbols)
 
 
-def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
+def _section_name_diagnostics(section: Section, out: list[Diagnostic], memo: NameMemo) -> int:
     """Add the name-rule diagnostics of ``section`` to ``out`` and note the section's
     symbols (:meth:`Section.symbols`) on the way.  Each distinct start tag is checked once
     (equal tags are one token); once ``out`` holds twice :data:`MAX_DIAGNOSTICS`, only the
-    first by position are kept and later findings past them are counted, not made: the
-    count returned.
+    first by severity, then position, are kept and later findings past them are counted,
+    not made: the count returned.
 
     The section's rows are told apart by tag and zone in C, from its columns, and only
     those whose tag has findings are read one by one (a document may be a million
@@ -294,15 +336,15 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     declarations, whose names depend on their entry (:func:`_element_name_diagnostics`)."""
     els = section.elements
     if els.kept:  # its elements are made once: read as they are
-        return _element_name_diagnostics(section, out)
+        return _element_name_diagnostics(section, out, memo)
     rows = els.rows
     cols = els.columns
     lo, n = rows.start, len(rows)
     zones = cols.zones[lo : lo + n]
     if _PORT_DECL in zones:
-        return _element_name_diagnostics(section, out)
+        return _element_name_diagnostics(section, out, memo)
     tags = cols.tags
-    # As _TAG_NAMES's, as machine integers (a list of them would cost 40 bytes a row).
+    # As NameMemo.tags's, as machine integers (a list of them would cost 40 bytes a row).
     keys = array("q", map(or_, map(_SHIFTED, map(id, islice(tags, lo, lo + n))), zones))
     symbols: dict[Symbol, None] = {}
     # What the tags with findings find, by key.
@@ -310,11 +352,11 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
     hits: list[tuple[int, tuple[tuple[int, int, str, str, Severity, NameData], ...]]] = []
     root = section.root
     if root is not None and root.zone not in _NAMELESS:  # the head's: read first
-        found = _tag_names(root, None)
+        found = _tag_names(root, None, memo)
         symbols.update(dict.fromkeys(found[1]))
         if found[0]:
             hits.append((root.token_start, found[0]))
-    shared = _TAG_NAMES
+    shared = memo.tags
     nameless = _NAMELESS_ZONES
     # Each key once, in the order of its first row (with one of its rows).
     for key, i in dict(zip(keys, range(n), strict=True)).items():
@@ -325,7 +367,7 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
         if hit is not None and hit[0] is tag:
             found = hit[1]
         else:
-            found = _tag_names(els[i], None)
+            found = _tag_names(els[i], None, memo)
             if len(shared) >= _MAX_CACHED:
                 shared.clear()
             shared[key] = (tag, found)
@@ -346,15 +388,16 @@ def _section_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
 
 class _Placer:
     """Places a tag's findings (:data:`_TagNames`) at its start into ``out``, keeping the
-    first :data:`MAX_DIAGNOSTICS` by position: once ``out`` holds twice as many, the rest
-    are cut, and later findings past the last kept are counted (``more``), not made."""
+    first :data:`MAX_DIAGNOSTICS` by :func:`cap_key`: once ``out`` holds twice as many, the
+    rest are cut, and later findings past the last kept are counted (``more``), not
+    made."""
 
     __slots__ = ("limit", "more", "out")
 
     def __init__(self, out: list[Diagnostic]) -> None:
         self.out = out
         self.more = 0
-        self.limit: tuple[int, int, str] | None = None
+        self.limit: tuple[int, int, int, str] | None = None
 
     def place(
         self, ts: int, findings: tuple[tuple[int, int, str, str, Severity, NameData], ...]
@@ -363,15 +406,15 @@ class _Placer:
         for rs, re_, code, message, severity, data in findings:
             start, end = ts + rs, ts + re_
             limit = self.limit
-            if limit is not None and (start, end, code) >= limit:
+            if limit is not None and (severity, start, end, code) >= limit:
                 self.more += 1  # past the first MAX_DIAGNOSTICS found: never kept
                 continue
             out.append(Diagnostic(start, end, code, message, severity, data))
             if len(out) >= 2 * MAX_DIAGNOSTICS:
-                out.sort(key=sort_key)  # stable: the first found first among equals
+                out.sort(key=cap_key)  # stable: the first found first among equals
                 self.more += len(out) - MAX_DIAGNOSTICS
                 del out[MAX_DIAGNOSTICS:]
-                self.limit = sort_key(out[-1])
+                self.limit = cap_key(out[-1])
 
 
 _PORT_DECL: Final = int(Zone.PORT_DECL)
@@ -379,10 +422,10 @@ _NAMELESS_ZONES: Final = frozenset(map(int, _NAMELESS))
 _SHIFTED: Final = (4).__rlshift__  # x -> x << 4
 
 
-def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
+def _element_name_diagnostics(section: Section, out: list[Diagnostic], memo: NameMemo) -> int:
     """:func:`_section_name_diagnostics` element by element."""
     seen: dict[int, _TagNames] = {}  # this section's tags (alive while it runs)
-    shared = _TAG_NAMES
+    shared = memo.tags
     symbols: dict[Symbol, None] = {}
     placer = _Placer(out)
     els = section.elements
@@ -399,13 +442,13 @@ def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
         if found is None:
             if zone == port_decl:  # its symbols depend on the entry it is in: not kept
                 p = el.parent
-                found = _tag_names(el, els[p - 1] if p > 0 else None)
+                found = _tag_names(el, els[p - 1] if p > 0 else None, memo)
             else:
                 hit = shared.get(key)
                 if hit is not None and hit[0] is tag:
                     found = hit[1]
                 else:
-                    found = _tag_names(el, None)
+                    found = _tag_names(el, None, memo)
                     if len(shared) >= _MAX_CACHED:
                         shared.clear()
                     shared[key] = (tag, found)
@@ -421,36 +464,37 @@ def _element_name_diagnostics(section: Section, out: list[Diagnostic]) -> int:
 
 def compute(doc: Document) -> Capped:
     model = doc.model
+    memo = names_memo(doc)
     more = 0
     if model.head is None:
         out = lexical_diagnostics(doc.scan)
         out.extend(make(p.start, p.end, p.code, p.message) for p in model.problems)
-        out.extend(name_diagnostics(model))
+        out.extend(name_diagnostics(model, memo))
     else:
         # Each section's own diagnostics are kept on it; they are only moved here, from
         # the sections that have some.  Which those are is remembered for the document:
         # an edit leaves all but a few sections as they were.
-        head = _own(model.head)
+        head = _own(model.head, memo)
         out = list(head)
         more = head.more
         sections = model.sections
-        seen, with_diagnostics = _SECTIONS_WITH_DIAGNOSTICS.get(doc.history, ([], set()))
+        seen, with_diagnostics = doc.history.memo.get("own-sections", ([], set()))
         p, q = common_ends(seen, sections)
         with_diagnostics = with_diagnostics.difference(seen[p : len(seen) - q])
-        with_diagnostics.update(sec for sec in sections[p : len(sections) - q] if _own(sec))
-        _SECTIONS_WITH_DIAGNOSTICS[doc.history] = (sections, with_diagnostics)
+        with_diagnostics.update(sec for sec in sections[p : len(sections) - q] if _own(sec, memo))
+        doc.history.memo["own-sections"] = (sections, with_diagnostics)
         if with_diagnostics:
             origins = model.origins
             for k in compress(count(), map(with_diagnostics.__contains__, sections)):
                 o = origins[k]
-                own = _own(sections[k])
+                own = _own(sections[k], memo)
                 more += own.more
                 out.extend(
                     Diagnostic(d.start + o, d.end + o, d.code, d.message, d.severity, d.data)
                     for d in own
                 )
         if model.tail is not None:
-            tail = _own(model.tail)
+            tail = _own(model.tail, memo)
             out.extend(tail)
             more += tail.more
     return capped(out, more)
@@ -476,19 +520,25 @@ def with_severities(
 def limited(
     diags: list[Diagnostic], maximum: int = MAX_DIAGNOSTICS, more: int = 0
 ) -> list[Diagnostic]:
-    """At most ``maximum`` diagnostics (the first by position), plus one that says how many
-    were left out (``more`` of them before ``diags`` was made): hostile or binary input
-    must not flood the client."""
+    """At most ``maximum`` diagnostics (the most severe, the first by position among
+    equals: :func:`cap_key`), in the order of ``diags``, plus one that says how many were
+    left out (``more`` of them before ``diags`` was made): hostile or binary input must
+    not flood the client, and hints must not push an error out."""
     left_out = len(diags) + more - maximum
     if left_out <= 0:
         return diags
-    kept = diags[:maximum]
+    if len(diags) > maximum:
+        chosen = set(map(id, sorted(diags, key=cap_key)[:maximum]))
+        kept = [d for d in diags if id(d) in chosen]
+    else:
+        kept = list(diags)
     kept.append(
         make(
             0,
             0,
             TOO_MANY_PROBLEMS.code,
-            f"{left_out} more problems are not shown (only the first {maximum} are reported)",
+            f"{left_out} more problems are not shown (only {maximum} are reported:"
+            " errors first, then warnings, information and hints)",
         )
     )
     return kept
@@ -496,7 +546,8 @@ def limited(
 
 def own_diagnostics(doc: Document) -> Capped:
     """The diagnostics of ``doc`` alone (lexical, XML structure, names), kept on it until
-    its next edit: the first :data:`MAX_DIAGNOSTICS`, with how many more there are."""
+    its next edit: the first :data:`MAX_DIAGNOSTICS` by :func:`cap_key`, with how many
+    more there are."""
     found = doc.own_diagnostics
     if not isinstance(found, Capped):
         found = doc.own_diagnostics = compute(doc)
@@ -508,7 +559,7 @@ def size_limited(doc: Document, max_bytes: int) -> list[Diagnostic]:
     names, which stay cheap) and ``document-too-large`` saying the rest does not run.
     Capped like every other path, and found with the cyclic collector paused: hostile
     input has the most problems."""
-    own = with_gc_paused(own_diagnostics)(doc)
+    own = own_diagnostics(doc)
     out = list(limited(own, more=own.more))
     out.append(
         make(

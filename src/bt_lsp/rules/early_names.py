@@ -27,7 +27,13 @@ from typing import cast
 
 from lxml import etree
 
-from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, ref_diagnostics, violations
+from bt_lsp.rules.diagnostics import (
+    MAX_DIAGNOSTICS,
+    Diagnostic,
+    NameMemo,
+    ref_diagnostics,
+    violations,
+)
 from bt_lsp.rules.names import (
     RESERVED_PORT_NAMES,
     NameKind,
@@ -50,7 +56,7 @@ class _Reader:
     """An lxml parser target: follows each element's zone and notes those with a name
     that breaks a rule (a superset of what the model reports: the model decides)."""
 
-    __slots__ = ("count", "good_keys", "good_models", "instances", "stack", "suspects")
+    __slots__ = ("count", "good_keys", "good_models", "instances", "memo", "stack", "suspects")
 
     def __init__(self, instances: bool) -> None:
         self.instances = instances  # whether instance names can break their rule here
@@ -61,6 +67,7 @@ class _Reader:
         # node (a valid port name, or a reserved attribute, which is not a port).
         self.good_models: set[str] = set(_BY_ID)
         self.good_keys: set[str] = set(RESERVED_PORT_NAMES)
+        self.memo = NameMemo()  # what the name rules found, for this pass
 
     def start(self, tag: str, attrib: dict[str, str]) -> None:
         index = self.count
@@ -80,10 +87,12 @@ class _Reader:
         elif zone in (_TREE, _ENTRY):
             value = attrib.get("ID")
             role = Role.TREE_DEF if zone == _TREE else Role.MODEL_DEF
-            suspect = value is not None and bool(violations(value, _MODEL, role))
+            suspect = value is not None and bool(violations(value, _MODEL, role, self.memo))
         elif zone == _PORT_DECL:
             value = attrib.get("name")
-            suspect = value is not None and bool(violations(value, _PORT, Role.PORT_DECL))
+            suspect = value is not None and bool(
+                violations(value, _PORT, Role.PORT_DECL, self.memo)
+            )
         else:
             suspect = False
         if suspect:
@@ -92,7 +101,7 @@ class _Reader:
     def _node_suspect(self, tag: str, attrib: dict[str, str]) -> bool:
         good_models, good_keys = self.good_models, self.good_keys
         if tag not in good_models:
-            if violations(tag, _MODEL, Role.NODE_TYPE):
+            if violations(tag, _MODEL, Role.NODE_TYPE, self.memo):
                 return True
             good_models.add(tag)
         # The model keeps a tag's first MAX_ATTRS attributes (the rest are only counted).
@@ -105,13 +114,13 @@ class _Reader:
                 good_keys |= new_keys
         value = attrib.get("ID")
         if value is not None and value not in good_models:
-            if violations(value, _MODEL, Role.NODE_ID):
+            if violations(value, _MODEL, Role.NODE_ID, self.memo):
                 return True
             good_models.add(value)
         if not self.instances:
             return False
         value = attrib.get("name")
-        return value is not None and bool(violations(value, _INSTANCE, Role.INSTANCE))
+        return value is not None and bool(violations(value, _INSTANCE, Role.INSTANCE, self.memo))
 
     def end(self, tag: str) -> None:
         self.stack.pop()
@@ -195,6 +204,6 @@ def early_name_diagnostics(text: str) -> list[Diagnostic] | None:
         parent: Element | None = None
         if zone == _PORT_DECL:
             parent = start_tag_element(text, offsets[parent_index], _ENTRY)
-        out.extend(ref_diagnostics(start_tag_refs(text, offsets[index], zone, parent)))
+        out.extend(ref_diagnostics(start_tag_refs(text, offsets[index], zone, parent), reader.memo))
     out.sort(key=lambda d: (d.start, d.end, d.code))
     return out

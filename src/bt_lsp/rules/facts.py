@@ -6,7 +6,6 @@ per section (kept on the section), so that an edit costs what its own sections d
 
 from __future__ import annotations
 
-import weakref
 from array import array
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -24,7 +23,7 @@ from bt_lsp.syntax.sections import Section
 from bt_lsp.syntax.table import ElementTable
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import Document, History
+    from bt_lsp.syntax.document import Document
 
 _ENTRY_CATEGORIES: Final[frozenset[str]] = frozenset(
     {"Action", "Condition", "Control", "Decorator", "SubTree"}
@@ -37,26 +36,22 @@ _DIRECTIONS: Final[Mapping[str, Direction]] = MappingProxyType(
 # Groot2 writes `editable` on the entries whose ports its editor may change: not a port.
 _ENTRY_NON_PORT_ATTRS: Final[frozenset[str]] = frozenset({"ID", "name", "description", "editable"})
 
-# Model -> facts, keyed by document; a cached entry is valid while the document's model is
-# the same object (a document builds a new model after every edit).
-_CACHE: weakref.WeakKeyDictionary[History, tuple[Model, str | None, DocumentFacts]] = (
-    weakref.WeakKeyDictionary()
-)
-
 
 def facts_of(doc: Document, path: str | None = None) -> DocumentFacts:
     """What ``doc`` declares (cached per model and path)."""
     model = doc.model
     if path is None:
         path = doc.path
-    hit = _CACHE.get(doc.history)
+    # Kept for the document (its history); valid while its model is the same object (a
+    # document builds a new model after every edit).
+    hit: tuple[Model, str | None, DocumentFacts] | None = doc.history.memo.get("facts")
     if hit is not None and hit[0] is model and hit[1] == path:
         return hit[2]
     if model.head is None:
         facts = extract_facts(model, path)
     else:
         facts = extract_sections(model, path, hit[2] if hit is not None else None)
-    _CACHE[doc.history] = (model, path, facts)
+    doc.history.memo["facts"] = (model, path, facts)
     return facts
 
 
@@ -158,11 +153,12 @@ def _extract_all(
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
     trees_at, models_at, subs_at = array("q"), array("q"), array("q")
+    spans: _Spans = {}  # for this pass (see _OpenTree.close)
     for section, o in zip(sections, origins, strict=True):
         trees_at.append(len(trees))
         models_at.append(len(models))
         subs_at.append(len(subtree_models))
-        _extract_into(section.elements, path, o, trees, models, subtree_models)
+        _extract_into(section.elements, path, o, trees, models, subtree_models, spans)
     trees_at.append(len(trees))
     models_at.append(len(models))
     subs_at.append(len(subtree_models))
@@ -227,7 +223,7 @@ def _extract(elements: Iterable[Element], path: str | None) -> DocumentFacts:
     trees: list[TreeDecl] = []
     models: list[ModelDecl] = []
     subtree_models: list[ModelDecl] = []
-    _extract_into(elements, path, 0, trees, models, subtree_models)
+    _extract_into(elements, path, 0, trees, models, subtree_models, {})
     return DocumentFacts(path, tuple(trees), tuple(models), tuple(subtree_models))
 
 
@@ -238,8 +234,10 @@ def _extract_into(
     trees: list[TreeDecl],
     models: list[ModelDecl],
     subtree_models: list[ModelDecl],
+    spans: _Spans,
 ) -> None:
-    """Add the declarations of ``elements``, placed ``origin`` code points further on."""
+    """Add the declarations of ``elements``, placed ``origin`` code points further on
+    (the calls' spans shared through ``spans``)."""
     tree: _OpenTree | None = None
     entry: _OpenEntry | None = None
     # Members bound once: reading one from its enum class is slow in Python 3.11.
@@ -255,7 +253,7 @@ def _extract_into(
             continue
         if el.depth <= 1 or zone == entry_zone:
             if tree is not None:
-                trees.append(tree.close(path, origin))
+                trees.append(tree.close(path, origin, spans))
                 tree = None
             if entry is not None:
                 decl = entry.close(path, origin)
@@ -287,7 +285,7 @@ def _extract_into(
                     )
                 )
     if tree is not None:
-        trees.append(tree.close(path, origin))
+        trees.append(tree.close(path, origin, spans))
     if entry is not None:
         decl = entry.close(path, origin)
         (subtree_models if decl.category == "SubTree" else models).append(decl)
@@ -320,20 +318,19 @@ class _OpenTree:
     calls: list[str] = field(default_factory=list)
     spans: list[tuple[int, int]] = field(default_factory=list)
 
-    def close(self, path: str | None, origin: int) -> TreeDecl:
+    def close(self, path: str | None, origin: int, kept: _Spans) -> TreeDecl:
         s = self.start
         spans = tuple([(a - s, b - s) for a, b in self.spans])
-        # Trees written alike call at the same offsets: one tuple for them all (bounded).
-        shared = _SPANS.get(spans)
+        # Trees written alike call at the same offsets: one tuple for those of one pass.
+        shared = kept.get(spans)
         if shared is None:
-            if len(_SPANS) >= 4096:
-                _SPANS.clear()
-            shared = _SPANS[spans] = spans
+            shared = kept[spans] = spans
         calls = tuple(self.calls)
         return _new(TreeDecl, (self.id, path, s + origin, self.end + origin, calls, shared))
 
 
-_SPANS: dict[tuple[tuple[int, int], ...], tuple[tuple[int, int], ...]] = {}
+# The calls' spans of trees, each once (see _OpenTree.close).
+_Spans = dict[tuple[tuple[int, int], ...], tuple[tuple[int, int], ...]]
 
 
 @dataclass(slots=True)

@@ -12,8 +12,9 @@ Offsets and columns are counted in code points within the name (0-based ``offset
 from __future__ import annotations
 
 import re
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Final
 
 from bt_lsp.rules.codes import BT, NAMES, FixData, Severity, define
@@ -614,13 +615,15 @@ def is_allowed_port_name(name: str) -> bool:
 
 
 # What each attribute BehaviorTree.CPP reserves is, for the messages.
-_RESERVED_MEANING: Final[dict[str, str]] = {
-    "ID": "`ID` names the tree a <SubTree> calls",
-    "name": "`name` is the instance name of every node",
-    "_autoremap": "`_autoremap` is an attribute of the <SubTree> call itself, not a port",
-    **{n: f"`{n}` is a precondition script of every node" for n in PRECONDITIONS},
-    **{n: f"`{n}` is a postcondition script of every node" for n in POSTCONDITIONS},
-}
+_RESERVED_MEANING: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        "ID": "`ID` names the tree a <SubTree> calls",
+        "name": "`name` is the instance name of every node",
+        "_autoremap": "`_autoremap` is an attribute of the <SubTree> call itself, not a port",
+        **{n: f"`{n}` is a precondition script of every node" for n in PRECONDITIONS},
+        **{n: f"`{n}` is a postcondition script of every node" for n in POSTCONDITIONS},
+    }
+)
 _BTCPP4_RESERVES = "it reserves only ID, name, _autoremap and the pre/post conditions"
 
 

@@ -19,7 +19,7 @@ from bt_lsp.rules import (  # noqa: F401  (they define codes)
     includes,
     names,
 )
-from bt_lsp.rules.codes import BT, NAMES, PROJECT, XML, Code, all_defined
+from bt_lsp.rules.codes import BT, NAMES, PROJECT, XML, Code, all_defined, freeze
 from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
     base,
     document,
@@ -29,6 +29,8 @@ from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
     scripts,
     trees,
 )
+
+freeze()  # every module that defines a code is imported: none is defined later
 
 #: The families in the order the README lists them, with their headings.
 FAMILIES: Final[Mapping[str, str]] = MappingProxyType(

@@ -42,6 +42,7 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import lru_cache
+from types import MappingProxyType
 from typing import Final
 
 from bt_lsp.rules.names import POSTCONDITIONS, PRECONDITIONS
@@ -88,42 +89,46 @@ _ASCII_LETTERS: Final = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRS
 _IDENT_START: Final = _ASCII_LETTERS | {"_", "@"}
 _IDENT_CHAR: Final = _ASCII_LETTERS | _DIGITS | {"_"}
 
-_TWO_CHAR_OPS: Final = {
-    "..": _BINARY,
-    "&&": _BINARY,
-    "||": _BINARY,
-    "==": _BINARY,
-    "!=": _BINARY,
-    "<=": _BINARY,
-    ">=": _BINARY,
-    ":=": _BINARY,
-    "+=": _BINARY,
-    "-=": _BINARY,
-    "*=": _BINARY,
-    "/=": _BINARY,
-}
-_ONE_CHAR_OPS: Final = {
-    "+": _BINARY,
-    "-": _MINUS,
-    "*": _BINARY,
-    "/": _BINARY,
-    "&": _BINARY,
-    "|": _BINARY,
-    "^": _BINARY,
-    "~": _PREFIX,
-    "!": _PREFIX,
-    "<": _BINARY,
-    ">": _BINARY,
-    "=": _BINARY,
-    "?": _QUESTION,
-    ":": _COLON,
-    "(": _LPAREN,
-    ")": _RPAREN,
-    ";": _SEMI,
-}
+_TWO_CHAR_OPS: Final = MappingProxyType(
+    {
+        "..": _BINARY,
+        "&&": _BINARY,
+        "||": _BINARY,
+        "==": _BINARY,
+        "!=": _BINARY,
+        "<=": _BINARY,
+        ">=": _BINARY,
+        ":=": _BINARY,
+        "+=": _BINARY,
+        "-=": _BINARY,
+        "*=": _BINARY,
+        "/=": _BINARY,
+    }
+)
+_ONE_CHAR_OPS: Final = MappingProxyType(
+    {
+        "+": _BINARY,
+        "-": _MINUS,
+        "*": _BINARY,
+        "/": _BINARY,
+        "&": _BINARY,
+        "|": _BINARY,
+        "^": _BINARY,
+        "~": _PREFIX,
+        "!": _PREFIX,
+        "<": _BINARY,
+        ">": _BINARY,
+        "=": _BINARY,
+        "?": _QUESTION,
+        ":": _COLON,
+        "(": _LPAREN,
+        ")": _RPAREN,
+        ";": _SEMI,
+    }
+)
 
 _MAX_SHOWN: Final = 24
-_WORD_OPERATORS: Final = {"and": "&&", "or": "||"}
+_WORD_OPERATORS: Final = MappingProxyType({"and": "&&", "or": "||"})
 _LITERAL_WORDS: Final = frozenset({"true", "false"})
 
 

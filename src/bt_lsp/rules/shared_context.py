@@ -231,15 +231,15 @@ class SharedDecls:
             f = facts_of(model_doc, model_path)
             sources.append(f)
             if model_path.endswith(".btproj"):
-                advisory.append(_tagged(f, "palette"))
+                advisory.append(_tagged(f, "palette", model_doc))
             else:
-                authoritative.append(_tagged(f, "catalog"))
+                authoritative.append(_tagged(f, "catalog", model_doc))
                 catalog = True
             subtree_models.append(f.subtree_models)
         for model_path, model_doc in ros_models:
             f = facts_of(model_doc, model_path)
             sources.append(("ros", f))
-            authoritative.append(_tagged(f, "ros"))
+            authoritative.append(_tagged(f, "ros", model_doc))
         trees = [e.facts.trees for e in closure_entries]
         trees.append(own_facts.trees)
         return Context(
@@ -267,9 +267,9 @@ def _entry(path: str, doc: Document) -> _Entry:
     """How ``combine`` takes one other document's models."""
     f = facts_of(doc, path)
     if path.endswith(".btproj"):
-        return _Entry(path, f, _tagged(f, "palette"), False)
+        return _Entry(path, f, _tagged(f, "palette", doc), False)
     if f.models and is_generated_catalog(doc):
-        return _Entry(path, f, _tagged(f, "generated"), True)
+        return _Entry(path, f, _tagged(f, "generated", doc), True)
     return _Entry(path, f, f.models, False)
 
 

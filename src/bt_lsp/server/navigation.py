@@ -51,7 +51,6 @@ from bt_lsp.server.lookup import (
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit
-from bt_lsp.syntax.gcpause import with_gc_paused
 from bt_lsp.syntax.sections import Section
 from bt_lsp.syntax.text import Encoding, LineIndex
 
@@ -384,7 +383,6 @@ def _section_text(
     return "".join(out)
 
 
-@with_gc_paused  # a large outline makes hundreds of thousands of objects at once
 def outline_json(doc: Document, ctx: Context, enc: Encoding) -> RawJson:
     """:func:`document_symbols_json` of the document's outline, made of its sections'
     pieces: a section's JSON is kept on it (with the categories it shows, see

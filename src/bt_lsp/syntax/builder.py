@@ -29,7 +29,7 @@ from bt_lsp.syntax.table import ZONES as _ZONES
 from bt_lsp.syntax.table import Columns, ElementTable, Growing, keeps, offsets_code
 from bt_lsp.syntax.tokens import EXTRA_ROOT, LENIENT, XML_SYNTAX, Kind, Token
 from bt_lsp.syntax.values import decode_value
-from bt_lsp.syntax.xmlnames import cached_xml_name_problem
+from bt_lsp.syntax.xmlnames import XmlNameMemo, cached_xml_name_problem
 
 _ZONE_OUTSIDE = Zone.OUTSIDE
 _ZONE_TREE = Zone.TREE
@@ -37,14 +37,14 @@ _ZONE_PORT_DECL = Zone.PORT_DECL
 _ZONE_ROOT = Zone.ROOT
 
 
-def _name_problems(tok: Token, checked: bool) -> tuple[tuple[int, str], ...]:
+def _name_problems(tok: Token, checked: bool, memo: XmlNameMemo) -> tuple[tuple[int, str], ...]:
     """The XML-name problems of a start tag's names, relative to the tag's start."""
     found: list[tuple[int, str]] = []
-    xp = cached_xml_name_problem(tok.name, checked and tok.name not in EXPLICIT_TAGS, False)
+    xp = cached_xml_name_problem(tok.name, checked and tok.name not in EXPLICIT_TAGS, False, memo)
     if xp is not None:
         found.append((1 + xp[0], xp[1]))
     for a in tok.attrs:
-        xp = cached_xml_name_problem(a.name, checked, True)
+        xp = cached_xml_name_problem(a.name, checked, True, memo)
         if xp is not None:
             found.append((a.name_start + xp[0], xp[1]))
     return tuple(found)
@@ -65,6 +65,7 @@ class _Builder:
         "has_root",
         "kids",
         "lexical",
+        "names",
         "origin",
         "problems",
         "stack",
@@ -80,8 +81,10 @@ class _Builder:
         cols: Growing,
         stack: list[int],
         has_root: bool,
+        names: XmlNameMemo,
     ) -> None:
         self.text = text
+        self.names = names  # the XML-name checks of this build
         self.origin = origin
         self.tok_origin = tok_origin
         self.cols = cols
@@ -144,7 +147,7 @@ class _Builder:
                     pz = zones[parent]
                     if tok is not last_tok or pz != last_pz:
                         last_zone = zone_in(tok.name, _ZONES[pz])
-                        last_names = _name_problems(tok, last_zone == node_zone)
+                        last_names = _name_problems(tok, last_zone == node_zone, self.names)
                         last_tok, last_pz = tok, pz
                     zone = last_zone
                     names = last_names
@@ -166,7 +169,7 @@ class _Builder:
                     else:
                         zone = _ZONE_ROOT
                     self.has_root = True
-                    names = _name_problems(tok, False)
+                    names = _name_problems(tok, False, self.names)
                 add_tag(tok)
                 add_zone(zone)
                 add_start(tstart)
@@ -391,13 +394,19 @@ def _stand_in(
 
 
 def _section(
-    tokens: list[Token], starts: Sequence[int], text: str, i: int, root_tag: Token, code: str
+    tokens: list[Token],
+    starts: Sequence[int],
+    text: str,
+    i: int,
+    root_tag: Token,
+    code: str,
+    names: XmlNameMemo,
 ) -> tuple[Section, int, int]:
     """The section that starts at token ``i`` (a start tag with only the root open)."""
     origin = starts[i]
     cols = Growing(code)
     _stand_in(cols, root_tag, -origin, -i, -1, -1)
-    b = _Builder(text, origin, i, cols, [0], True)
+    b = _Builder(text, origin, i, cols, [0], True, names)
     j, end = b.run(tokens, starts, i, _SECTION)
     if end == EOF:
         b.finish(keep_root=True)
@@ -419,7 +428,8 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
     n = len(tokens)
     code = offsets_code(len(text))
     hcols = Growing(code)
-    hb = _Builder(text, 0, 0, hcols, [], False)
+    xml_names: XmlNameMemo = {}  # for this build
+    hb = _Builder(text, 0, 0, hcols, [], False, xml_names)
     i, state = hb.run(tokens, starts, 0, _HEAD)
     root_tag = hcols.tags[0] if hcols.tags else None
     model = Model([], [], [])
@@ -472,7 +482,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
                     state = old.sections[-1].end
                     base = bases[-1] + len(sections[-1].elements)
                     break
-            sec, j, state = _section(tokens, starts, text, i, root_tag, code)
+            sec, j, state = _section(tokens, starts, text, i, root_tag, code, xml_names)
             sections.append(sec)
             origins.append(starts[i])
             firsts.append(i)
@@ -492,7 +502,7 @@ def build(scan: Scan, text: str, old: Model | None = None, change: Rescan | None
             extent, name_at = re_[0] + o, re_[1] + o if re_[1] >= 0 else -1
         tcols = Growing(code)
         _stand_in(tcols, root_tag, root_start, root_tindex, extent, name_at)
-        tb = _Builder(text, 0, 0, tcols, [0] if state != CLOSED else [], True)
+        tb = _Builder(text, 0, 0, tcols, [0] if state != CLOSED else [], True, xml_names)
         tb.run(tokens, starts, i, _TAIL)
         tb.finish(keep_root=False)
         model.tail_start = starts[i] if i < n else len(text)

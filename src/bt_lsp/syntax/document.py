@@ -17,10 +17,10 @@ short lock, and kept only if no edit came in meanwhile.
 from __future__ import annotations
 
 import threading
-from typing import Any
+from types import MappingProxyType
+from typing import Any, Final
 
 from bt_lsp.syntax.builder import build
-from bt_lsp.syntax.gcpause import gc_paused, with_gc_paused
 from bt_lsp.syntax.kind import HEAD_CHARS, bt_evidence_end, looks_like_bt
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.scanner import Rescan, Scan, rescan, scan
@@ -28,22 +28,52 @@ from bt_lsp.syntax.text import LineIndex
 
 __all__ = ["Document", "History", "looks_like_bt"]
 
+# The keys of what the layers above keep for a document from one version to the next
+# (see History), and the slots that hold them.
+_HISTORY_SLOTS: Final = MappingProxyType(
+    {
+        key: "_memo_" + key.replace("-", "_")
+        for key in (
+            "amended",
+            "facts",
+            "generated",
+            "names",
+            "own-sections",
+            "section-checks",
+            "tagged",
+            "walks",
+        )
+    }
+)
+
 
 class History:
-    """What a document and its snapshots have in common: the key of the caches the rules
-    keep from one version to the next (a snapshot analysed on a worker thread finds what
-    the versions before it left, instead of starting again in proportion to the whole
-    document), and the lock held while one of them is analysed, so that two threads never
-    update those caches at once."""
+    """What a document and its snapshots have in common: the caches the rules keep from
+    one version to the next (a snapshot analysed on a worker thread finds what the
+    versions before it left, instead of starting again in proportion to the whole
+    document), read and written like a dict by fixed keys (``history.memo``), and the
+    lock held while one of them is analysed, so that two threads never update those
+    caches at once.  A value is replaced whole, never changed in place, except by an
+    analysis holding the lock."""
 
-    __slots__ = ("__weakref__", "lock")
+    __slots__ = ("__weakref__", "lock", *_HISTORY_SLOTS.values())
 
     def __init__(self) -> None:
         self.lock = threading.RLock()
 
+    @property
+    def memo(self) -> History:
+        """The caches, by key (a history is its own memo, as a section is)."""
+        return self
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return getattr(self, _HISTORY_SLOTS[key], default)
+
+    def __setitem__(self, key: str, value: Any) -> None:
+        setattr(self, _HISTORY_SLOTS[key], value)
+
 
 class Document:
-    @with_gc_paused
     def __init__(self, text: str, path: str | None = None, *, scanned: bool = True) -> None:
         self.path = path
         self.text = text
@@ -81,8 +111,7 @@ class Document:
         tokens = self._scan
         if tokens is None:
             text = self.text
-            with gc_paused():
-                tokens = scan(text)
+            tokens = scan(text)
             if self.text is text:
                 self._scan = tokens
         return tokens
@@ -179,8 +208,7 @@ class Document:
                 tokens = self.scan
             state = tokens, self.text, self._base, self._change
             edits = self._edits
-        with gc_paused():
-            model = build(*state)
+        model = build(*state)
         with self._lock:
             if self._edits == edits and self._model is None:
                 self._model = model

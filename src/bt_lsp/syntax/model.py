@@ -25,8 +25,7 @@ from bt_lsp.syntax.elements import (
     Symbol,
     Zone,
 )
-from bt_lsp.syntax.gcpause import gc_paused
-from bt_lsp.syntax.sections import Part, Section, section_top
+from bt_lsp.syntax.sections import Part, Section, SectionRefs, section_top
 from bt_lsp.syntax.table import ElementTable, Prefixed
 
 
@@ -71,10 +70,13 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
     symbols; the references of a symbol are made (in document coordinates) when asked for,
     from the sections that have it."""
 
-    __slots__ = ("_chunks", "_keys", "_refs")
+    __slots__ = ("_chunks", "_held", "_keys", "_refs")
 
-    def __init__(self, chunks: list[tuple[Part, tuple[Symbol, ...]]]) -> None:
+    def __init__(
+        self, chunks: list[tuple[Part, tuple[Symbol, ...]]], held: list[SectionRefs]
+    ) -> None:
         self._chunks = chunks
+        self._held = held  # the sections' names made here, kept by the model
         keys: set[Symbol] = set()
         for _, symbols in chunks:
             keys.update(symbols)
@@ -90,7 +92,7 @@ class _SymbolIndex(Mapping[Symbol, list[NameRef]]):
                 part.ref(r)
                 for part, symbols in self._chunks
                 if symbol in symbols
-                for r in part.section.refs
+                for r in _held_refs(part.section, self._held)
                 if r.symbol == symbol
             ]
             self._refs[symbol] = refs
@@ -120,6 +122,7 @@ class Model:
         "_by_symbol",
         "_by_zone",
         "_elements",
+        "_held",
         "_problems",
         "_ref_starts",
         "_refs",
@@ -151,6 +154,8 @@ class Model:
         self._ref_starts = ref_starts
         self._by_symbol: Mapping[Symbol, list[NameRef]] | None = None
         self._by_zone: dict[Zone | None, list[Element]] = {}
+        # The sections' names this model asked for, kept while it lives (Section.refs).
+        self._held: list[SectionRefs] = []
         self.root_element: Element | None = None
         self.local: Section | None = None  # the section a section's own model is of
         self.head: Section | None = None  # None for a model that is not made of sections
@@ -190,8 +195,7 @@ class Model:
             self._refs = self.local.refs
         if self._refs is None:
             parts = self.parts()
-            with gc_paused():
-                local = [p.section.refs for p in parts]
+            local = [p.section.refs for p in parts]
             bases = [0, *accumulate(map(len, local))]
             self._refs = _Lazy(bases[-1], bases[:-1], lambda c, j: parts[c].ref(local[c][j]))
         return self._refs
@@ -219,7 +223,7 @@ class Model:
         """The name token containing ``offset`` (its end counts: a cursor after a name)."""
         if self.head is not None:
             part = self.part_at(offset)
-            local = part.section.ref_at(offset - part.origin)
+            local = part.section.ref_at(offset - part.origin, self._held)
             return part.ref(local) if local is not None else None
         i = bisect_right(self.ref_starts, offset) - 1
         if i >= 0 and self.refs[i].start <= offset <= self.refs[i].end:
@@ -249,9 +253,8 @@ class Model:
         """Every symbol's references in document order (built once, on first use)."""
         if self._by_symbol is None:
             if self.head is not None:
-                with gc_paused():
-                    chunks = [(p, p.section.symbols()) for p in self.parts()]
-                    self._by_symbol = _SymbolIndex(chunks)
+                chunks = [(p, p.section.symbols()) for p in self.parts()]
+                self._by_symbol = _SymbolIndex(chunks, self._held)
             else:
                 index: dict[Symbol, list[NameRef]] = {}
                 for r in self.refs:
@@ -386,3 +389,12 @@ class _Chain(Sequence[Element]):
 
 # The root of a section's own model when the document's is not at hand.
 _STAND_IN = Element("", Zone.ROOT, 0, 0, -1, 0, (), False, True)
+
+
+def _held_refs(section: Section, held: list[SectionRefs]) -> SectionRefs:
+    """``section``'s names, kept in ``held`` when made here (see :attr:`Section.refs`)."""
+    refs = section.kept_refs()
+    if refs is None:
+        refs = section.refs
+        held.append(refs)
+    return refs

@@ -22,7 +22,7 @@ from bt_lsp.syntax.elements import (
     port_symbol,
     tree_symbol,
 )
-from bt_lsp.syntax.scanner import scan_token
+from bt_lsp.syntax.scanner import ScanPools, scan_token
 from bt_lsp.syntax.tokens import Attr
 from bt_lsp.syntax.vocabulary import RESERVED_PORT_NAMES, NameKind
 
@@ -62,30 +62,45 @@ _new = tuple.__new__
 
 _S = TypeVar("_S", bound=Symbol)
 
-# Every symbol made so far, to share (bounded).
-_SYMBOLS: dict[Symbol, Symbol] = {}
 
+class SymbolPool:
+    """Equal symbols made once, for one pass over names (its caller's, never shared
+    between threads): the symbols made so far, the port symbols of each owner by port
+    name, and each node type's symbol with its ports' (every element looks them up).
+    Bounded."""
 
-def shared_symbol(symbol: _S) -> _S:
-    shared = _SYMBOLS.get(symbol)
-    if shared is None:
-        if len(_SYMBOLS) >= 65536:
-            _SYMBOLS.clear()
-        shared = _SYMBOLS[symbol] = symbol
-    return cast(_S, shared)  # equal symbols are of one class
+    __slots__ = ("models", "ports", "symbols")
 
+    def __init__(self) -> None:
+        self.symbols: dict[Symbol, Symbol] = {}
+        self.ports: dict[NameSymbol, dict[str, Symbol]] = {}
+        self.models: dict[str, tuple[NameSymbol, dict[str, Symbol]]] = {}
 
-# The port symbols of each owner, by port name (bounded).
-_PORTS: dict[NameSymbol, dict[str, Symbol]] = {}
+    def shared(self, symbol: _S) -> _S:
+        symbols = self.symbols
+        shared = symbols.get(symbol)
+        if shared is None:
+            if len(symbols) >= 65536:
+                symbols.clear()
+            shared = symbols[symbol] = symbol
+        return cast(_S, shared)  # equal symbols are of one class
 
+    def port_symbols(self, owner: NameSymbol) -> dict[str, Symbol]:
+        ports = self.ports.get(owner)
+        if ports is None:
+            if len(self.ports) >= 4096:
+                self.ports.clear()
+            ports = self.ports[owner] = {}
+        return ports
 
-def _port_symbols(owner: NameSymbol) -> dict[str, Symbol]:
-    ports = _PORTS.get(owner)
-    if ports is None:
-        if len(_PORTS) >= 4096:
-            _PORTS.clear()
-        ports = _PORTS[owner] = {}
-    return ports
+    def model_symbols(self, name: str) -> tuple[NameSymbol, dict[str, Symbol]]:
+        found = self.models.get(name)
+        if found is None:
+            if len(self.models) >= 4096:
+                self.models.clear()
+            owner = model_symbol(name)
+            found = self.models[name] = (self.shared(owner), self.port_symbols(owner))
+        return found
 
 
 def _value_ref(
@@ -96,6 +111,7 @@ def _value_ref(
     kind: NameKind | None,
     role: Role,
     symbol: Symbol | None,
+    pool: SymbolPool,
 ) -> None:
     if a.value is not None:
         out.append(
@@ -107,7 +123,7 @@ def _value_ref(
                     a.value,
                     kind,
                     role,
-                    shared_symbol(symbol) if symbol is not None else None,
+                    pool.shared(symbol) if symbol is not None else None,
                     idx,
                     a.quote,
                 ),
@@ -115,24 +131,18 @@ def _value_ref(
         )
 
 
-# The symbol of each node type and the symbols of its ports, by type (bounded): every
-# element of a document looks them up.
-_MODEL_SYMBOLS: dict[str, tuple[NameSymbol, dict[str, Symbol]]] = {}
-
-
-def _model_symbols(name: str) -> tuple[NameSymbol, dict[str, Symbol]]:
-    found = _MODEL_SYMBOLS.get(name)
-    if found is None:
-        if len(_MODEL_SYMBOLS) >= 4096:
-            _MODEL_SYMBOLS.clear()
-        owner = model_symbol(name)
-        found = _MODEL_SYMBOLS[name] = (shared_symbol(owner), _port_symbols(owner))
-    return found
-
-
-def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef]) -> None:
+def name_refs(
+    el: Element,
+    idx: int,
+    parent: Element | None,
+    out: list[NameRef],
+    pool: SymbolPool | None = None,
+) -> None:
     """Append the name tokens of one element to ``out``, by where the element sits (the
-    contract's positions)."""
+    contract's positions); their symbols shared through ``pool`` (a pass over many
+    elements passes one)."""
+    if pool is None:
+        pool = SymbolPool()
     zone = el.zone
     ts = el.token_start
     if zone == _ZONE_NODE:
@@ -145,11 +155,11 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
                     if name == "SubTree"
                     else (_ROLE_NODE_ID, model_symbol(a.value or ""))
                 )
-                _value_ref(out, el, idx, a, _KIND_MODEL, role, sym)
+                _value_ref(out, el, idx, a, _KIND_MODEL, role, sym, pool)
             owner = _owner(el)
-            ports = _port_symbols(owner)
+            ports = pool.port_symbols(owner)
         else:
-            type_symbol, ports = _model_symbols(name)
+            type_symbol, ports = pool.model_symbols(name)
             owner = type_symbol
             out.append(
                 _new(
@@ -188,7 +198,7 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
             elif an not in RESERVED_PORT_NAMES:
                 psym = ports.get(an)
                 if psym is None:
-                    psym = ports[an] = shared_symbol(port_symbol(owner, an))
+                    psym = ports[an] = pool.shared(port_symbol(owner, an))
                 out.append(
                     _new(
                         NameRef,
@@ -198,16 +208,18 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
     elif zone == _ZONE_ROOT:
         a = el.attr("main_tree_to_execute")
         if a is not None:
-            _value_ref(out, el, idx, a, None, _ROLE_MAIN_TREE, tree_symbol(a.value or ""))
+            _value_ref(out, el, idx, a, None, _ROLE_MAIN_TREE, tree_symbol(a.value or ""), pool)
     elif zone == _ZONE_TREE:
         a = el.attr("ID")
         if a is not None:
-            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, tree_symbol(a.value or ""))
+            _value_ref(
+                out, el, idx, a, _KIND_MODEL, _ROLE_TREE_DEF, tree_symbol(a.value or ""), pool
+            )
     elif zone == _ZONE_MODEL_ENTRY:
         a = el.attr("ID")
         if a is not None:
             entry = NameSymbol("tree" if el.name == "SubTree" else "model", a.value or "")
-            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_MODEL_DEF, entry)
+            _value_ref(out, el, idx, a, _KIND_MODEL, _ROLE_MODEL_DEF, entry, pool)
     elif zone == _ZONE_PORT_DECL and parent is not None:
         a = el.attr("name")
         if a is not None:
@@ -219,6 +231,7 @@ def name_refs(el: Element, idx: int, parent: Element | None, out: list[NameRef])
                 _KIND_PORT,
                 _ROLE_PORT_DECL,
                 port_symbol(_owner(parent), a.value or ""),
+                pool,
             )
 
 
@@ -233,7 +246,7 @@ def start_tag_refs(text: str, at: int, zone: Zone, parent: Element | None) -> li
 
 def start_tag_element(text: str, at: int, zone: Zone) -> Element:
     """The element whose start tag is at offset ``at``, alone (no parent or children)."""
-    tok = scan_token(text, at)
+    tok = scan_token(text, at, ScanPools())
     return Element(
         tok.name, zone, at, 0, -1, 0, tok.attrs, tok.self_closing, tok.closed, length=tok.length
     )

@@ -22,6 +22,7 @@ from __future__ import annotations
 import re
 from array import array
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import TypeVar
 
 from bt_lsp.syntax.tag_limits import MAX_ATTRS, MAX_TAG_PROBLEMS, TagLimits
@@ -50,41 +51,73 @@ _FAST_ATTR_RE = re.compile(
     r"[ \t\r\n]+([^ \t\r\n/>=<\"']+)[ \t\r\n]*=[ \t\r\n]*(?:\"([^\"<]*)\"|'([^'<]*)')"
 )
 # An unterminated attribute value ends at its quote or before a line that starts a tag.
-_VALUE_END_RE = {
-    q: re.compile(q + r"|[\r\n][ \t\r\n]*<(?=[A-Za-z_:/!?]|[^\x00-\x7f])") for q in "\"'"
-}
-_STRAY_QUOTE_END = {q: re.compile(f"[{q}<]") for q in "\"'"}
+_VALUE_END_RE = MappingProxyType(
+    {q: re.compile(q + r"|[\r\n][ \t\r\n]*<(?=[A-Za-z_:/!?]|[^\x00-\x7f])") for q in "\"'"}
+)
+_STRAY_QUOTE_END = MappingProxyType({q: re.compile(f"[{q}<]") for q in "\"'"})
 _UNQUOTED_RE = re.compile(r"[^ \t\r\n<>]*")
 
 # Makes a named tuple from all its fields without the Python-level constructor (three times
 # quicker, for the hot paths).
 _new = tuple.__new__
 
-# Shared tokens: text runs by length, end tags and start tags without attributes by their
-# text (bounded).
-_TEXT_TOKENS: dict[int, Token] = {}
-_END_TOKENS: dict[str, Token] = {}
-_START_TOKENS: dict[str, Token] = {}
-# Tag and attribute names, shared (bounded).
-_NAMES: dict[str, str] = {}
 _SHARED_MAX = 8192
-# Short attribute values, shared (bounded): blackboard keys, types and literals recur all
-# over a document (a megabyte of BT XML has three times as many values as distinct ones).
-_VALUES: dict[str, str] = {}
+# Short attribute values are shared: blackboard keys, types and literals recur all over a
+# document (a megabyte of BT XML has three times as many values as distinct ones).
 _SHARED_VALUE_LENGTH = 16
 
-
-def _text_token(length: int) -> Token:
-    """A text run followed by '<' (its scan looked at that '<' too)."""
-    tok = _TEXT_TOKENS.get(length)
-    if tok is None:
-        if len(_TEXT_TOKENS) >= _SHARED_MAX:
-            _TEXT_TOKENS.clear()
-        tok = _TEXT_TOKENS[length] = Token(Kind.TEXT, length, length + 1)
-    return tok
-
-
 _T = TypeVar("_T")
+
+
+class ScanPools:
+    """Equal pieces of the tokens of one scan, made once (each pool bounded): text runs by
+    length, end tags and start tags without attributes by their text, tag and attribute
+    names, short attribute values, and attributes (relative to their tag).  A scan makes
+    its own (:func:`scan`, :func:`rescan`): never shared between threads."""
+
+    __slots__ = (
+        "attrs",
+        "end_tokens",
+        "names",
+        "older_attrs",
+        "older_names",
+        "older_values",
+        "start_tokens",
+        "text_tokens",
+        "values",
+    )
+
+    def __init__(self) -> None:
+        self.text_tokens: dict[int, Token] = {}
+        self.end_tokens: dict[str, Token] = {}
+        self.start_tokens: dict[str, Token] = {}
+        self.names: dict[str, str] = {}
+        self.values: dict[str, str] = {}
+        self.attrs: dict[Attr, Attr] = {}
+        self.older_names: dict[str, str] = {}
+        self.older_values: dict[str, str] = {}
+        self.older_attrs: dict[Attr, Attr] = {}
+
+    def text_token(self, length: int) -> Token:
+        """A text run followed by '<' (its scan looked at that '<' too)."""
+        pool = self.text_tokens
+        tok = pool.get(length)
+        if tok is None:
+            if len(pool) >= _SHARED_MAX:
+                pool.clear()
+            tok = pool[length] = Token(Kind.TEXT, length, length + 1)
+        return tok
+
+    def name(self, name: str) -> str:
+        return self.names.get(name) or _keep(self.names, self.older_names, name)
+
+    def value(self, raw: str) -> str:
+        if len(raw) > _SHARED_VALUE_LENGTH:
+            return raw
+        return self.values.get(raw) or _keep(self.values, self.older_values, raw)
+
+    def attr(self, attr: Attr) -> Attr:
+        return self.attrs.get(attr) or _keep(self.attrs, self.older_attrs, attr)
 
 
 def _keep(pool: dict[_T, _T], older: dict[_T, _T], x: _T) -> _T:
@@ -101,28 +134,11 @@ def _keep(pool: dict[_T, _T], older: dict[_T, _T], x: _T) -> _T:
     return found
 
 
-# Attributes (relative to their tag) shared by equal tags' attributes (bounded).
-_ATTRS: dict[Attr, Attr] = {}
-_OLDER_ATTRS: dict[Attr, Attr] = {}
-_OLDER_NAMES: dict[str, str] = {}
-_OLDER_VALUES: dict[str, str] = {}
-
-
-def _name(name: str) -> str:
-    return _NAMES.get(name) or _keep(_NAMES, _OLDER_NAMES, name)
-
-
-def _value(raw: str) -> str:
-    if len(raw) > _SHARED_VALUE_LENGTH:
-        return raw
-    return _VALUES.get(raw) or _keep(_VALUES, _OLDER_VALUES, raw)
-
-
-def _scan_text(text: str, pos: int, n: int) -> Token:
+def _scan_text(text: str, pos: int, n: int, pools: ScanPools) -> Token:
     end = text.find("<", pos)
     if end == -1:
         return Token(Kind.TEXT, n - pos, n - pos)
-    return _text_token(end - pos)
+    return pools.text_token(end - pos)
 
 
 def _scan_delimited(
@@ -196,17 +212,18 @@ def _scan_doctype(text: str, pos: int, n: int) -> Token:
     )
 
 
-def _scan_end_tag(text: str, pos: int, n: int) -> Token:
+def _scan_end_tag(text: str, pos: int, n: int, pools: ScanPools) -> Token:
     m = _FAST_END_RE.match(text, pos)
     if m is not None:  # the common case: shared
         key = m.group(0)
-        tok = _END_TOKENS.get(key)
+        shared = pools.end_tokens
+        tok = shared.get(key)
         if tok is None:
-            if len(_END_TOKENS) >= _SHARED_MAX:
-                _END_TOKENS.clear()
-            name = _name(m.group(1))
+            if len(shared) >= _SHARED_MAX:
+                shared.clear()
+            name = pools.name(m.group(1))
             length = len(key)
-            tok = _END_TOKENS[key] = Token(Kind.END, length, length + 1, name, 2, 2 + len(name))
+            tok = shared[key] = Token(Kind.END, length, length + 1, name, 2, 2 + len(name))
         return tok
     problems: list[Problem] = []
     m = _NAME_RE.match(text, pos + 2)
@@ -247,7 +264,7 @@ def _scan_end_tag(text: str, pos: int, n: int) -> Token:
     )
 
 
-def _scan_start_fast(text: str, pos: int) -> Token | None:
+def _scan_start_fast(text: str, pos: int, pools: ScanPools) -> Token | None:
     m = _FAST_NAME_RE.match(text, pos)
     if m is None:
         return None
@@ -257,19 +274,21 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
         if m is None:
             return None
         key = text[pos : m.end()]
-        tok = _START_TOKENS.get(key)
+        shared = pools.start_tokens
+        tok = shared.get(key)
         if tok is None:  # shared, like end tags: a document may be made of "<Frob/>"
-            if len(_START_TOKENS) >= _SHARED_MAX:
-                _START_TOKENS.clear()
+            if len(shared) >= _SHARED_MAX:
+                shared.clear()
             length = m.end() - pos
-            name = _name(text[pos + 1 : m.start()])
+            name = pools.name(text[pos + 1 : m.start()])
             self_closing = m.group(1) == "/"
-            tok = _START_TOKENS[key] = _new(
+            tok = shared[key] = _new(
                 Token,
                 (_START, length, length + 1, name, 1, 1 + len(name), (), self_closing, True, ()),
             )
         return tok
-    name = _name(m.group(1))
+    shared_name, shared_value, shared_attr = pools.name, pools.value, pools.attr
+    name = shared_name(m.group(1))
     attrs: list[Attr] = []
     problems: list[Problem] = []
     seen: set[str] = set()
@@ -304,17 +323,17 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
         attr = _new(
             Attr,
             (
-                _name(aname),
+                shared_name(aname),
                 ns - pos,
                 ne - pos,
-                _value(raw) if "&" not in raw else decode_value(raw, vs, problems),
+                shared_value(raw) if "&" not in raw else decode_value(raw, vs, problems),
                 vs,
                 ve - pos,
                 quote,
             ),
         )
         # Equal attributes at the same place in their tags are one tuple, like short values.
-        attrs.append(_ATTRS.get(attr) or _keep(_ATTRS, _OLDER_ATTRS, attr))
+        attrs.append(shared_attr(attr))
     close = _FAST_CLOSE_RE.match(text, a_end)
     if close is None:
         return None
@@ -338,8 +357,8 @@ def _scan_start_fast(text: str, pos: int) -> Token | None:
     )
 
 
-def _scan_start(text: str, pos: int, n: int) -> Token:
-    fast = _scan_start_fast(text, pos)
+def _scan_start(text: str, pos: int, n: int, pools: ScanPools) -> Token:
+    fast = _scan_start_fast(text, pos, pools)
     if fast is not None:
         return fast
     problems: list[Problem] = []
@@ -500,14 +519,17 @@ def _scan_start(text: str, pos: int, n: int) -> Token:
     )
 
 
-def scan_token(text: str, pos: int) -> Token:
-    """Scan the one token that starts at ``pos`` (``pos < len(text)``)."""
+def scan_token(text: str, pos: int, pools: ScanPools | None = None) -> Token:
+    """Scan the one token that starts at ``pos`` (``pos < len(text)``); its pieces shared
+    through ``pools`` (a scan of many tokens passes one)."""
+    if pools is None:
+        pools = ScanPools()
     n = len(text)
     if text[pos] != "<":
-        return _scan_text(text, pos, n)
+        return _scan_text(text, pos, n, pools)
     nxt = text[pos + 1] if pos + 1 < n else ""
     if nxt == "/":
-        return _scan_end_tag(text, pos, n)
+        return _scan_end_tag(text, pos, n, pools)
     if nxt == "!":
         if text.startswith("<!--", pos):
             return _scan_delimited(text, pos, n, Kind.COMMENT, "<!--", "-->", "comment")
@@ -527,7 +549,7 @@ def scan_token(text: str, pos: int) -> Token:
     if nxt == "?":
         return _scan_delimited(text, pos, n, Kind.PI, "<?", "?>", "processing instruction")
     if nxt and nxt not in _NAME_STOP:
-        return _scan_start(text, pos, n)
+        return _scan_start(text, pos, n, pools)
     return Token(
         Kind.STRAY,
         1,
@@ -563,6 +585,7 @@ _PAUSE = 2048
 
 
 def scan(text: str) -> Scan:
+    pools = ScanPools()  # for this scan
     tokens: list[Token] = []
     starts = array("q")  # machine ints: a list would hold an int object per token
     add_token, add_start = tokens.append, starts.append
@@ -577,7 +600,7 @@ def scan(text: str) -> Scan:
     while pos < n:
         if pause:
             pause -= 1
-            tok = scan_token(text, pos)
+            tok = scan_token(text, pos, pools)
             add_token(tok)
             add_start(pos)
             pos += tok.length
@@ -593,7 +616,7 @@ def scan(text: str) -> Scan:
             tok, s1, t1, s2, t2, s3, t3 = t3, s3, t3, s1, t1, s2, t2
             found += 1
         else:
-            tok = scan_token(text, pos)
+            tok = scan_token(text, pos, pools)
             reach = tok.reach
             s3, t3, s2, t2 = s2, t2, s1, t1
             # (Not a tag with attributes: those seldom repeat whole.)
@@ -657,6 +680,7 @@ def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> 
     n = len(new_text)
     new_tokens: list[Token] = []
     new_starts: list[int] = []
+    pools = ScanPools()  # for this re-scan
     k = first  # candidate old token to resynchronise with
     nold = len(tokens)
     while pos < n:
@@ -671,7 +695,7 @@ def rescan(old: Scan, new_text: str, start: int, old_end: int, new_len: int) -> 
                     new_list.extend(tokens[k:])
                     result = Scan(new_list, starts.replaced(first, k, new_starts, delta))
                     return result, Rescan(first, k, first + len(new_tokens))
-        tok = scan_token(new_text, pos)
+        tok = scan_token(new_text, pos, pools)
         new_tokens.append(tok)
         new_starts.append(pos)
         pos += tok.length

@@ -10,9 +10,10 @@ and keeps only the set of symbols they refer to.
 from __future__ import annotations
 
 from bisect import bisect_right
-from collections import OrderedDict
 from collections.abc import Iterator, Sequence
+from types import MappingProxyType
 from typing import Any, Final
+from weakref import ref as weak_ref
 
 from bt_lsp.syntax.elements import (
     DECLARING_ROLES,
@@ -25,7 +26,7 @@ from bt_lsp.syntax.elements import (
     Zone,
     model_symbol,
 )
-from bt_lsp.syntax.nametokens import name_refs, shared_symbol
+from bt_lsp.syntax.nametokens import SymbolPool, name_refs
 from bt_lsp.syntax.table import ZONES, ElementTable
 from bt_lsp.syntax.tokens import Token
 
@@ -41,10 +42,12 @@ OPEN, CLOSED, EOF = 0, 1, 2  # how a section ends: at root level, closing the ro
 
 
 # The memo's keys and the slots that hold them (named apart from a section's own).
-_MEMO_SLOTS: Final = {
-    key: "_memo_" + key.replace("-", "_")
-    for key in ("diagnostics", "outline", "outline-json", "semantics", "symbols", "top")
-}
+_MEMO_SLOTS: Final = MappingProxyType(
+    {
+        key: "_memo_" + key.replace("-", "_")
+        for key in ("diagnostics", "outline", "outline-json", "semantics", "symbols", "top")
+    }
+)
 
 
 class SectionMemo:
@@ -88,6 +91,7 @@ class Section(SectionMemo):
     """
 
     __slots__ = (
+        "_refs",
         "elements",
         "end",
         "length",
@@ -117,6 +121,7 @@ class Section(SectionMemo):
         self.lexical = lexical
         self.end = end
         self.root_end = root_end
+        self._refs: weak_ref[SectionRefs] | None = None  # see refs
 
     @property
     def cache(self) -> SectionMemo:
@@ -139,23 +144,29 @@ class Section(SectionMemo):
         return ZONES[self.elements.columns.zones[1]]
 
     @property
-    def refs(self) -> list[NameRef]:
+    def refs(self) -> SectionRefs:
         """The section's name tokens, in order.  Made from its elements when asked for,
-        and kept for the few sections asked about last only: a document has more names
-        than elements."""
-        refs = _RECENT_REFS.get(self)
+        and not kept by the section: a document has more names than elements.  The section
+        finds them again (a weak reference) while someone keeps them: the model that asked
+        (:meth:`Model.refs`, :meth:`Model.ref_at`) keeps those it asked for, so that they
+        live as long as the version of the document that needs them.  Reading and setting
+        the reference are single steps, so two threads asking at once at worst make them
+        twice."""
+        refs = self.kept_refs()
         if refs is not None:
-            _RECENT_REFS.move_to_end(self)
             return refs
-        refs = self._make_refs()
+        refs = SectionRefs(self._make_refs())
         if "symbols" not in self.cache:  # small, kept: see symbols()
             self.cache["symbols"] = tuple(
                 dict.fromkeys(r.symbol for r in refs if r.symbol is not None)
             )
-        _RECENT_REFS[self] = refs
-        if len(_RECENT_REFS) > 64:
-            _RECENT_REFS.popitem(last=False)
+        self._refs = weak_ref(refs)
         return refs
+
+    def kept_refs(self) -> SectionRefs | None:
+        """The section's name tokens if someone keeps them (see :attr:`refs`)."""
+        kept = self._refs
+        return kept() if kept is not None else None
 
     def _make_refs(self) -> list[NameRef]:
         refs = list(self._element_refs())
@@ -166,7 +177,7 @@ class Section(SectionMemo):
         """The section's name tokens, not in order, without keeping them (for a pass
         over all of them, such as the name rules: a list of them all costs more memory
         than the text they are in); notes the section's symbols on the way."""
-        refs = _RECENT_REFS.get(self)
+        refs = self.kept_refs()
         if refs is not None:
             yield from refs
             return
@@ -183,14 +194,15 @@ class Section(SectionMemo):
     def _element_refs(self) -> Iterator[NameRef]:
         """The name tokens of each element in turn."""
         refs: list[NameRef] = []
+        pool = SymbolPool()  # for this pass
         root = self.root
         if root is not None:
-            name_refs(root, 0, None, refs)
+            name_refs(root, 0, None, refs, pool)
             yield from refs
             refs.clear()
         els = self.elements
         if els.kept:  # made already, or to be made once anyway
-            yield from self._kept_refs(els)
+            yield from self._kept_refs(els, pool)
             return
         cols = els.columns
         tags, zones, starts, names_at = cols.tags, cols.zones, cols.starts, cols.names_at
@@ -213,41 +225,46 @@ class Section(SectionMemo):
                 p = el.parent
                 parent = els[p - 1] if p > 0 and zone == _ZONE_PORT_DECL else None
                 refs = []
-                name_refs(el, i, parent, refs)
+                name_refs(el, i, parent, refs, pool)
                 if zone != _ZONE_PORT_DECL:
                     last_tag, last_zone, first_ts, first = tag, zone, ts, refs
                 yield from refs
             at = names_at[i]
             if at >= 0 and zone == _ZONE_NODE:
-                end_ref = _end_ref(tag.name, ts + at, i)
+                end_ref = _end_ref(tag.name, ts + at, i, pool)
                 if end_ref is not None:
                     yield end_ref
 
     @staticmethod
-    def _kept_refs(els: ElementTable) -> Iterator[NameRef]:
+    def _kept_refs(els: ElementTable, pool: SymbolPool) -> Iterator[NameRef]:
         refs: list[NameRef] = []
         for i, el in enumerate(els, 1):
             zone = el.zone
             p = el.parent
-            name_refs(el, i, els[p - 1] if p > 0 and zone == _ZONE_PORT_DECL else None, refs)
+            parent = els[p - 1] if p > 0 and zone == _ZONE_PORT_DECL else None
+            name_refs(el, i, parent, refs, pool)
             if zone == _ZONE_NODE and el.end_name_at >= 0:
-                end_ref = _end_ref(el.name, el.token_start + el.end_name_at, i)
+                end_ref = _end_ref(el.name, el.token_start + el.end_name_at, i, pool)
                 if end_ref is not None:
                     refs.append(end_ref)
             if refs:
                 yield from refs
                 refs.clear()
 
-    def ref_at(self, offset: int) -> NameRef | None:
+    def ref_at(self, offset: int, held: list[SectionRefs] | None = None) -> NameRef | None:
         """The name token containing local ``offset`` (see :meth:`Model.ref_at`).  In a
         large section whose names are not made yet, read from the one tag that holds it:
         making them all to find one took seconds in a tree of a million elements, at the
-        first hover after each edit."""
-        if len(self.elements.rows) > _FEW and self not in _RECENT_REFS:
+        first hover after each edit.  Names made to find it are added to ``held``."""
+        refs = self.kept_refs()
+        if refs is None and len(self.elements.rows) > _FEW:
             found = self.ref_in_tag(offset)
             if not isinstance(found, _Unsure):
                 return found
-        refs = self.refs
+        if refs is None:
+            refs = self.refs
+            if held is not None:  # the caller keeps them (see refs)
+                held.append(refs)
         i = bisect_right([r.start for r in refs], offset) - 1
         if i >= 0 and refs[i].start <= offset <= refs[i].end:
             return refs[i]
@@ -285,7 +302,7 @@ class Section(SectionMemo):
             if ens >= 0 and ens <= offset <= ens + len(el.name):
                 if el.zone != _ZONE_NODE:
                     return UNSURE
-                return _end_ref(el.name, ens, i)
+                return _end_ref(el.name, ens, i, SymbolPool())
             end = el.end  # (-1: never closed, so an ancestor's end tag may hold it)
             if end > offset or el.parent <= 0:
                 return UNSURE if end == offset else None
@@ -311,7 +328,7 @@ class Section(SectionMemo):
         :data:`DECLARING_ROLES`), in order, made from the elements of the zones that hold
         them only (found in its zones column, in C): a tree of a million node uses
         declares nothing, and a hover asks what declares a name."""
-        refs = _RECENT_REFS.get(self)
+        refs = self.kept_refs()
         if refs is not None:
             return [r for r in refs if r.role in DECLARING_ROLES]
         els = self.elements
@@ -324,11 +341,13 @@ class Section(SectionMemo):
                 found.append(at)
                 at = zones.find(zone, at + 1, rows.stop)
         out: list[NameRef] = []
+        pool = SymbolPool()
         for r in sorted(found):
             k = r - rows.start
             el = els[k]
             p = el.parent
-            name_refs(el, k + 1, els[p - 1] if p > 0 and el.zone == _ZONE_PORT_DECL else None, out)
+            parent = els[p - 1] if p > 0 and el.zone == _ZONE_PORT_DECL else None
+            name_refs(el, k + 1, parent, out, pool)
         out.sort(key=_start)
         return [r for r in out if r.role in DECLARING_ROLES]
 
@@ -346,7 +365,13 @@ class Section(SectionMemo):
         return found
 
 
-_RECENT_REFS: OrderedDict[Section, list[NameRef]] = OrderedDict()
+class SectionRefs(list[NameRef]):
+    """A section's name tokens (:attr:`Section.refs`): a list that the section can refer
+    to weakly."""
+
+    __slots__ = ("__weakref__",)
+
+
 # A section of more elements finds the name at an offset from its tag (Section.ref_at).
 _FEW: Final = 256
 
@@ -414,13 +439,13 @@ def section_top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> E
     return el
 
 
-def _end_ref(name: str, at: int, i: int) -> NameRef | None:
+def _end_ref(name: str, at: int, i: int, pool: SymbolPool) -> NameRef | None:
     """The name token of the end tag at ``at`` of compact node ``i``: it names the node's
     type too."""
     if name in EXPLICIT_TAGS or name == "SubTree":
         return None
     return NameRef(
-        at, at + len(name), name, None, _ROLE_NODE_TYPE_END, shared_symbol(model_symbol(name)), i
+        at, at + len(name), name, None, _ROLE_NODE_TYPE_END, pool.shared(model_symbol(name)), i
     )
 
 

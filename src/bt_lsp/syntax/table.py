@@ -20,6 +20,7 @@ from array import array
 from collections.abc import Iterator, Mapping, Sequence
 from itertools import chain, repeat
 from operator import itemgetter
+from types import MappingProxyType
 from typing import TypeAlias, overload
 
 from bt_lsp.syntax.elements import NO_CHILDREN, Element, Zone, of_row
@@ -36,7 +37,7 @@ _CHUNK = 512
 # Sections of at most this many rows are packed (a column read of them copies its slice).
 PACKED_ROWS = 64
 # The contents of columns without port declarations (shared).
-_NO_CONTENTS: Mapping[int, str] = {}
+_NO_CONTENTS: Mapping[int, str] = MappingProxyType({})
 
 # A row's values as :meth:`Columns.row` gives them (seven).
 _Row: TypeAlias = Sequence[int]

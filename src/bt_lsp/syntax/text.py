@@ -17,30 +17,35 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_left, bisect_right
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from itertools import accumulate, count
 from operator import add
+from types import MappingProxyType
 from typing import Final, Literal, overload
 
 __all__ = ["Encoding", "LineIndex", "Offsets", "normalize_encoding", "positions_of"]
 
 Encoding = Literal["utf-8", "utf-16", "utf-32"]
 
-_ENCODINGS: Final[dict[str, Encoding]] = {
-    "utf-8": "utf-8",
-    "utf8": "utf-8",
-    "utf-16": "utf-16",
-    "utf16": "utf-16",
-    "utf-32": "utf-32",
-    "utf32": "utf-32",
-}
+_ENCODINGS: Final[Mapping[str, Encoding]] = MappingProxyType(
+    {
+        "utf-8": "utf-8",
+        "utf8": "utf-8",
+        "utf-16": "utf-16",
+        "utf16": "utf-16",
+        "utf-32": "utf-32",
+        "utf32": "utf-32",
+    }
+)
 
 # Codec name (no byte-order mark) and bytes per code unit, per encoding.
-_CODECS: Final[dict[str, tuple[str, int]]] = {
-    "utf-8": ("utf-8", 1),
-    "utf-16": ("utf-16-le", 2),
-    "utf-32": ("utf-32-le", 4),
-}
+_CODECS: Final[Mapping[str, tuple[str, int]]] = MappingProxyType(
+    {
+        "utf-8": ("utf-8", 1),
+        "utf-16": ("utf-16-le", 2),
+        "utf-32": ("utf-32-le", 4),
+    }
+)
 
 
 def normalize_encoding(value: object) -> Encoding:

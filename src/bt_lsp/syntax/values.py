@@ -7,12 +7,13 @@ error, a blackboard key) maps back through these offsets."""
 from __future__ import annotations
 
 import re
+from types import MappingProxyType
 
 from bt_lsp.syntax.tokens import UNESCAPED, XML_SYNTAX, Problem
 
 # An entity or character reference (the one definition: the value offsets follow it too).
 REFERENCE_RE = re.compile(r"&(#[0-9]+|#x[0-9A-Fa-f]+|[A-Za-z_:][A-Za-z0-9_.:-]*);")
-_PREDEFINED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
+_PREDEFINED = MappingProxyType({"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"})
 
 
 def _char_ref(body: str) -> str | None:

@@ -54,17 +54,20 @@ def xml_name_problem(name: str, checked: bool, port: bool = False) -> tuple[int,
     return None
 
 
-# Names repeat: their XML-name check is remembered (bounded; cleared when full).
-_XML_NAME_CACHE: dict[tuple[str, bool, bool], tuple[int, str] | None] = {}
+# What names were found to break, by (name, checked, port): for one pass (names repeat).
+XmlNameMemo = dict[tuple[str, bool, bool], tuple[int, str] | None]
 
 
-def cached_xml_name_problem(name: str, checked: bool, port: bool) -> tuple[int, str] | None:
+def cached_xml_name_problem(
+    name: str, checked: bool, port: bool, memo: XmlNameMemo
+) -> tuple[int, str] | None:
+    """:func:`xml_name_problem`, remembered in ``memo`` (the caller's, bounded)."""
     key = (name, checked, port)
     try:
-        return _XML_NAME_CACHE[key]
+        return memo[key]
     except KeyError:
         pass
-    if len(_XML_NAME_CACHE) >= 65536:
-        _XML_NAME_CACHE.clear()
-    found = _XML_NAME_CACHE[key] = xml_name_problem(name, checked, port)
+    if len(memo) >= 65536:
+        memo.clear()
+    found = memo[key] = xml_name_problem(name, checked, port)
     return found

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from itertools import islice
 from typing import TYPE_CHECKING, Literal
 
+from bt_lsp.rules.codes import defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Capped, capped
 from bt_lsp.rules.semantics import document, models, nodes, ports, trees
@@ -180,17 +181,22 @@ def _check_rows(st: State, els: ElementTable) -> None:
 
 
 def _add_found(st: State, ts: int, found: tuple[Finding, ...]) -> None:
-    """Add what a remembered tag's checks found, for the tag at ``ts``.  Past the first
-    :data:`~bt_lsp.rules.diagnostics.MAX_DIAGNOSTICS` by position, a finding after them is
-    counted without calling ``st.add`` (which would count it too: a document of a million
-    equal findings keeps 2,000)."""
+    """Add what a remembered tag's checks found, for the tag at ``ts``.  Past the
+    :data:`~bt_lsp.rules.diagnostics.MAX_DIAGNOSTICS` kept (by severity, then position),
+    a finding after them is counted without calling ``st.add`` (which would count it
+    too: a document of a million equal findings keeps 2,000)."""
     add = st.add
     for s, e, code, message, severity, data in found:
         start = ts + s
         limit = st.limit
-        if limit is not None and start > limit[0]:
-            st.more += 1
-            continue
+        if limit is not None:  # past the cap however st.add ranks it: counted here
+            sev = defined(code).severity if severity is None else severity
+            if (sev, start) > (
+                limit[0],
+                limit[1],
+            ):  # (add may make an error a warning, never the reverse)
+                st.more += 1
+                continue
         add(start, ts + e, code, message, severity, data)
 
 

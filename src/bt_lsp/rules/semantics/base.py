@@ -5,13 +5,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Final, Literal
 
 from bt_lsp.rules.builtins import BUILTINS, Category, NodeModel, PortModel
 from bt_lsp.rules.builtins_v3 import V3_BUILTINS, V3_OPTIONAL_PORTS
 from bt_lsp.rules.codes import BT, FixData, Severity, define, defined
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, sort_key
+from bt_lsp.rules.diagnostics import MAX_DIAGNOSTICS, Diagnostic, cap_key
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.tokens import Token
@@ -98,9 +99,9 @@ def resolve_builtin(type_id: str) -> Resolved | None:
     )
 
 
-_BUILTIN_RESOLVED: Final[dict[str, Resolved]] = {
-    k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None
-}
+_BUILTIN_RESOLVED: Final[Mapping[str, Resolved]] = MappingProxyType(
+    {k: r for k in BUILTINS if (r := resolve_builtin(k)) is not None}
+)
 
 
 def _resolve_v3(m: NodeModel) -> Resolved:
@@ -114,9 +115,9 @@ def _resolve_v3(m: NodeModel) -> Resolved:
 
 
 #: The built-ins of a BehaviorTree.CPP 3.8 factory (see :mod:`bt_lsp.rules.builtins_v3`).
-_BUILTIN_RESOLVED_V3: Final[dict[str, Resolved]] = {
-    k: _resolve_v3(m) for k, m in V3_BUILTINS.items()
-}
+_BUILTIN_RESOLVED_V3: Final[Mapping[str, Resolved]] = MappingProxyType(
+    {k: _resolve_v3(m) for k, m in V3_BUILTINS.items()}
+)
 
 
 # When ``State.out`` holds this many diagnostics, it is cut to the first MAX_DIAGNOSTICS.
@@ -156,11 +157,12 @@ class State:
     origin: int = 0
     uses_lines: bool = False  # whether a message names a line (see line_of)
     # How many diagnostics were found and not kept in ``out``: only the first
-    # MAX_DIAGNOSTICS by position are ever published, so no more are kept (see add).
+    # MAX_DIAGNOSTICS by severity, then position (cap_key) are ever published, so no more
+    # are kept (see add).
     more: int = 0
-    # Once ``out`` holds MAX_DIAGNOSTICS: the key of its last diagnostic by position,
-    # which a later one must be below to be kept (an equal one sorts after it).
-    limit: tuple[int, int, str] | None = None
+    # Once ``out`` holds MAX_DIAGNOSTICS: the cap_key of its last diagnostic by that
+    # order, which a later one must be below to be kept (an equal one sorts after it).
+    limit: tuple[int, int, int, str] | None = None
     # What a rule found for a name, by its own key, so that a document repeating the name
     # a hundred thousand times costs one finding (the run over one section records
     # what it read, so each run has its own).
@@ -197,18 +199,20 @@ class State:
     ) -> None:
         if self.record is not None:
             self.record.append((start, end, code, message, severity, data))
-        limit = self.limit
-        if limit is not None and (start, end, code) >= limit:
-            self.more += 1  # after the first MAX_DIAGNOSTICS found: never kept
-            return
         sev = defined(code).severity if severity is None else severity
-        if (
+        downgraded = (
             sev == Severity.ERROR
             and not self.v4
             and code in VERSION_4_RULES
             and not (self.v3 and code in V3_CREATION_RULES)
-        ):
+        )
+        if downgraded:
             sev = Severity.WARNING
+        limit = self.limit
+        if limit is not None and (sev, start, end, code) >= limit:
+            self.more += 1  # after the first MAX_DIAGNOSTICS kept: never kept
+            return
+        if downgraded:
             if self.v3:
                 message += " (a check BehaviorTree.CPP 4 makes; this project builds against 3)"
             elif self.ctx.btcpp_unclear:
@@ -223,12 +227,12 @@ class State:
         out = self.out
         out.append(Diagnostic(start, end, code, message, sev, data))
         if len(out) == MAX_DIAGNOSTICS and limit is None:
-            self.limit = max(map(sort_key, out))  # one at or after it is the cap's + 1st
-        elif len(out) >= _SHRINK_AT:  # keep the first by position (a stable sort)
-            out.sort(key=sort_key)
+            self.limit = max(map(cap_key, out))  # one at or after it is the cap's + 1st
+        elif len(out) >= _SHRINK_AT:  # keep the first by cap_key (a stable sort)
+            out.sort(key=cap_key)
             self.more += len(out) - MAX_DIAGNOSTICS
             del out[MAX_DIAGNOSTICS:]
-            self.limit = sort_key(out[-1])
+            self.limit = cap_key(out[-1])
 
     def resolve(self, type_id: str) -> Resolved | None:
         """The model of node type ``type_id``: built-in first (of the project's

@@ -40,7 +40,9 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Final, cast
 
 from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
@@ -166,17 +168,19 @@ PARALLEL_THRESHOLD: Final = define(
 )
 
 
-_BUILTIN_LOWER: Final[dict[str, str]] = {k.lower(): k for k in BUILTINS}
+_BUILTIN_LOWER: Final[Mapping[str, str]] = MappingProxyType({k.lower(): k for k in BUILTINS})
 _LEADING_INT: Final = re.compile(r"-?[0-9]+")
 # Entries of V3_RENAMES that are typos rather than version 3 names.
 _MISSPELLINGS: Final = frozenset({"RetryUntilSuccesful"})
 # Built-ins of BehaviorTree.CPP 3 that version 4 dropped.
-V3_ONLY: Final[dict[str, str]] = {
-    "BlackboardCheckInt": "ScriptCondition or a _skipIf/_successIf precondition",
-    "BlackboardCheckDouble": "ScriptCondition or a _skipIf/_successIf precondition",
-    "BlackboardCheckString": "ScriptCondition or a _skipIf/_successIf precondition",
-    "BlackboardCheckBool": "ScriptCondition or a _skipIf/_successIf precondition",
-}
+V3_ONLY: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        "BlackboardCheckInt": "ScriptCondition or a _skipIf/_successIf precondition",
+        "BlackboardCheckDouble": "ScriptCondition or a _skipIf/_successIf precondition",
+        "BlackboardCheckString": "ScriptCondition or a _skipIf/_successIf precondition",
+        "BlackboardCheckBool": "ScriptCondition or a _skipIf/_successIf precondition",
+    }
+)
 
 
 def check_node(st: State, el: Element) -> Resolved | None:

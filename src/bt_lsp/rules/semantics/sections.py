@@ -20,7 +20,6 @@ them; such rules belong to the document-wide pass), nor the root's other childre
 from __future__ import annotations
 
 import dataclasses
-import weakref
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from itertools import compress, count
 from typing import TYPE_CHECKING, Final, TypeVar, cast
@@ -35,7 +34,6 @@ from bt_lsp.syntax.model import Model
 from bt_lsp.syntax.sections import Section
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import History
     from bt_lsp.syntax.text import LineIndex
 
 __all__ = ["check_sections"]
@@ -152,9 +150,6 @@ class _History:
     lines: set[Section] = dataclasses.field(default_factory=set)
 
 
-_HISTORY: weakref.WeakKeyDictionary[History, _History] = weakref.WeakKeyDictionary()
-
-
 def check_sections(st: State, check: Callable[[State, Sequence[Element]], None]) -> None:
     """Add the section pass's diagnostics of every section of ``st.model`` to ``st.out``:
     ``check`` runs over the elements of the sections whose remembered results are out of
@@ -188,9 +183,11 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
             sig = found[key] = _signature(mappings[field], key, ctx.path)
         return sig
 
-    hist = _HISTORY.get(st.doc.history)
+    # Kept for the document (its history), updated by one analysis at a time (its lock).
+    hist: _History | None = st.doc.history.memo.get("section-checks")
     if hist is None:
-        hist = _HISTORY[st.doc.history] = _History()
+        hist = _History()
+        st.doc.history.memo["section-checks"] = hist
     sections, origins = model.sections, model.origins
     n = len(sections)
     old = hist.sections

@@ -38,7 +38,6 @@
 from __future__ import annotations
 
 import os
-import weakref
 from itertools import compress
 from operator import itemgetter
 from typing import TYPE_CHECKING, Final
@@ -52,7 +51,7 @@ from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.tokens import Attr
 
 if TYPE_CHECKING:
-    from bt_lsp.syntax.document import History
+    pass
 
 # The codes of these rules (see bt_lsp.rules.registry).
 TREE_CHILD_COUNT: Final = define(
@@ -342,11 +341,6 @@ _Cycle = tuple[str, int, str]
 _Graph = tuple[
     str | None, str | None, tuple[str, ...], tuple[tuple[str, ...], ...], tuple[str | None, ...]
 ]
-# The last walk of each document, used again while its graph is the same: typing inside a
-# tree rarely changes which trees call which.
-_WALKS: weakref.WeakKeyDictionary[History, tuple[_Graph, list[_Cycle]]] = (
-    weakref.WeakKeyDictionary()
-)
 _LAST = itemgetter(-1)
 _PATH, _CALLS = itemgetter(1), itemgetter(4)
 
@@ -368,12 +362,14 @@ def check_recursion(st: State) -> None:
         tuple(map(_CALLS, kept)),
         tuple(map(_PATH, kept)),
     )
-    last = _WALKS.get(st.doc.history)
+    # The document's last walk, used again while its graph is the same: typing inside a
+    # tree rarely changes which trees call which.
+    last: tuple[_Graph, list[_Cycle]] | None = st.doc.history.memo.get("walks")
     if last is not None and last[0] == graph_key:
         cycles = last[1]
     else:
         cycles = _walk(dict(zip(graph_key[2], kept, strict=True)), main, ctx.path)
-        _WALKS[st.doc.history] = (graph_key, cycles)
+        st.doc.history.memo["walks"] = (graph_key, cycles)
     for tree_id, idx, shown in cycles:
         decl = ctx.trees[tree_id][-1]
         s, e = decl.call_offsets[idx]
