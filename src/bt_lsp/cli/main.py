@@ -11,6 +11,7 @@ import os
 import re
 import sys
 from collections.abc import Sequence
+from typing import TextIO
 
 from bt_lsp import __version__
 from bt_lsp.project.fileio import DEFAULT_MAX_BYTES
@@ -260,9 +261,9 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     return check.run(args.paths, options)
 
 
-def _isatty(stream: object) -> bool:
+def _isatty(stream: TextIO) -> bool:
     try:
-        return bool(stream.isatty())
+        return stream.isatty()
     except (AttributeError, ValueError, OSError):
         return False
 
