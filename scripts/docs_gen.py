@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bt_lsp.project.schema import KEYS
-from bt_lsp.rules.codes import Code
+from bt_lsp.rules.codes import Applicability, Code, FixSpec
 from bt_lsp.rules.registry import CODES, FAMILIES
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -30,6 +30,28 @@ def _cell(text: str) -> str:
 def _fix_title(template: str) -> str:
     """A fix title template with its fields shown as placeholders: ``Rename '‹old›'``."""
     return re.sub(r"\{(\w+)\}", r"‹\1›", template)
+
+
+_CLASS = {
+    Applicability.SAFE: "safe: `check --fix` and fix-all apply it",
+    Applicability.UNSAFE: "unsafe: only `check --fix --unsafe-fixes` applies it",
+    Applicability.DISPLAY_ONLY: "unsafe: offered in the editor only",
+}
+
+
+def _fix_line(f: FixSpec) -> str:
+    when = f", for {f.when}" if f.when else ""
+    return f"{_fix_title(f.title)} ({_CLASS[f.applicability]}{when})"
+
+
+def _fix_cell(fixes: list[FixSpec]) -> str:
+    """The quick fixes of a code, each title once with its classes: ``(safe, unsafe)``."""
+    classes: dict[str, list[str]] = {}
+    for f in fixes:
+        found = classes.setdefault(f.title, [])
+        if f.applicability.value not in found:
+            found.append(f.applicability.value)
+    return "; ".join(f"`{_cell(_fix_title(t))}` ({', '.join(c)})" for t, c in classes.items())
 
 
 def _xml(text: str) -> list[str]:
@@ -54,8 +76,7 @@ def rule_page(c: Code) -> str:
         f"| Family | [{family}](index.md#{_anchor(family)}) |",
     ]
     if c.fixes:
-        titles = "; ".join(f"`{_cell(_fix_title(t))}`" for t in c.fixes.values())
-        out.append(f"| Quick fixes | {titles} |")
+        out.append(f"| Quick fixes | {_fix_cell(list(c.fixes.values()))} |")
     if c.since:
         out.append(f"| Applies to | {_cell(c.since)} |")
     out.append("")
@@ -73,11 +94,13 @@ def rule_page(c: Code) -> str:
     if c.fixes:
         out.append("In the editor, the quick fix on the diagnostic offers:")
         out.append("")
-        out += [f"- {_fix_title(t)}" for t in c.fixes.values()]
+        out += [f"- {_fix_line(f)}" for f in c.fixes.values()]
         out += [
             "",
-            "`bt-lsp check --fix` applies the preferred fix of every diagnostic, in every "
-            "file it checks (a rename changes all the places at once).",
+            "`bt-lsp check --fix` applies the first safe fix of every diagnostic, the "
+            "editor's preferred one, in every file it checks (a rename changes all the "
+            "places at once); `check --fix --unsafe-fixes` its first fix that is safe or "
+            "unsafe. See [fixes: safe and unsafe](../cli.md#fixes-safe-and-unsafe).",
         ]
     else:
         out.append(

@@ -159,6 +159,7 @@ def test_fix_adds_the_format() -> None:
         '<root>\n  <BehaviorTree ID="M">\n    <AlwaysSuccess/>\n  </BehaviorTree>\n</root>\n',
         '<root BTCPP_format="4">\n'
         '  <BehaviorTree ID="M">\n    <AlwaysSuccess/>\n  </BehaviorTree>\n</root>\n',
+        'Add BTCPP_format="4" to <root>',  # unsafe with no version known: not preferred
     )
 
 

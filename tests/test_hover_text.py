@@ -3,6 +3,8 @@ fact), the quick fix's count of places, and blackboard keys."""
 
 from __future__ import annotations
 
+import re
+
 from bt_lsp.ide.hover import hover_at
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
@@ -137,3 +139,41 @@ def test_a_node_learned_from_cpp_says_where_relative_with_a_link() -> None:
     assert plain is not None
     assert "Action registered in src/app/src/main.cpp:21." in plain.text
     assert "/ws/src" not in plain.text
+
+
+# A name with an asterisk, a backslash and a space, and a port declared with a reserved
+# name: the hover lists the characters and states the rules, whose text has '*', '\',
+# '_' and '<'.
+BAD_CHARS = (
+    '<root BTCPP_format="4">\n'
+    '  <BehaviorTree ID="a*b\\c d"><AlwaysSuccess/></BehaviorTree>\n'
+    '  <TreeNodesModel><SubTree ID="S"><input_port name="_skipIf"/></SubTree></TreeNodesModel>\n'
+    "</root>\n"
+)
+
+
+def _outside_code(markdown: str) -> str:
+    """The Markdown with its code spans and bold markers taken out."""
+    text = re.sub(r"``.*?``|`[^`]*`", "", markdown)
+    return text.replace("**", "")
+
+
+def test_markdown_hover_shows_special_characters_the_same_everywhere() -> None:
+    # Outside code spans no '\' (Neovim 0.7 hides it before punctuation or a space, 0.11
+    # shows an escape as typed), no '*' or '_' (emphasis in Neovim 0.7) and no '<'.
+    for needle, into in (("a*b", 1), ("_skipIf", 1)):
+        md = _hover(BAD_CHARS, needle, into)
+        prose = _outside_code(md)
+        for char in "\\*_<":
+            assert char not in prose, (char, md)
+    md = _hover(BAD_CHARS, "a*b")
+    assert "path separators (/ backslash :), wildcards (`*` ? `|`)" in md
+    assert "`'*'` (asterisk)" in md
+    assert "U+005C (backslash)" in md
+    assert "' ' (space)" in md  # nothing to protect: as the diagnostic says it
+    md = _hover(BAD_CHARS, "_skipIf")
+    assert "`_skipIf`, `_successIf`" in md and "`<SubTree>`" in md
+    # Plain text is as the diagnostics say it.
+    plain = _hover(BAD_CHARS, "a*b", markdown=False)
+    assert "path separators (/ \\ :), wildcards (* ? |)" in plain
+    assert "'\\\\' (backslash)" in plain and "'*' (asterisk)" in plain

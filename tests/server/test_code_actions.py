@@ -473,3 +473,54 @@ async def test_tree_port_fix_renames_its_key_inside_the_tree(client: BtClient) -
         .replace('name="who.m"', 'name="who_m"')
     )
     assert names_only(await _send_edits(client, uri, 2, text, action)) == []
+
+
+# A typo of a built-in, a built-in without its required port, a call of a missing tree
+# and a raw '&': one safe fix (the escape), the others unsafe.
+UNSAFE = (
+    '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+    '  <BehaviorTree ID="Main">\n'
+    '    <Fallbak name="a&b">\n'
+    "      <Repeat><AlwaysSuccess/></Repeat>\n"
+    '      <SubTree ID="Charge"/>\n'
+    "    </Fallbak>\n"
+    "  </BehaviorTree>\n"
+    "</root>\n"
+)
+
+
+async def test_unsafe_fixes_say_so_and_fix_all_leaves_them(client: BtClient) -> None:
+    text = UNSAFE
+    uri = client.open(text)
+    await client.diags(uri, 1)
+
+    async def quick(needle: str) -> list[types.CodeAction]:
+        found = await client.code_actions(
+            uri, _at(client, text, needle), only=[types.CodeActionKind.QuickFix]
+        )
+        return [a for a in found if isinstance(a, types.CodeAction)]
+
+    (typo, *_) = await quick("Fallbak")
+    assert typo.title == "Rename 'Fallbak' to 'Fallback' (unsafe)" and not typo.is_preferred
+    (port,) = await quick("Repeat")
+    assert port.title == 'Add num_cycles="" (unsafe)' and not port.is_preferred
+    assert 'Repeat num_cycles=""' in await _apply(client, uri, text, port)
+    (create,) = await quick("Charge")
+    assert create.title == "Create the tree 'Charge' that fails until it is written (unsafe)"
+    created = await _apply(client, uri, text, create)
+    assert created.endswith(
+        '  <BehaviorTree ID="Charge">\n'
+        "    <!-- TODO: write this tree; until then it fails when it runs -->\n"
+        "    <AlwaysFailure/>\n"
+        "  </BehaviorTree>\n"
+        "</root>\n"
+    )
+    (escape,) = await quick("&")
+    assert escape.title == "Escape '&' as '&amp;'" and escape.is_preferred
+
+    (fix_all,) = await client.code_actions(
+        uri, types.Range(types.Position(0, 0), types.Position(0, 0)), only=[FIX_ALL]
+    )
+    assert fix_all.title == "Apply all safe bt-lsp fixes"
+    # The safe fix only, as `bt-lsp check --fix` makes it.
+    assert await _apply(client, uri, text, fix_all) == text.replace("a&b", "a&amp;b")

@@ -196,7 +196,7 @@ async def test_a_bad_id_registered_in_cpp_is_renamed_there_first(cpp_client: BtC
     assert fixes and not any(a.is_preferred for a in fixes)
     assert fixes[0].title == (
         "Rename 'Battery.Ok' to 'Battery_Ok' (1 place); the node type 'Battery.Ok' is "
-        "registered in C++ in register.cpp: rename it there too"
+        "registered in C++ in register.cpp: rename it there too (unsafe)"
     )
     cpp_client.replace(cpp, 3, text)
     cpp_client.replace(main, 3, MAIN.read_text())

@@ -175,7 +175,7 @@ async def test_quick_fix_edits_are_exact(client: BtClient) -> None:
     assert action.edit is not None
     m = re.fullmatch(
         r"Rename '😋\.p' to '(.+)' \(1 place\); the port '😋\.p' of the node type '𝔘\.x' "
-        r"is registered outside the workspace: rename it there too",
+        r"is registered outside the workspace: rename it there too \(unsafe\)",
         action.title,
     )
     assert m is not None, action.title

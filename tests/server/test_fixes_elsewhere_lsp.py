@@ -130,7 +130,9 @@ async def test_a_node_type_registered_elsewhere_gets_no_preferred_fix(lsp: NavCl
     actions = await _actions(lsp, "Say.Hi")
     named = [a for a in actions if a.kind == types.CodeActionKind.QuickFix]
     assert named and not any(a.is_preferred for a in named)
-    assert named[0].title.endswith("is registered outside the workspace: rename it there too")
+    assert named[0].title.endswith(
+        "is registered outside the workspace: rename it there too (unsafe)"
+    )
 
 
 async def test_edits_of_other_files_need_confirmation(lsp: NavClient) -> None:

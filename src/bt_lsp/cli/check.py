@@ -4,7 +4,9 @@ Output formats:
 
 * ``text``: one line per diagnostic on stdout, ``path:line:col: severity code message``
   (1-based line and column; columns count characters, i.e. code points), and a summary
-  line on stderr.
+  line on stderr.  ``--output-format full`` adds the source line and a caret under the
+  range; ``--statistics`` prints a count per code instead of the diagnostics; on a
+  terminal (``--color``) the path, severity and code are coloured.
 * ``json``: one array on stdout of ``{path, line, column, endLine, endColumn, severity,
   code, message}``; positions as in ``text``, ``endColumn`` is the column just after the
   last character. A file that cannot be read is an object with code ``file-error`` and
@@ -30,22 +32,23 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import sys
 import time
 import traceback
 from collections import Counter
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Final, TextIO
 
-from bt_lsp.cli.fix import fix_document
+from bt_lsp.cli.fix import fix_document, fixability
 from bt_lsp.cli.fix_workspace import Planned, fix_files
 from bt_lsp.cli.formats import Format
 from bt_lsp.cli.formats.json import to_json
 from bt_lsp.cli.formats.sarif import to_sarif
-from bt_lsp.cli.formats.text import format_text, visible
+from bt_lsp.cli.formats.text import OutputFormat, Style, format_text, statistics, visible
 from bt_lsp.cli.project import (
     BUILD_FOLDER,
     NOT_BT,
@@ -82,17 +85,21 @@ from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import shown
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
-from bt_lsp.rules.diagnostics import with_severities
+from bt_lsp.rules.diagnostics import Diagnostic, with_severities
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
 
 __all__ = ["Options", "Progress", "check_file", "parse_severities", "run"]
+
+# The line ends of Document.lines: the source lines of --output-format full.
+_LINE_BREAK: Final = re.compile(r"\r\n|\r|\n")
 
 
 @dataclass(frozen=True, slots=True)
 class Options:
     format: Format = "text"
     fix: bool = False
+    unsafe_fixes: bool = False  # --unsafe-fixes: --fix applies the unsafe fixes too
     severities: Mapping[str, Severity | None] = field(default_factory=dict)
     progress: bool = True
     max_bytes: int = DEFAULT_MAX_BYTES
@@ -104,6 +111,9 @@ class Options:
     follow_symlinks: bool = False  # --fix rewrites files linked from outside the folder
     min_severity: Severity | None = None  # --min-severity (None: the configuration's)
     quiet: bool = False  # --quiet: the diagnostics and errors only
+    output_format: OutputFormat = "concise"  # --output-format (text only)
+    color: bool = False  # colour the text output (--color, NO_COLOR, FORCE_COLOR)
+    statistics: bool = False  # --statistics: a count per code instead of the diagnostics
     started: float = field(default_factory=time.time)  # older temporaries are stale
 
 
@@ -146,7 +156,7 @@ def check_file(
     it is."""
     result = FileResult(path)
     if planned is not None:
-        return _planned_result(result, planned)
+        return _planned_result(result, planned, options, project)
     try:
         decoded = read_text(path, options.max_bytes)
     except FileError as e:
@@ -160,6 +170,7 @@ def check_file(
             facts = Scanner().facts(path, decoded.text.encode("utf-8", "surrogatepass"))
             diags = with_severities(cpp_name_diagnostics(facts, decoded.text), options.severities)
             result.findings = findings_of(path, doc, diags)
+            result.text = doc.text
             return result
         raw = file_diagnostics(doc, project)
         # The workspace's settings for the file hold the flags' severities over its
@@ -173,7 +184,9 @@ def check_file(
         if options.fix:
             me = normalize(path)
             others = {str(p): d for p, d in (before or {}).items() if p != me}
-            outcome = fix_document(decoded, doc, raw, diags, project, others)
+            outcome = fix_document(
+                decoded, doc, raw, diags, project, others, unsafe=options.unsafe_fixes
+            )
             if isinstance(outcome, str):
                 result.not_fixed = outcome
             elif outcome is not None and keep is not None:
@@ -188,11 +201,13 @@ def check_file(
                 result.fixed = max(len(diags) - len(fixed_diags), 0)
                 result.notes = outcome.notes
                 doc, diags = outcome.doc, fixed_diags
-        result.findings = findings_of(path, doc, diags)
+        result.findings = findings_of(path, doc, diags, _fixable(doc, options, project))
+        result.text = doc.text
     except FileError as e:
         result.not_fixed = e.message
         result.unwritten = True
         result.findings = findings_of(path, doc, diags)
+        result.text = doc.text
     except Exception as e:
         result.detail = traceback.format_exc()
         result.error = FileError(
@@ -201,7 +216,16 @@ def check_file(
     return result
 
 
-def _planned_result(result: FileResult, planned: Planned) -> FileResult:
+def _fixable(
+    doc: Document, options: Options, project: ProjectIndex | None
+) -> Callable[[Diagnostic], bool] | None:
+    """Which diagnostics a fix fixes, for ``--statistics`` (not worked out otherwise)."""
+    return fixability(doc, project, options.unsafe_fixes) if options.statistics else None
+
+
+def _planned_result(
+    result: FileResult, planned: Planned, options: Options, project: ProjectIndex | None
+) -> FileResult:
     """The result of a file that the fix of the whole workspace handled."""
     doc, diags = planned.doc, planned.diags
     outcome = planned.outcome
@@ -213,7 +237,8 @@ def _planned_result(result: FileResult, planned: Planned) -> FileResult:
         fixed_diags = with_severities(outcome.raw, planned.severities)
         result.fixed = max(len(diags) - len(fixed_diags), 0)
         doc, diags = outcome.doc, fixed_diags
-    result.findings = findings_of(result.path, doc, diags)
+    result.findings = findings_of(result.path, doc, diags, _fixable(doc, options, project))
+    result.text = doc.text
     return result
 
 
@@ -385,6 +410,7 @@ def run(
         for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
             say(err, line + "\n")
     results: list[FileResult] = [*configs, *(FileResult(e.path, error=e) for e in walk_errors)]
+    style = Style(color=options.color)
     # What fixes see of the other files: the workspace before any file is fixed.
     before = dict(project.bt_documents()) if options.fix else None
     roots = [p for p in paths if os.path.isdir(p)]
@@ -398,7 +424,11 @@ def run(
         return linked or not_replaceable(path)  # read-only, hard links
 
     # Every rename of --fix in all the files it touches, or in none (see fix_workspace).
-    planned = fix_files(files, project, options.max_bytes, keep_of) if options.fix else {}
+    planned = (
+        fix_files(files, project, options.max_bytes, keep_of, options.unsafe_fixes)
+        if options.fix
+        else {}
+    )
     for i, path in enumerate(files, 1):
         progress.show(i, path)
         keep = keep_of(path)
@@ -413,12 +443,21 @@ def run(
             say(err, f"fixed {plural(r.fixed, 'problem')} in {visible(path)}\n")
         for note in r.notes if not options.quiet else ():
             say(err, f"bt-lsp: {visible(path)}: {visible(note)}\n")
-        if options.format == "text" and r.findings:
-            say(out, "".join(line + "\n" for line in format_text(r.findings)))
+        if options.format == "text" and r.findings and not options.statistics:
+            source = _LINE_BREAK.split(r.text) if options.output_format == "full" else None
+            lines = format_text(r.findings, style, source)
+            say(out, "".join(line + "\n" for line in lines))
     progress.clear()
 
     if options.format != "text":
         _report(out, options.format, results)
+    elif options.statistics:
+        summaries = {code: c.summary.replace("`", "") for code, c in CODES.items()}
+        table = statistics((f for r in results for f in r.findings), summaries, style)
+        if table:
+            say(out, "".join(line + "\n" for line in table))
+        if not options.quiet:
+            say(err, summary(results) + "\n")
     elif not options.quiet:
         text = summary([r for r in results if not r.config])
         if configs:

@@ -8,14 +8,18 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections import Counter
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from bt_lsp.cli.results import file_diagnostics
-from bt_lsp.ide import name_fixes as fixes
+from bt_lsp.ide.fix_all import applies, has_bulk_fix
+from bt_lsp.ide.fix_all import fix_document as plan_fixes
+from bt_lsp.ide.name_fixes import fixes_for_name
+from bt_lsp.ide.semantic_fixes import fixes_for_rule
 from bt_lsp.project.fileio import Decoded
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules.codes import XML, defined
+from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, apply_edits
@@ -75,17 +79,47 @@ def fix_document(
     diags: list[Diagnostic],
     project: ProjectIndex | None = None,
     others: Mapping[str, Document] | None = None,
+    unsafe: bool = False,
 ) -> Fixed | str | None:
     """The fixed document, or why the file cannot be fixed safely (``None``: nothing to
-    fix).  ``others`` are the other files of the workspace as they were before any was
-    fixed: a name is renamed only with its target."""
-    registered = (
-        project.context_for(normalize(doc.path), doc).models
+    fix): every safe fix (with ``unsafe``, the unsafe ones too).  ``others`` are the other
+    files of the workspace as they were before any was fixed: a name is renamed only with
+    its target."""
+    ctx = context_of(doc, project)
+    planned = plan_fixes(doc, ctx, diags, others, unsafe=unsafe)
+    return apply_fixes(decoded, doc, raw, planned.edits, planned.notes, project)
+
+
+def fixability(
+    doc: Document, project: ProjectIndex | None, unsafe: bool = False
+) -> Callable[[Diagnostic], bool]:
+    """Whether a fix that ``--fix`` (with ``unsafe``, ``--fix --unsafe-fixes``) applies
+    fixes a diagnostic of ``doc``: the ``[*]`` of ``--statistics``."""
+    ctx = context_of(doc, project)
+    others = (
+        project.other_documents(normalize(doc.path))
         if project is not None and doc.path is not None
-        else None
+        else {}
     )
-    fix_all = fixes.fix_all(doc, diags, others, registered)
-    return apply_fixes(decoded, doc, raw, fix_all.edits, fix_all.notes, project)
+
+    def fixable(d: Diagnostic) -> bool:
+        if not has_bulk_fix(d, unsafe):
+            return False
+        found = (
+            fixes_for_name(doc, d, others, ctx.models)
+            if d.is_name_rule
+            else fixes_for_rule(doc, ctx, d)
+        )
+        return any(applies(f, unsafe) for f in found)
+
+    return fixable
+
+
+def context_of(doc: Document, project: ProjectIndex | None) -> Context:
+    """What the rules knew of ``doc``'s surroundings when they checked it."""
+    if project is not None and doc.path is not None:
+        return project.context_for(normalize(doc.path), doc)
+    return Context.from_document(doc)
 
 
 def apply_fixes(

@@ -10,6 +10,10 @@ files it touches, and a rename is applied only if every one of those files can b
 and written; otherwise it is left out everywhere, with a note saying why.  The files that
 a set of renames links are written together: when one write fails, the others are put
 back as they were.
+
+The fixes of the other rules change one file each (:func:`bt_lsp.ide.fix_all.rule_fixes`:
+the safe ones, with ``--unsafe-fixes`` the unsafe ones too); they give way to the renames:
+when a file cannot be fixed with them, it is fixed without them, with a note.
 """
 
 from __future__ import annotations
@@ -19,8 +23,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bt_lsp.cli.fix import Fixed, apply_fixes
+from bt_lsp.cli.fix import Fixed, apply_fixes, context_of
 from bt_lsp.cli.results import file_diagnostics
+from bt_lsp.ide.fix_all import rule_fixes
 from bt_lsp.ide.name_edits import shown
 from bt_lsp.ide.name_fixes import WorkspaceRename, edits_in, fix_workspace
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES
@@ -29,6 +34,7 @@ from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.diagnostics import Diagnostic, with_severities
 from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit
 
 __all__ = ["Planned", "edits_in", "fix_files"]
 
@@ -110,9 +116,11 @@ def fix_files(
     project: ProjectIndex,
     max_bytes: int,
     keep: Callable[[str], str | None],
+    unsafe: bool = False,
 ) -> dict[str, Planned]:
     """Fix the checked files ``paths`` of ``project``'s workspace (see the module), by
-    normalized path.  ``keep`` says why a file must not be rewritten (``None``: it may)."""
+    normalized path.  ``keep`` says why a file must not be rewritten (``None``: it may);
+    ``unsafe``: apply the unsafe fixes too."""
     checked = _read(paths, project, max_bytes)
     docs: dict[str, Document] = {k: p.doc for k, (_, p) in checked.items()}
     # A workspace file that a checked one reaches through a symbolic link is that file.
@@ -127,9 +135,14 @@ def fix_files(
     alive = list(plan.renames)
     refused: dict[str, str] = {}
     fixed: dict[str, Fixed] = {}
+    # The files whose other fixes were given up, so that their renames could be made.
+    without_local: set[str] = set()
+    may_fix_locally = {
+        k for k, (given, p) in checked.items() if any(not d.is_name_rule for d in p.diags)
+    }
     while True:
         fixed.clear()
-        touched = sorted({p for r in alive for p in r.paths})
+        touched = sorted({p for r in alive for p in r.paths} | (may_fix_locally - without_local))
         newly: dict[str, str] = {}
         for path in touched:
             if path in refused:
@@ -138,14 +151,29 @@ def fix_files(
                 newly[path] = "it is not among the checked files"
                 continue
             given, planned = checked[path]
+            mine = [r for r in alive if path in r.paths]
+            renames = edits_in(mine, path)
+            local: list[TextEdit] = []
+            if path not in without_local:
+                ctx = context_of(planned.doc, project)
+                fixes = rule_fixes(planned.doc, ctx, planned.diags, unsafe=unsafe, taken=renames)
+                local = [e for f in fixes for e in f.edits]
+            if not renames and not local:
+                continue
             why = keep(given)
             if why is not None:
                 newly[path] = why
                 continue
-            mine = [r for r in alive if path in r.paths]
             outcome = apply_fixes(
-                planned.decoded, planned.doc, planned.raw, edits_in(mine, path), [], project
+                planned.decoded, planned.doc, planned.raw, [*renames, *local], [], project
             )
+            if isinstance(outcome, str) and local and renames:
+                # The renames first: they change other files too.
+                planned.notes.append(f"left the fixes of other problems as they are: {outcome}")
+                without_local.add(path)
+                outcome = apply_fixes(
+                    planned.decoded, planned.doc, planned.raw, renames, [], project
+                )
             if isinstance(outcome, str):
                 newly[path] = outcome
             elif outcome is not None:
@@ -168,7 +196,10 @@ def fix_files(
     for path, why in refused.items():
         if path in checked:
             checked[path][1].outcome = why
-    _write(checked, fixed, _components(alive), project)
+    groups = _components(alive)
+    linked = {p for g in groups for p in g}
+    groups += [[p] for p in sorted(fixed) if p not in linked]  # other fixes only
+    _write(checked, fixed, groups, project)
     return {k: p for k, (_, p) in checked.items()}
 
 

@@ -11,6 +11,7 @@ import os
 import re
 import sys
 from collections.abc import Sequence
+from typing import TextIO
 
 from bt_lsp import __version__
 from bt_lsp.cli import live
@@ -72,9 +73,36 @@ def build_parser() -> argparse.ArgumentParser:
         help="output format (default: %(default)s)",
     )
     check.add_argument(
+        "--output-format",
+        choices=("concise", "full"),
+        help="text output: one line per diagnostic (concise, the default), or with the "
+        "source line and a caret under the range (full)",
+    )
+    check.add_argument(
+        "--color",
+        choices=("auto", "always", "never"),
+        default="auto",
+        help="colour the text output (default: auto, on a terminal unless NO_COLOR is set, "
+        "or when FORCE_COLOR is)",
+    )
+    check.add_argument(
+        "--statistics",
+        action="store_true",
+        help="print the number of diagnostics per code instead of the diagnostics ([*]: a "
+        "fix that --fix applies fixes them all; [-]: some of them)",
+    )
+    check.add_argument(
         "--fix",
         action="store_true",
-        help="apply every preferred fix in place, then report what is left",
+        help="apply every safe fix in place (the editor's preferred fixes), then report "
+        "what is left",
+    )
+    check.add_argument(
+        "--unsafe-fixes",
+        action="store_true",
+        help="with --fix, apply the unsafe fixes too (those that change what loads or runs: "
+        "a typo guess, a placeholder port value, a new tree); --statistics counts them as "
+        "fixable",
     )
     check.add_argument(
         "--severity",
@@ -202,15 +230,22 @@ def _serve(args: argparse.Namespace) -> int:
 
 def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     from bt_lsp.cli import check
+    from bt_lsp.cli.formats.text import use_color
     from bt_lsp.rules.codes import Severity
 
     try:
         severities = check.parse_severities(args.severity)
     except ValueError as e:
         parser.error(f"--severity: {e}")
+    if args.format != "text" and (args.output_format or args.statistics):
+        flag = "--output-format" if args.output_format else "--statistics"
+        parser.error(f"{flag} is for --format text")
+    text = args.format == "text"
+    color = text and use_color(args.color, _isatty(sys.stdout), os.environ)
     options = check.Options(
         format=args.format,
         fix=args.fix,
+        unsafe_fixes=args.unsafe_fixes,
         severities=severities,
         progress=not args.no_progress,
         max_bytes=args.max_file_size,
@@ -222,8 +257,18 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         follow_symlinks=args.follow_symlinks,
         min_severity=Severity.parse(args.min_severity) if args.min_severity else None,
         quiet=args.quiet,
+        output_format=args.output_format or "concise",
+        color=color,
+        statistics=args.statistics,
     )
     return check.run(args.paths, options)
+
+
+def _isatty(stream: TextIO) -> bool:
+    try:
+        return stream.isatty()
+    except (AttributeError, ValueError, OSError):
+        return False
 
 
 def _render(args: argparse.Namespace) -> int:

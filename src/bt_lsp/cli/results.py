@@ -4,7 +4,7 @@ converted, the result of the file, the summary line and the exit status."""
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Final
@@ -29,7 +29,8 @@ class Finding:
 
     ``line``/``column`` are 1-based, columns in code points; ``end_column`` is the column
     after the last character. ``utf16_*`` are the same columns in UTF-16 code units.
-    ``token`` is the text the diagnostic covers (for stable fingerprints).
+    ``token`` is the text the diagnostic covers (for stable fingerprints); ``fixable``:
+    a fix the run may apply fixes it (known only for ``--statistics``).
     """
 
     path: str
@@ -43,6 +44,7 @@ class Finding:
     code: str
     message: str
     token: str = ""
+    fixable: bool = False
 
 
 @dataclass(slots=True)
@@ -56,6 +58,7 @@ class FileResult:
     detail: str = ""  # the traceback of an internal error
     unwritten: bool = False  # --fix could not write the fixed file (exit status 2)
     config: bool = False  # a configuration file that cannot be used (exit status 2)
+    text: str = ""  # the text the findings are positions of (for --output-format full)
 
 
 def file_diagnostics(doc: Document, project: ProjectIndex | None = None) -> list[Diagnostic]:
@@ -66,7 +69,13 @@ def file_diagnostics(doc: Document, project: ProjectIndex | None = None) -> list
     return project.diagnostics(normalize(doc.path), doc)
 
 
-def findings_of(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[Finding]:
+def findings_of(
+    path: str,
+    doc: Document,
+    diags: Iterable[Diagnostic],
+    fixable: Callable[[Diagnostic], bool] | None = None,
+) -> list[Finding]:
+    """The findings of ``diags`` in ``doc``; ``fixable`` says which a fix may fix."""
     lines = doc.lines
     out: list[Finding] = []
     for d in diags:
@@ -87,6 +96,7 @@ def findings_of(path: str, doc: Document, diags: Iterable[Diagnostic]) -> list[F
                 d.code,
                 d.message,
                 doc.text[d.start : min(d.end, d.start + 200)],
+                fixable is not None and fixable(d),
             )
         )
     return out

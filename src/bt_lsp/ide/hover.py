@@ -3,6 +3,13 @@ a blackboard key is written and read.
 
 Written as Markdown or as plain text (for clients that ask for it: no ``**``, no backticks,
 no tables), and narrow either way: lists rather than wide tables, which a hover cuts off.
+
+Text that is not Markdown (a rule's statement, a character of a name) is made to read the
+same in every client that renders Markdown (:func:`markdown_safe`).  A backslash escape
+does not: Neovim 0.7 hides a backslash before punctuation or a space, even inside a code
+span, while Neovim 0.11 shows escapes as typed; and an unescaped ``*`` or ``_`` starts
+emphasis in Neovim 0.7's Markdown syntax.  So the Markdown-special characters go into
+code spans (which every client shows as typed), and a backslash is named.
 """
 
 from __future__ import annotations
@@ -22,7 +29,7 @@ from bt_lsp.rules.builtins_v3 import V3_BUILTINS
 from bt_lsp.rules.codes import NAMES, defined
 from bt_lsp.rules.context import Context, source_label
 from bt_lsp.rules.diagnostics import name_violations
-from bt_lsp.rules.names import RULES, Violation
+from bt_lsp.rules.names import RULES, BadChar, Violation
 from bt_lsp.rules.semantics.models import reserved_declaration_at
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import DECLARING_ROLES, NameRef, Role
@@ -50,6 +57,26 @@ def _visible(text: str) -> str:
 
 
 _INLINE_CODE_RE = re.compile(r"`+ ?([^`]*?) ?`+")
+# A word of plain text, and the characters that Markdown (CommonMark, Neovim 0.7's syntax)
+# may read as markup in it.
+_WORD_RE = re.compile(r"[^\s(),;]+")
+_MARKUP = frozenset("\\`*_<>&[]|#~!")
+
+
+def _safe_word(match: re.Match[str]) -> str:
+    word = match.group()
+    if word == "\\":
+        return "backslash"
+    if not _MARKUP.intersection(word):
+        return word
+    return f"`` {word} ``" if "`" in word else f"`{word}`"
+
+
+def markdown_safe(text: str) -> str:
+    """Plain ``text`` written so that a Markdown hover shows it as it is, in VS Code and
+    in Neovim 0.7 and 0.11 alike: every word with a Markdown-special character in a code
+    span, a lone backslash as the word ``backslash``."""
+    return _WORD_RE.sub(_safe_word, text)
 
 
 def file_link(shown: str, path: str | None) -> str:
@@ -90,6 +117,18 @@ class _Writer:
         if "`" in shown:
             return f"`` {shown} ``"
         return f"`{shown}`"
+
+    def plain(self, text: str) -> str:
+        """Text that is not Markdown (a rule, a character's description), as the client
+        shows it as written (see :func:`markdown_safe`)."""
+        return markdown_safe(text) if self.markdown else text
+
+    def char(self, c: BadChar) -> str:
+        """An offending character: ``'.' (period)``; a backslash, which no Markdown
+        client shows alike escaped or not, by its code point in Markdown."""
+        if self.markdown and c.char == "\\":
+            return "U+005C (backslash)"
+        return self.plain(c.shown)
 
     def prose(self, text: str) -> str:
         """A description written in Markdown (built-in nodes, rules), as the client reads
@@ -254,7 +293,7 @@ def _bad_name(
     title = _KIND_TITLE[str(ref.kind)]
     w.title(f"{title} {w.code(ref.text)} breaks the BehaviorTree.CPP naming rules")
     w.lines.append("")
-    w.items([f"{w.code(v.code)}: {w.prose(RULES.get(v.code, v.rule))}" for v in violations])
+    w.items([f"{w.code(v.code)}: {w.plain(RULES.get(v.code, v.rule))}" for v in violations])
     chars = [c for v in violations for c in v.chars]
     if chars:
         w.para("Characters:")
@@ -262,8 +301,8 @@ def _bad_name(
         for c in chars:
             line, col = doc.lines.position(_raw_offset(doc, ref, c.offset), "utf-32")
             items.append(
-                f"column {c.column} (line {line + 1}, col {col + 1}): {c.shown}, "
-                f"{c.category}: {c.reason}"
+                f"column {c.column} (line {line + 1}, col {col + 1}): {w.char(c)}, "
+                f"{w.plain(c.category)}: {w.plain(c.reason)}"
             )
         w.items(items)
     registered = ctx.models if ctx is not None else None

@@ -39,6 +39,7 @@ from bt_lsp.ide.name_edits import (
 )
 from bt_lsp.ide.rename import RenamePlan, Renamer, RenameRefused, combined
 from bt_lsp.ide.sanitize import candidates, sanitize
+from bt_lsp.rules.codes import Applicability
 from bt_lsp.rules.context import ModelDecl
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.names import NAME_FIX_TITLES
@@ -95,18 +96,22 @@ class Renaming:
         return where
 
     @property
+    def fix(self) -> str:
+        """The key of the fix among the name codes' fixes (``NAME_FIX_TITLES``)."""
+        if self.caution is not None:
+            return "rename-elsewhere"
+        return "rename" if self.new else "clear"
+
+    @property
+    def applicability(self) -> Applicability:
+        return NAME_FIX_TITLES[self.fix].applicability
+
+    @property
     def title(self) -> str:
-        where = self.where
-        old = shown(self.old)
-        title = (
-            NAME_FIX_TITLES["clear"].format(old=old, where=where)
-            if not self.new
-            else NAME_FIX_TITLES["rename"].format(old=old, new=shown(self.new), where=where)
-        )
+        values = {"old": shown(self.old), "new": shown(self.new), "where": self.where}
+        title = NAME_FIX_TITLES[self.fix].title.format(caution=self.caution, **values)
         if self.kept is not None:
             title += f"; {self.kept} left as it is"
-        if self.caution is not None:
-            title += f"; {self.caution}"
         return title
 
     @property
@@ -242,7 +247,14 @@ def fixes_for_name(
     others = others or {}
     taken = taken_names(doc.model, ref.symbol, [d.model for d in others.values()])
     return [
-        Fix(r.title, r.plan.edits, i == 0 and r.caution is None, diag, r.plan.other_edits)
+        Fix(
+            r.title,
+            r.plan.edits,
+            i == 0 and r.applicability is Applicability.SAFE,
+            diag,
+            r.plan.other_edits,
+            r.applicability,
+        )
         for i, r in enumerate(renamings(Renamer(doc, others, registered), ref, taken))
     ]
 

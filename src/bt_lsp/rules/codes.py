@@ -16,7 +16,7 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from enum import IntEnum
+from enum import Enum, IntEnum
 from types import MappingProxyType
 from typing import Final
 
@@ -51,10 +51,56 @@ class Severity(IntEnum):
         raise ValueError(f"unknown severity {word!r}")
 
 
+class Applicability(Enum):
+    """Whether a fix may be applied without the author looking at it, as ruff classifies
+    fixes.
+
+    * ``SAFE``: it cannot change what BehaviorTree.CPP loads and runs beyond removing the
+      problem it fixes, and where the file fails to load there is exactly one thing it can
+      have meant.  The editor's preferred fix, fix-all and ``check --fix`` apply it.
+    * ``UNSAFE``: very likely right, but it changes what loads or runs (a typo guess that a
+      node registered in C++ bt-lsp did not see could make wrong, a placeholder value, a new
+      tree).  Offered in the editor marked "(unsafe)"; ``check --unsafe-fixes`` applies it.
+    * ``DISPLAY_ONLY``: a suggestion for the author to judge case by case (declaring a
+      model, renaming a name also registered in C++, giving a port that may be optional).
+      Offered in the editor marked "(unsafe)"; never applied in bulk.
+    """
+
+    SAFE = "safe"
+    UNSAFE = "unsafe"
+    DISPLAY_ONLY = "display-only"
+
+
+@dataclass(frozen=True, slots=True)
+class FixSpec:
+    """One fix of a code: its title (a :meth:`str.format` template), its class, and when
+    it is offered where the code has several fixes of one title (for its page)."""
+
+    title: str
+    applicability: Applicability
+    when: str = ""
+
+
+def safe(title: str, when: str = "") -> FixSpec:
+    """A fix that ``check --fix``, fix-all and the editor's preferred fix apply."""
+    return FixSpec(title, Applicability.SAFE, when)
+
+
+def unsafe(title: str, when: str = "") -> FixSpec:
+    """A fix that only ``check --unsafe-fixes`` applies in bulk."""
+    return FixSpec(title, Applicability.UNSAFE, when)
+
+
+def display_only(title: str, when: str = "") -> FixSpec:
+    """A fix offered in the editor only, one at a time."""
+    return FixSpec(title, Applicability.DISPLAY_ONLY, when)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Code:
-    """One diagnostic code.  ``fixes`` are the titles of its quick fixes by fix, as
-    :meth:`str.format` templates (see :meth:`fix_title`).  The rest is the prose of the
+    """One diagnostic code.  ``fixes`` are its quick fixes by key: each a title (a
+    :meth:`str.format` template, see :meth:`fix_title`) and whether it is safe (see
+    :class:`Applicability`): the one place a fix's class is defined.  The rest is the prose of the
     code's documentation page, each part optional (Markdown; ``bad`` and ``good`` are XML):
     what BehaviorTree.CPP does, why it matters, a document that gets the diagnostic and the
     same document fixed, and the BehaviorTree.CPP versions the rule applies to."""
@@ -63,7 +109,7 @@ class Code:
     severity: Severity
     summary: str
     family: str
-    fixes: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    fixes: Mapping[str, FixSpec] = field(default_factory=lambda: MappingProxyType({}))
     doc: str = ""
     why: str = ""
     bad: str = ""
@@ -77,7 +123,16 @@ class Code:
 
     def fix_title(self, fix: str, **values: object) -> str:
         """The title of the fix ``fix`` with ``values`` filled in."""
-        return self.fixes[fix].format(**values)
+        return self.fixes[fix].title.format(**values)
+
+    def applicability(self, fix: str) -> Applicability:
+        """Whether the fix ``fix`` is safe, unsafe or offered in the editor only."""
+        return self.fixes[fix].applicability
+
+    @property
+    def has_safe_fix(self) -> bool:
+        """Whether fix-all and ``check --fix`` may fix a diagnostic of this code."""
+        return any(f.applicability is Applicability.SAFE for f in self.fixes.values())
 
 
 class FixData:
@@ -108,7 +163,7 @@ def define(
     summary: str,
     family: str,
     *,
-    fixes: Mapping[str, str] | None = None,
+    fixes: Mapping[str, FixSpec] | None = None,
     doc: str = "",
     why: str = "",
     bad: str = "",

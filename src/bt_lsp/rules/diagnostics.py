@@ -12,7 +12,7 @@ from itertools import chain, compress, count, islice
 from operator import or_
 from typing import TYPE_CHECKING, Any, Final
 
-from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined
+from bt_lsp.rules.codes import NAMES, XML, FixData, Severity, define, defined, safe
 from bt_lsp.rules.names import NameData, NameKind, Violation, check_name
 from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.syntax.elements import Element, NameRef, Role, Symbol, Zone
@@ -69,7 +69,8 @@ XML_UNESCAPED_CHAR: Final = define(
     Severity.WARNING,
     "a raw `&` or `<` in an attribute value (tinyxml2 accepts it, XML does not)",
     XML,
-    fixes={"escape": "Escape '{char}' as '{escaped}'"},
+    # tinyxml2 reads the escaped character as it read the raw one: the value is the same.
+    fixes={"escape": safe("Escape '{char}' as '{escaped}'")},
 )
 XML_DOCTYPE: Final = define(
     "xml-doctype",

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Final
 
-from bt_lsp.rules.codes import BT, NAMES, FixData, Severity, define
+from bt_lsp.rules.codes import BT, NAMES, FixData, Severity, define, display_only, safe
 from bt_lsp.syntax.elements import Role
 from bt_lsp.syntax.vocabulary import (
     BTCPP_RESERVED_ATTRIBUTES,
@@ -42,12 +42,19 @@ class NameData(FixData):
         return {"name": self.name, "kind": str(self.kind), "role": str(self.role)}
 
 
-#: The titles of the quick fixes of every name code: a rename to a sanitized, unique name
-#: (``where`` counts the places and the other files it changes), or clearing an instance
-#: name that has nothing left to keep.
+#: The quick fixes of every name code: a rename to a sanitized, unique name (``where``
+#: counts the places and the other files it changes) or clearing an instance name that has
+#: nothing left to keep, both safe: BehaviorTree.CPP refuses the name, and every reference
+#: is renamed with it.  A name whose target bt-lsp cannot rename with it (a node type
+#: registered in C++ or in an installed catalog) is offered in the editor only: applied
+#: alone, the rename would break the reference.
 NAME_FIX_TITLES: Final = {
-    "rename": "Rename '{old}' to '{new}' ({where})",
-    "clear": "Clear '{old}' ({where})",
+    "rename": safe("Rename '{old}' to '{new}' ({where})"),
+    "clear": safe("Clear '{old}' ({where})"),
+    "rename-elsewhere": display_only(
+        "Rename '{old}' to '{new}' ({where}); {caution}",
+        "a node type registered in C++ or in an installed catalog, which bt-lsp cannot rename",
+    ),
 }
 
 # The versions the name rules apply to (the ``since`` of each code's page).

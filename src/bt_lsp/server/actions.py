@@ -1,5 +1,9 @@
 """textDocument/codeAction and codeAction/resolve: quick fixes and fix-all.
 
+Fix-all (``source.fixAll.bt-lsp``) applies the safe fixes, as ``bt-lsp check --fix`` does
+(:func:`bt_lsp.ide.fix_all.fix_document`); a quick fix that is not safe says so in its
+title, ``(unsafe)``, as ruff's do.
+
 Fixes come from the server's own diagnostics in the requested range, never from the
 client's copies (Neovim 0.7 sends byte columns there).  When the client can resolve
 edits lazily, actions carry only a reference to their fix and the edit is built on
@@ -15,7 +19,8 @@ from lsprotocol import types
 from pygls.uris import from_fs_path
 
 from bt_lsp.ide import semantic_fixes
-from bt_lsp.ide.name_fixes import Fix, fix_all, fixes_for_name
+from bt_lsp.ide.fix_all import fix_document, has_bulk_fix
+from bt_lsp.ide.name_fixes import Fix, fixes_for_name
 from bt_lsp.project.index import normalize
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
@@ -28,6 +33,13 @@ if TYPE_CHECKING:
     from bt_lsp.server.app import BtServer
 
 FIX_ALL_KIND = "source.fixAll.bt-lsp"
+FIX_ALL_TITLE = "Apply all safe bt-lsp fixes"
+
+
+def action_title(fix: Fix) -> str:
+    """A quick fix's title as the editor shows it: ``(unsafe)`` after one that fix-all and
+    ``check --fix`` do not apply."""
+    return fix.title if fix.safe else f"{fix.title} (unsafe)"
 
 
 def _wants(only: Sequence[str] | None, kind: str) -> bool:
@@ -81,10 +93,11 @@ def _all_fixes(ls: BtServer, od: OpenDocument, diag: Diagnostic) -> list[Fix]:
 
 
 def _fix_all_edit(ls: BtServer, od: OpenDocument) -> types.WorkspaceEdit:
-    """Every preferred name fix of the document; a tree defined here is renamed in the
-    other files that call it too (those edits need confirmation where the client can)."""
-    fixed = fix_all(od.doc, ls.diagnostics_of(od), _others(ls, od), _context(ls, od).models)
-    return _workspace_edit(ls, od, fixed.edits, fixed.other_edits, "Fix all bt-lsp name problems")
+    """Every safe fix of the document, as ``check --fix`` makes them; a tree defined here
+    is renamed in the other files that call it too (those edits need confirmation where
+    the client can)."""
+    fixed = fix_document(od.doc, _context(ls, od), ls.diagnostics_of(od), _others(ls, od))
+    return _workspace_edit(ls, od, fixed.edits, fixed.other_edits, FIX_ALL_TITLE)
 
 
 def register(server: BtServer) -> None:
@@ -126,7 +139,7 @@ def register(server: BtServer) -> None:
                         to_diagnostic(lines, d, enc, ls.code_descriptions)
                     ]
                     action = types.CodeAction(
-                        title=fix.title,
+                        title=action_title(fix),
                         kind=types.CodeActionKind.QuickFix,
                         diagnostics=fixed,
                         is_preferred=fix.preferred,
@@ -141,10 +154,12 @@ def register(server: BtServer) -> None:
                             "index": i,
                         }
                     else:
-                        action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits, fix.title)
+                        action.edit = _workspace_edit(
+                            ls, od, fix.edits, fix.other_edits, action_title(fix)
+                        )
                     actions.append(action)
-        if _wants(only, FIX_ALL_KIND) and any(d.is_name_rule for d in diags):
-            action = types.CodeAction(title="Fix all bt-lsp name problems", kind=FIX_ALL_KIND)
+        if _wants(only, FIX_ALL_KIND) and any(has_bulk_fix(d) for d in diags):
+            action = types.CodeAction(title=FIX_ALL_TITLE, kind=FIX_ALL_KIND)
             if ls.resolve_edits:
                 action.data = {"uri": od.uri, "version": od.version, "fixAll": True}
             else:
@@ -172,6 +187,8 @@ def register(server: BtServer) -> None:
                 index = data.get("index")
                 if isinstance(index, int) and 0 <= index < len(fixes):
                     fix = fixes[index]
-                    action.edit = _workspace_edit(ls, od, fix.edits, fix.other_edits, fix.title)
+                    action.edit = _workspace_edit(
+                        ls, od, fix.edits, fix.other_edits, action_title(fix)
+                    )
                 break
         return action

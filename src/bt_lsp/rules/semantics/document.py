@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from bt_lsp.rules.codes import BT, Severity, define
+from bt_lsp.rules.codes import BT, Severity, define, safe, unsafe
 from bt_lsp.rules.semantics.base import State, quoted
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
@@ -76,7 +76,16 @@ MISSING_FORMAT: Final = define(
     Severity.WARNING,
     "`<root>` has no `BTCPP_format`",
     BT,
-    fixes={"add": 'Add BTCPP_format="4" to <root>'},
+    fixes={
+        # Version 4 reads a file without the attribute as version 4 anyway: only the
+        # warning goes.
+        "add": safe('Add BTCPP_format="4" to <root>', "the project builds against version 4"),
+        # The file may be a version 3 one, which the attribute would make bt-lsp and Groot2
+        # read as version 4.
+        "add-unknown-version": unsafe(
+            'Add BTCPP_format="4" to <root>', "no BehaviorTree.CPP version was detected"
+        ),
+    },
 )
 DUPLICATE_MODEL_SECTION: Final = define(
     "duplicate-model-section", Severity.ERROR, "a second `<TreeNodesModel>` section", BT

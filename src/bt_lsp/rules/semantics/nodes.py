@@ -46,7 +46,16 @@ from types import MappingProxyType
 from typing import Final, cast
 
 from bt_lsp.rules.builtins import BUILTINS, V3_RENAMES
-from bt_lsp.rules.codes import BT, FixData, Severity, define
+from bt_lsp.rules.codes import (
+    BT,
+    Applicability,
+    FixData,
+    Severity,
+    define,
+    display_only,
+    safe,
+    unsafe,
+)
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.conversions import is_blackboard_reference
 from bt_lsp.rules.names import NameKind, check_name
@@ -57,13 +66,17 @@ from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 @dataclass(frozen=True, slots=True)
 class UnknownNodeData(FixData):
     """What ``unknown-node`` tells its fixes: the type as written, whether the node is in
-    explicit form, and the type to rename it to (``preferred`` when that is surely
-    meant: a version 3 name or a built-in spelled in another case)."""
+    explicit form, the type to rename it to, and which of the code's rename fixes that is
+    (``rename``, safe: surely meant; ``rename-likely``; ``rename-maybe``)."""
 
     type: str
     explicit: bool
     rename: str | None = None
-    preferred: bool = False
+    fix: str = "rename-maybe"
+
+    @property
+    def preferred(self) -> bool:
+        return self.rename is not None and UNKNOWN_NODE.applicability(self.fix) is SAFE
 
     def as_json(self) -> dict[str, object]:
         out: dict[str, object] = {"type": self.type, "explicit": self.explicit}
@@ -72,13 +85,16 @@ class UnknownNodeData(FixData):
         return out
 
 
+SAFE: Final = Applicability.SAFE
+
 # The codes of these rules (see bt_lsp.rules.registry).
 ID_ON_COMPACT_NODE: Final = define(
     "id-on-compact-node",
     Severity.ERROR,
     "`ID` on a node written in compact form",
     BT,
-    fixes={"remove": "Remove ID from <{element}>"},
+    # The element name is the node type either way: only the refused attribute goes.
+    fixes={"remove": safe("Remove ID from <{element}>")},
 )
 UNKNOWN_NODE: Final = define(
     "unknown-node",
@@ -89,9 +105,22 @@ UNKNOWN_NODE: Final = define(
     ),
     BT,
     fixes={
-        "rename": "Rename '{type}' to '{new}'",
-        "subtree": "Call tree '{type}' with <SubTree>",
-        "declare": "Declare '{type}' in <TreeNodesModel>",
+        # BehaviorTree.CPP surely fails on the name and surely means the new one.
+        "rename": safe(
+            "Rename '{type}' to '{new}'",
+            "a version 3 name in a version 4 project, a built-in in another case, or the "
+            "one nearest name while every registration is known",
+        ),
+        # C++ that bt-lsp did not read may register the name as written.
+        "rename-likely": unsafe(
+            "Rename '{type}' to '{new}'",
+            "a name one edit from a known one, or one of several nearest names",
+        ),
+        # The diagnostic is a hint: the name is most likely registered in C++.
+        "rename-maybe": display_only("Rename '{type}' to '{new}'", "a farther guess"),
+        "subtree": unsafe("Call tree '{type}' with <SubTree>"),
+        # A model written for the node hides the problem without making it load.
+        "declare": display_only("Declare '{type}' in <TreeNodesModel>"),
     },
     doc="""
         Every node type must be registered with the factory (a built-in, or a custom node
@@ -264,7 +293,8 @@ def _unknown_finding(st: State, type_id: str, explicit: bool) -> _Finding | None
     ctx = st.ctx
     if type_id in V3_RENAMES:
         new = V3_RENAMES[type_id]
-        data = UnknownNodeData(type_id, explicit, new, preferred=True)
+        # Safe where the project is known to build against version 4 (or says so).
+        data = UnknownNodeData(type_id, explicit, new, "rename" if st.v4 else "rename-likely")
         if st.v3:  # only the misspelling: 3.8 registers the other version 3 names
             message = (
                 f"{quoted(type_id)} is a misspelling that BehaviorTree.CPP 3.8 does not "
@@ -306,7 +336,7 @@ def _unknown_finding(st: State, type_id: str, explicit: bool) -> _Finding | None
         )
     known = _BUILTIN_LOWER.get(type_id.lower())
     if known is not None:
-        data = UnknownNodeData(type_id, explicit, known, preferred=True)
+        data = UnknownNodeData(type_id, explicit, known, "rename")
         return (
             f"Node type {quoted(type_id)} is not registered; did you mean {quoted(known)}? "
             "(names are case-sensitive)",
@@ -320,15 +350,19 @@ def _unknown_finding(st: State, type_id: str, explicit: bool) -> _Finding | None
             Severity.HINT,
             data,
         )
-    suggestion = _closest(st, type_id)
+    suggestion, unique = _closest(st, type_id)
+    fix = "rename-maybe"
     if _complete(ctx):
         severity = None
+        # Every registration is known: the name fails to load, and one name is nearest.
+        fix = "rename" if unique else "rename-likely"
     elif suggestion is not None and edit_distance(type_id, suggestion, 1) <= 1:
         severity = Severity.WARNING  # one typo away from a known model: very likely wrong
+        fix = "rename-likely"
     else:
         severity = Severity.HINT
     if suggestion is not None:
-        data = UnknownNodeData(type_id, explicit, suggestion)
+        data = UnknownNodeData(type_id, explicit, suggestion, fix)
     if ctx.workspace_has_custom_models:
         message = (
             f"Node type {quoted(type_id)} is not a built-in node and is not declared in any "
@@ -395,20 +429,26 @@ def _base(path: str | None) -> str:
     return os.path.basename(path) if path else "another document"
 
 
-def _closest(st: State, type_id: str) -> str | None:
-    """A known node type that ``type_id`` is probably a typo of (edit distance 1-2)."""
+def _closest(st: State, type_id: str) -> tuple[str | None, bool]:
+    """A known node type that ``type_id`` is probably a typo of (edit distance 1-2), and
+    whether it is the only one that near."""
     if len(type_id) < 5:
-        return None
+        return None, False
     n = len(type_id)
     limit = 1 if n < 8 else 2
     best: tuple[int, str] | None = None
-    for cand in (*BUILTINS, *st.ctx.models):
+    unique = False
+    for cand in dict.fromkeys((*BUILTINS, *st.ctx.models)):
         if abs(len(cand) - n) > limit:
             continue
         d = edit_distance(type_id, cand, limit)
-        if d <= limit and (best is None or d < best[0]):
-            best = (d, cand)
-    return best[1] if best is not None else None
+        if d > limit:
+            continue
+        if best is None or d < best[0]:
+            best, unique = (d, cand), True
+        elif d == best[0]:
+            unique = False
+    return (best[1], unique) if best is not None else (None, False)
 
 
 def _children(st: State, el: Element, res: Resolved) -> None:

@@ -67,7 +67,7 @@ from typing import Final
 
 from bt_lsp.rules import port_types
 from bt_lsp.rules.builtins import PortModel
-from bt_lsp.rules.codes import BT, FixData, Severity, define
+from bt_lsp.rules.codes import BT, FixData, Severity, define, display_only, unsafe
 from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
 from bt_lsp.rules.names import (
     POSTCONDITIONS,
@@ -163,6 +163,9 @@ MISSING_REQUIRED_PORT: Final = define(
         """,
     bad="<Repeat><AlwaysSuccess/></Repeat>",
     good='<Repeat num_cycles="3"><AlwaysSuccess/></Repeat>',
+    # No value is right without the author: an input gets an empty value to fill in (which
+    # a typed port rejects until it is), a <SubTree> port the key of its name.
+    fixes={"add": unsafe("Add {ports}")},
     since="""
         Every version (the built-ins' ports are those of the detected version).
         """,
@@ -181,6 +184,8 @@ MISSING_PORT_WITHOUT_DEFAULT: Final = define(
         a hint. Silence it with `severity = { missing-port-without-default = "off" }` without
         losing the built-ins' `missing-required-port` errors.
         """,
+    # The port may well be optional in the node's code: giving it changes what it does.
+    fixes={"add": display_only("Add {ports}")},
     why="""
         When the node's code does need the port, the node fails at its first tick.
         """,
@@ -260,7 +265,14 @@ UNKNOWN_ATTRIBUTE: Final = define(
     "an underscore attribute that is neither a port nor reserved (kept in the node's "
     "`other_attributes`; a hint unless it looks like a misspelled reserved name)",
     BT,
-    fixes={"rename": "Did you mean '{suggestion}'? Rename '{old}'"},
+    fixes={
+        # BehaviorTree.CPP loads the file and ignores the attribute today; the reserved one
+        # takes effect (a precondition starts to run): a change of behaviour.
+        "rename": unsafe(
+            "Did you mean '{suggestion}'? Rename '{old}'", "surely a misspelling of it"
+        ),
+        "guess": display_only("Did you mean '{suggestion}'? Rename '{old}'", "a guess"),
+    },
 )
 
 

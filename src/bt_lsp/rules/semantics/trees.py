@@ -43,7 +43,7 @@ from operator import itemgetter
 from typing import TYPE_CHECKING, Final
 
 from bt_lsp.rules.builtins import BUILTINS
-from bt_lsp.rules.codes import BT, Severity, define
+from bt_lsp.rules.codes import BT, Severity, define, unsafe
 from bt_lsp.rules.context import TreeDecl
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import State, TreeScope, quoted
@@ -65,6 +65,13 @@ UNKNOWN_SUBTREE: Final = define(
     Severity.ERROR,
     "a `<SubTree ID>` that names no tree",
     BT,
+    # bt-lsp never knows every tree an application registers (installed packages' files
+    # among them), so a call renamed to a near tree may call the wrong one; a new tree
+    # changes what the call runs.
+    fixes={
+        "rename": unsafe("Rename '{old}' to '{new}'"),
+        "create": unsafe("Create the tree '{tree}' that fails until it is written"),
+    },
     doc="""
         `<SubTree ID="X">` calls the tree `X`, which must be loaded by the time the tree is
         created: otherwise BehaviorTree.CPP throws `Can't find a tree with name: X`. bt-lsp looks
