@@ -57,6 +57,7 @@ def test_every_form_has_a_fixture() -> None:
         "literal_defaults",
         "macro_composed",
         "registrar",
+        "template_base",
     }
 
 

@@ -394,7 +394,7 @@ class _Linker:
             if isinstance(target, _Class):
                 cls_name = target.facts.qualname
                 class_path, class_span = target.path, target.facts.span
-                kind, why = self._kind(target, 0)
+                kind, why = self._kind(target, 0, subst)
                 if kind is None:
                     flags.append(FLAG_KIND_UNKNOWN)
                     notes.append(why)
@@ -483,15 +483,22 @@ class _Linker:
         same_file = [c for c in cands if c.path == path]
         return (same_file or cands)[0]
 
-    def _lineage(self, cls: _Class, depth: int) -> tuple[_Class | _Lib | None, dict[str, str], str]:
-        """The base through which ``cls`` descends from a BehaviorTree.CPP node class."""
+    def _lineage(
+        self, cls: _Class, depth: int, outer: dict[str, str] | None = None
+    ) -> tuple[_Class | _Lib | None, dict[str, str], str]:
+        """The base through which ``cls`` descends from a BehaviorTree.CPP node class.
+
+        ``outer`` gives ``cls``'s template arguments: a base that is a template parameter
+        (``template <class B> class Logged : public B``) is the argument given.
+        """
         unknown: list[str] = []
         for b in cls.facts.bases:
-            target, subst = self._resolve(b, cls, cls.path)
+            ref = _substitute(b, outer) if outer else b
+            target, subst = self._resolve(ref, cls, cls.path)
             if isinstance(target, _Lib):
                 return target, subst, ""
             if isinstance(target, _Class) and target.facts is not cls.facts and depth < _MAX_DEPTH:
-                k, _ = self._kind(target, depth + 1)
+                k, _ = self._kind(target, depth + 1, _compose(subst, outer or {}))
                 if k is not None:
                     return target, subst, ""
                 unknown.append(b)
@@ -502,14 +509,16 @@ class _Linker:
         bases = ", ".join(unknown) or cls.facts.bases[0]
         return None, {}, f"base class {bases} of {cls.facts.qualname} is not in the sources read"
 
-    def _kind(self, cls: _Class, depth: int) -> tuple[str | None, str]:
+    def _kind(
+        self, cls: _Class, depth: int, subst: dict[str, str] | None = None
+    ) -> tuple[str | None, str]:
         if depth > _MAX_DEPTH:
             return None, "base classes nest too deep"
-        target, _, why = self._lineage(cls, depth)
+        target, s2, why = self._lineage(cls, depth, subst)
         if isinstance(target, _Lib):
             return target.kind, ""
         if isinstance(target, _Class):
-            return self._kind(target, depth + 1)
+            return self._kind(target, depth + 1, _compose(s2, subst or {}))
         return None, why
 
     def _fn(self, cls: _Class, name: str) -> tuple[str, PortsFn] | None:
@@ -560,10 +569,11 @@ class _Linker:
             )
             return out
         if cls.facts.using_ports:
-            target, s2 = self._resolve(cls.facts.using_ports, cls, cls.path)
+            using = _substitute(cls.facts.using_ports, subst)
+            target, s2 = self._resolve(using, cls, cls.path)
             self._ports_from(target, _compose(s2, subst), out, cls.facts.using_ports, depth)
             return out
-        target, s2, why = self._lineage(cls, depth)
+        target, s2, why = self._lineage(cls, depth, subst)
         if target is None:
             out.missing.append(why)
             return out
@@ -579,13 +589,15 @@ class _Linker:
             out.missing.append(f"{ref}::providedPorts() is not in the sources read")
 
     def _basic(
-        self, cls: _Class | None, ref: str, depth: int
+        self, cls: _Class | None, ref: str, depth: int, outer: dict[str, str]
     ) -> tuple[_Class, tuple[str, PortsFn], dict[str, str]] | None:
-        """The ``providedBasicPorts`` that a call in ``cls`` reaches, with its substitution."""
+        """The ``providedBasicPorts`` that a call in ``cls`` (whose template arguments
+        ``outer`` gives) reaches, with the substitution of its class."""
         start: _Class | None = cls
-        subst: dict[str, str] = {}
+        subst = dict(outer)
         if ref and cls is not None:
-            t, subst = self._resolve(ref, cls, cls.path)
+            t, s2 = self._resolve(_substitute(ref, outer), cls, cls.path)
+            subst = _compose(s2, outer)
             start = t if isinstance(t, _Class) else None
         cur = start
         for _ in range(_MAX_DEPTH):
@@ -596,7 +608,7 @@ class _Linker:
                 return cur, fn, subst
             if "providedBasicPorts" in cur.facts.declared:
                 return None  # defined out of line in a file that was not read
-            target, s2, _ = self._lineage(cur, depth)
+            target, s2, _ = self._lineage(cur, depth, subst)
             if not isinstance(target, _Class):
                 return None
             subst = _compose(s2, subst)
@@ -626,19 +638,19 @@ class _Linker:
                 if cls is None:
                     out.missing.append(f"{op.ref}::providedPorts() is not in the sources read")
                 elif not op.ref:
-                    target, s2, why = self._lineage(cls, depth)
+                    target, s2, why = self._lineage(cls, depth, subst)
                     if target is None:
                         out.missing.append(why)
                     self._ports_from(target, _compose(s2, subst), out, cls.facts.qualname, depth)
                 else:
-                    target, s2 = self._resolve(op.ref, cls, path)
+                    target, s2 = self._resolve(_substitute(op.ref, subst), cls, path)
                     if isinstance(target, _Class) and target.facts is cls.facts:
-                        target, s2, _ = self._lineage(cls, depth)
+                        target, s2, _ = self._lineage(cls, depth, subst)
                     self._ports_from(target, _compose(s2, subst), out, op.ref, depth)
             elif op.kind == "basic":
                 inner = _Ports()
                 self._eval(op.ops, cls, subst, path, inner, arg, depth)
-                found = self._basic(cls, op.ref, depth) if depth < _MAX_DEPTH else None
+                found = self._basic(cls, op.ref, depth, subst) if depth < _MAX_DEPTH else None
                 if found is None:
                     out.merge(inner)
                     owner = op.ref or (cls.facts.qualname if cls else "")
@@ -647,7 +659,7 @@ class _Linker:
                     )
                 else:
                     bcls, (bpath, fn), s2 = found
-                    self._eval(fn.ops, bcls, _compose(s2, subst), bpath, out, inner, depth + 1)
+                    self._eval(fn.ops, bcls, s2, bpath, out, inner, depth + 1)
                     if not _uses_param(fn.ops):
                         # A body that was not read (a library base whose basic ports
                         # depend on its release): the node's own ports are still among
