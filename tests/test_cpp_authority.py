@@ -269,3 +269,35 @@ def test_a_catalogs_port_types_win_over_the_spelling_of_the_cpp(
     )
     found = _check(capsys, tree.parents[2], "t.xml")
     assert not [f for f in found.values() if f[1] == "blackboard-type-mismatch"]
+
+
+def test_an_id_two_classes_register_has_no_authoritative_port_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two programs register their own ``Takeoff`` (one of them not built): a catalog
+    exported from one says what that program registered, not what the program that
+    loads this tree does, so a port it lacks is a hint."""
+    tree = _ws(tmp_path, FACTORY)
+    src = tree.parent / "src"
+    (src / "takeoff.cpp").write_text(
+        "struct Takeoff : BT::SyncActionNode { static BT::PortsList providedPorts() "
+        '{ return { BT::InputPort<double>("goal") }; } };\n'
+        'void reg(BT::BehaviorTreeFactory& f) { f.registerNodeType<Takeoff>("Takeoff"); }\n'
+    )
+    (src / "old_mission.cpp").write_text(
+        "struct Takeoff : BT::SyncActionNode { static BT::PortsList providedPorts() "
+        '{ return { BT::InputPort<double>("takeoff_target") }; } };\n'
+        'void old(BT::BehaviorTreeFactory& f) { f.registerNodeType<Takeoff>("Takeoff"); }\n'
+    )
+    (tree.parent / "all_nodes.xml").write_text(
+        '<root BTCPP_format="4"><TreeNodesModel>'
+        '<Action ID="Takeoff"><input_port name="goal" type="double"/></Action>'
+        "</TreeNodesModel></root>\n"
+    )
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T">\n'
+        '<Takeoff speed="1"/>\n'
+        "</BehaviorTree></root>\n"
+    )
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert found[2][:2] == ("hint", "undeclared-port")

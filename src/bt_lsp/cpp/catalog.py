@@ -12,7 +12,7 @@ A class that is never registered is not in the catalog.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Final, NamedTuple
 
@@ -35,6 +35,7 @@ __all__ = [
     "FLAG_DEFAULT_EXPRESSION",
     "FLAG_DUPLICATE_ID",
     "FLAG_KIND_UNKNOWN",
+    "FLAG_NOT_BUILT",
     "FLAG_PORTS_INCOMPLETE",
     "Catalog",
     "CppNode",
@@ -47,11 +48,22 @@ FLAG_KIND_UNKNOWN: Final = "kind-unknown"
 FLAG_PORTS_INCOMPLETE: Final = "ports-incomplete"
 FLAG_DEFAULT_EXPRESSION: Final = "default-expression"
 FLAG_DUPLICATE_ID: Final = "duplicate-id"
+# Registered in a source file that the project's build does not compile (its CMake lists
+# the sources of every target, and not this one): not one of the project's nodes.
+FLAG_NOT_BUILT: Final = "not-built"
 # The flags that make a node advisory: every one (a default written as an expression is
 # text bt-lsp cannot show as BehaviorTree.CPP would).
 _ADVISORY: Final = frozenset(
-    {FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE, FLAG_DUPLICATE_ID, FLAG_DEFAULT_EXPRESSION}
+    {
+        FLAG_KIND_UNKNOWN,
+        FLAG_PORTS_INCOMPLETE,
+        FLAG_DUPLICATE_ID,
+        FLAG_DEFAULT_EXPRESSION,
+        FLAG_NOT_BUILT,
+    }
 )
+# Files compiled on their own (a class defined in one is seen by no other file).
+_SOURCE_SUFFIXES: Final = (".cpp", ".cc", ".cxx", ".c++")
 
 # BehaviorTree.CPP's base classes (4.x and 3.x names) and the kind each gives.
 LIBRARY_KINDS: Final[dict[str, str]] = {
@@ -182,6 +194,7 @@ class LinkMemo:
 
     def __init__(self) -> None:
         self.facts: dict[str, FileFacts] = {}
+        self.not_built: Mapping[str, str] = {}
         # (path, index of the registration) -> (registration, ID, node, names, missing)
         self.nodes: dict[tuple[str, int], _Made] = {}
         self.made = 0  # nodes made (not kept) by the last link, for tests and benchmarks
@@ -210,14 +223,18 @@ def link(
     files: Iterable[tuple[str, FileFacts]],
     library: Iterable[tuple[str, FileFacts]] = (),
     memo: LinkMemo | None = None,
+    not_built: Mapping[str, str] | None = None,
 ) -> Catalog:
     """The catalog of the nodes registered in ``files``.
 
     ``library`` files (known bases of libraries that are not in the sources) resolve
     classes after the project's own and never register anything.  With a ``memo`` of
     the last link, the nodes no change touches are kept (and the memo is updated).
+    ``not_built`` are the files the build does not compile, each with why: their
+    registrations come after the others' and are flagged :data:`FLAG_NOT_BUILT`, and
+    their classes and port lists are used only when no compiled file has one.
     """
-    return _Linker(list(files), list(library), memo).run()
+    return _Linker(list(files), list(library), memo, not_built or {}).run()
 
 
 class _Linker:
@@ -226,9 +243,14 @@ class _Linker:
         files: list[tuple[str, FileFacts]],
         library: list[tuple[str, FileFacts]],
         memo: LinkMemo | None = None,
+        not_built: Mapping[str, str] | None = None,
     ) -> None:
-        self.files = files
+        self.not_built: Mapping[str, str] = not_built or {}
+        # The compiled files' registrations first: an ID is theirs before an unbuilt copy's.
+        self.files = sorted(files, key=lambda pf: pf[0] in self.not_built)
         self.memo = memo
+        if memo is not None and memo.not_built != self.not_built:
+            memo.nodes = {}  # what is built changed: every node is made again
         # The names the node being made looked up, and those it found missing.
         self._names: set[str] = set()
         self._missing: set[str] = set()
@@ -293,10 +315,11 @@ class _Linker:
                 elif first is not None:
                     note = f"ID {id_!r} is also registered at {_where(first.path, first.id_span)}"
                     node = _with_flag(node, FLAG_DUPLICATE_ID, note)
+                    unbuilt = " (a file that is not built)" if path in self.not_built else ""
                     by_id[id_] = _with_flag(
                         first,
                         FLAG_DUPLICATE_ID,
-                        f"ID {id_!r} is also registered at {_where(path, reg.id_span)}",
+                        f"ID {id_!r} is also registered at {_where(path, reg.id_span)}{unbuilt}",
                     )
                     nodes[nodes.index(first)] = by_id[id_]
                 else:
@@ -311,6 +334,7 @@ class _Linker:
         if self.memo is not None:
             self.memo.facts = dict(self.files)
             self.memo.nodes = made
+            self.memo.not_built = dict(self.not_built)
         return Catalog(tuple(nodes), tuple(unresolved), by_id, frozenset(self.missing))
 
     def _kept_or_made(
@@ -417,6 +441,9 @@ class _Linker:
             notes.append(
                 "a default is an expression: its value is known only when the program runs"
             )
+        if path in self.not_built:
+            flags.append(FLAG_NOT_BUILT)
+            notes.append(self.not_built[path])
         return CppNode(
             id_,
             kind,
@@ -481,7 +508,13 @@ class _Linker:
             if same:
                 cands = same
         same_file = [c for c in cands if c.path == path]
-        return (same_file or cands)[0]
+        if same_file:
+            return same_file[0]
+        # A class defined in another source file is not seen from this one (but through
+        # a header); one the build compiles before one it does not.
+        seen = [c for c in cands if not c.path.endswith(_SOURCE_SUFFIXES)] or cands
+        built = [c for c in seen if c.path not in self.not_built] or seen
+        return built[0]
 
     def _lineage(
         self, cls: _Class, depth: int, outer: dict[str, str] | None = None
@@ -530,11 +563,27 @@ class _Linker:
         self._note(f"f:{cls.facts.name}::{name}")
         found = self.fns.get((cls.facts.name, name), [])
         q = cls.facts.qualname
-        return [
+        out = [
             (path, fn)
             for path, fn in found
-            if fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q)
+            if (fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q))
+            and (path == cls.path or not self._defines_other(path, cls))
         ]
+        if cls.path.endswith(_SOURCE_SUFFIXES) and any(path == cls.path for path, _ in out):
+            # A class defined in a source file: its functions are defined there (no other
+            # file sees the class).
+            out = [(path, fn) for path, fn in out if path == cls.path]
+        # A definition in a file the build compiles wins over one in a file it does not.
+        built = [(path, fn) for path, fn in out if path not in self.not_built]
+        return built or out
+
+    def _defines_other(self, path: str, cls: _Class) -> bool:
+        """Whether ``path`` defines another class of ``cls``'s name (whose own functions
+        its definitions there are)."""
+        return any(
+            c.path == path and c.facts is not cls.facts and c.facts.qualname == cls.facts.qualname
+            for c in self.classes.get(cls.facts.name, ())
+        )
 
     def _other_definition(self, cls: _Class, name: str, first: tuple[str, PortsFn]) -> str | None:
         """Where another definition of ``cls::name`` that reads differently is, if any."""
@@ -774,11 +823,14 @@ def _same(a: CppNode, b: CppNode) -> bool:
     def ports(n: CppNode) -> list[tuple[str, str, str, str | None]]:
         return [(p.name, p.direction, p.type, p.default) for p in n.ports]
 
+    def flags(n: CppNode) -> list[str]:
+        return [f for f in n.flags if f != FLAG_NOT_BUILT]
+
     return (
         a.cls is not None
         and a.cls == b.cls
         and a.kind == b.kind
-        and a.flags == b.flags
+        and flags(a) == flags(b)
         and ports(a) == ports(b)
     )
 

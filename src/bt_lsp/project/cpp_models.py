@@ -31,7 +31,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Final, NamedTuple
 
-from bt_lsp.cpp.catalog import Catalog, CppNode
+from bt_lsp.cpp.catalog import FLAG_DUPLICATE_ID, Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, cpp_sources, find_cpp_files, scan
@@ -398,10 +398,16 @@ class CppModels:
         decls = self.decls(cat, ctx.btcpp_version)
         merged = dict(ctx.models)
         for id_, d in decls.items():
+            node = cat.by_id[id_]
             if id_ not in merged:
                 merged[id_] = d
-            elif cat.by_id[id_].authoritative:
+            elif node.authoritative:
                 merged[id_] = _with_catalog_types(d, merged[id_])
+            elif FLAG_DUPLICATE_ID in node.flags and merged[id_].authoritative:
+                # Two classes register the ID (one maybe in a program that is not built):
+                # which one the program that loads this tree registers is not known, so
+                # no port list of the ID is: a catalog says what one program registered.
+                merged[id_] = d
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
