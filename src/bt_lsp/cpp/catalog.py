@@ -578,9 +578,11 @@ class _Linker:
         return built or out
 
     def _defines_other(self, path: str, cls: _Class) -> bool:
-        """Whether ``path`` defines another class of ``cls``'s name (whose own functions
-        its definitions there are)."""
-        return any(
+        """Whether the source file ``path`` defines another class of ``cls``'s name (whose
+        own functions its definitions there are: no other file sees that class).  Two
+        headers that define one class differently stay two definitions of it: which one
+        a registering file includes is not read."""
+        return path.endswith(_SOURCE_SUFFIXES) and any(
             c.path == path and c.facts is not cls.facts and c.facts.qualname == cls.facts.qualname
             for c in self.classes.get(cls.facts.name, ())
         )

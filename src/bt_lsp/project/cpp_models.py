@@ -31,7 +31,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Final, NamedTuple
 
-from bt_lsp.cpp.catalog import FLAG_DUPLICATE_ID, Catalog, CppNode
+from bt_lsp.cpp.catalog import FLAG_DUPLICATE_ID, FLAG_NOT_BUILT, Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, cpp_sources, find_cpp_files, scan
@@ -41,6 +41,7 @@ from bt_lsp.rules.builtins import Category, Direction, PortModel
 from bt_lsp.rules.builtins_v3 import builtins_for
 from bt_lsp.rules.context import Context, ModelDecl, ModelSource
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
+from bt_lsp.rules.decls import NOT_BUILT
 from bt_lsp.rules.diagnostics import Diagnostic
 
 MAX_CPP_FILES: Final = 20000
@@ -559,6 +560,8 @@ class CppModels:
         # with flags stays advisory.
         source: ModelSource = "cpp" if n.authoritative else "cpp-partial"
         where = f"{self.shown(Path(n.path))}:{n.id_span[0] + 1}"
+        if FLAG_NOT_BUILT in n.flags:
+            where += NOT_BUILT
         return ModelDecl(n.id, _category(n.kind), ports, n.path, start, end, source, where)
 
     def offsets(self, path: Path, span: Span) -> tuple[int, int]:
