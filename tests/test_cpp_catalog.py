@@ -247,3 +247,21 @@ def test_a_class_defined_in_another_source_file_is_not_the_one_registered(
     assert node.class_path is not None and node.class_path.endswith("go.h")
     assert [p.name for p in node.ports] == ["to"]
     assert node.flags == ()
+
+
+def test_simple_nodes_registered_alike_by_two_programs_are_one_node(tmp_path: Path) -> None:
+    program = (
+        "int main() { BT::BehaviorTreeFactory f; "
+        'BT::PortsList ports = { BT::InputPort<std::string>("message") };\n'
+        'f.registerSimpleAction("Log", Log, ports); }\n'
+    )
+    (tmp_path / "a.cpp").write_text(program)
+    (tmp_path / "b.cpp").write_text(program)
+    (tmp_path / "c.cpp").write_text(
+        'int main() { BT::BehaviorTreeFactory f; f.registerSimpleAction("Log", Log, '
+        '{ BT::InputPort<int>("level") }); }\n'
+    )
+    catalog = scan(find_cpp_files([tmp_path / "a.cpp", tmp_path / "b.cpp"]), Scanner(None))
+    assert catalog.by_id["Log"].flags == ()
+    catalog = scan(find_cpp_files([tmp_path]), Scanner(None))
+    assert catalog.by_id["Log"].flags == ("duplicate-id",)

@@ -828,8 +828,9 @@ def _same(a: CppNode, b: CppNode) -> bool:
     def flags(n: CppNode) -> list[str]:
         return [f for f in n.flags if f != FLAG_NOT_BUILT]
 
+    # Two simple registrations (no class) with the same port list: one manifest.
     return (
-        a.cls is not None
+        (a.cls is not None or a.form == b.form)
         and a.cls == b.cls
         and a.kind == b.kind
         and flags(a) == flags(b)
