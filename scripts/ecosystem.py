@@ -366,7 +366,12 @@ def models_of(root: Path) -> dict[str, dict[str, Any]]:
     rc, out, err = run_bt_lsp(["models", str(root), "--format", "json"])
     if rc != 0:
         raise RuntimeError(f"bt-lsp models {root}: exit {rc}: {err.strip()[-500:]}")
-    return {n["id"]: n for n in json.loads(out)["nodes"]}
+    # The first node of an ID is the one ``check`` uses (the others are copies or
+    # registrations in files that are not built, listed after it).
+    nodes: dict[str, dict[str, Any]] = {}
+    for n in json.loads(out)["nodes"]:
+        nodes.setdefault(n["id"], n)
+    return nodes
 
 
 def project_dirs(projects: Path, only: Sequence[str]) -> list[Path]:

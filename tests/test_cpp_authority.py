@@ -269,3 +269,66 @@ def test_a_catalogs_port_types_win_over_the_spelling_of_the_cpp(
     )
     found = _check(capsys, tree.parents[2], "t.xml")
     assert not [f for f in found.values() if f[1] == "blackboard-type-mismatch"]
+
+
+def test_an_id_two_classes_register_has_no_authoritative_port_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two programs register their own ``Takeoff`` (one of them not built): a catalog
+    exported from one says what that program registered, not what the program that
+    loads this tree does, so a port it lacks is a hint."""
+    tree = _ws(tmp_path, FACTORY)
+    src = tree.parent / "src"
+    (src / "takeoff.cpp").write_text(
+        "struct Takeoff : BT::SyncActionNode { static BT::PortsList providedPorts() "
+        '{ return { BT::InputPort<double>("goal") }; } };\n'
+        'void reg(BT::BehaviorTreeFactory& f) { f.registerNodeType<Takeoff>("Takeoff"); }\n'
+    )
+    (src / "old_mission.cpp").write_text(
+        "struct Takeoff : BT::SyncActionNode { static BT::PortsList providedPorts() "
+        '{ return { BT::InputPort<double>("takeoff_target") }; } };\n'
+        'void old(BT::BehaviorTreeFactory& f) { f.registerNodeType<Takeoff>("Takeoff"); }\n'
+    )
+    (tree.parent / "all_nodes.xml").write_text(
+        '<root BTCPP_format="4"><TreeNodesModel>'
+        '<Action ID="Takeoff"><input_port name="goal" type="double"/></Action>'
+        "</TreeNodesModel></root>\n"
+    )
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>\n'
+        '<Takeoff speed="1"/>\n'
+        '<SubTree ID="Takeoff"/>\n'
+        "</Sequence></BehaviorTree></root>\n"
+    )
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert found[2][:2] == ("hint", "undeclared-port")
+    # Which ports are not known, but the ID is registered: VerifyXML refuses the name.
+    assert found[3][:2] == ("error", "registered-name-as-tree-id")
+    assert "registered in src/app/src/old_mission.cpp:2" in found[3][2]
+
+
+def test_a_node_only_a_source_file_not_built_registers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The CMake lists its targets' sources and not ``old.cpp``: its node is a node of no
+    program built, so its name as a tree ID is a hint that says so."""
+    tree = _ws(tmp_path, FACTORY)
+    pkg = tree.parent
+    (pkg / "CMakeLists.txt").write_text("project(app)\nadd_executable(app src/main.cpp)\n")
+    (pkg / "src" / "old.cpp").write_text(
+        "struct Old : BT::SyncActionNode { static BT::PortsList providedPorts() "
+        "{ return {}; } };\n"
+        'int main() { BT::BehaviorTreeFactory f; f.registerNodeType<Old>("Old"); }\n'
+    )
+    tree.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Old">\n'
+        '<BehaviorTree ID="Old"><Old/></BehaviorTree></root>\n'
+    )
+    found = _check(capsys, tree.parents[2], "t.xml")
+    assert found[2] == (
+        "hint",
+        "registered-name-as-tree-id",
+        "'Old' is a node type registered in src/app/src/old.cpp:2 (not built); "
+        "BehaviorTree.CPP refuses a <BehaviorTree> ID that names a registered node, if the "
+        "program that loads this file registers it",
+    )

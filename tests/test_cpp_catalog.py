@@ -57,6 +57,7 @@ def test_every_form_has_a_fixture() -> None:
         "literal_defaults",
         "macro_composed",
         "registrar",
+        "template_base",
     }
 
 
@@ -204,3 +205,63 @@ def test_cache_dir_follows_xdg(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) 
     assert default_cache_dir() == tmp_path / "bt-lsp" / "cpp"
     monkeypatch.delenv("XDG_CACHE_HOME")
     assert default_cache_dir() == Path(os.path.expanduser("~")) / ".cache" / "bt-lsp" / "cpp"
+
+
+def test_a_source_file_no_target_builds_comes_after_the_built_one() -> None:
+    """``not_built``: the plugin's Takeoff (its class in a header, ports out of line) is
+    the ID's node; the copy that no target builds is flagged, and, as it registers
+    another class under the same ID, neither port list is authoritative."""
+    catalog = scan(find_cpp_files([DATA / "not_built"]), Scanner(None))
+    node = catalog.by_id["Takeoff"]
+    assert node.path.endswith("takeoff.cpp")
+    assert node.class_path is not None and node.class_path.endswith("takeoff.h")
+    assert [p.name for p in node.ports] == ["goal", "is_rc"]
+    assert node.flags == ("duplicate-id",)
+    assert "(a file that is not built)" in " ".join(node.notes)
+    assert not node.authoritative
+    copy = next(n for n in catalog.nodes if n.id == "Takeoff" and n is not node)
+    assert copy.path.endswith("mission (copy).cpp")
+    assert "lists mission (copy).cpp among its sources" in copy.notes[0]
+    assert "CMakeLists.txt" in copy.notes[0]
+    assert not catalog.by_id["MoveUp"].authoritative
+
+
+def test_a_class_defined_in_another_source_file_is_not_the_one_registered(
+    tmp_path: Path,
+) -> None:
+    """Two classes of one name: the registering file sees its header's, never one that
+    another source file defines for itself."""
+    (tmp_path / "go.h").write_text(
+        "class Go : public BT::SyncActionNode { public: static BT::PortsList providedPorts(); };\n"
+    )
+    (tmp_path / "a_old.cpp").write_text(
+        "class Go : public BT::StatefulActionNode { public: static BT::PortsList "
+        'providedPorts() { return { BT::InputPort<int>("old") }; } };\n'
+    )
+    (tmp_path / "go.cpp").write_text(
+        '#include "go.h"\nBT::PortsList Go::providedPorts() '
+        '{ return { BT::InputPort<int>("to") }; }\n'
+        'BT_REGISTER_NODES(factory) { factory.registerNodeType<Go>("Go"); }\n'
+    )
+    node = scan(find_cpp_files([tmp_path]), Scanner(None)).by_id["Go"]
+    assert node.class_path is not None and node.class_path.endswith("go.h")
+    assert [p.name for p in node.ports] == ["to"]
+    assert node.flags == ()
+
+
+def test_simple_nodes_registered_alike_by_two_programs_are_one_node(tmp_path: Path) -> None:
+    program = (
+        "int main() { BT::BehaviorTreeFactory f; "
+        'BT::PortsList ports = { BT::InputPort<std::string>("message") };\n'
+        'f.registerSimpleAction("Log", Log, ports); }\n'
+    )
+    (tmp_path / "a.cpp").write_text(program)
+    (tmp_path / "b.cpp").write_text(program)
+    (tmp_path / "c.cpp").write_text(
+        'int main() { BT::BehaviorTreeFactory f; f.registerSimpleAction("Log", Log, '
+        '{ BT::InputPort<int>("level") }); }\n'
+    )
+    catalog = scan(find_cpp_files([tmp_path / "a.cpp", tmp_path / "b.cpp"]), Scanner(None))
+    assert catalog.by_id["Log"].flags == ()
+    catalog = scan(find_cpp_files([tmp_path]), Scanner(None))
+    assert catalog.by_id["Log"].flags == ("duplicate-id",)

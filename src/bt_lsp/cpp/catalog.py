@@ -12,7 +12,7 @@ A class that is never registered is not in the catalog.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Final, NamedTuple
 
@@ -35,6 +35,7 @@ __all__ = [
     "FLAG_DEFAULT_EXPRESSION",
     "FLAG_DUPLICATE_ID",
     "FLAG_KIND_UNKNOWN",
+    "FLAG_NOT_BUILT",
     "FLAG_PORTS_INCOMPLETE",
     "Catalog",
     "CppNode",
@@ -47,11 +48,22 @@ FLAG_KIND_UNKNOWN: Final = "kind-unknown"
 FLAG_PORTS_INCOMPLETE: Final = "ports-incomplete"
 FLAG_DEFAULT_EXPRESSION: Final = "default-expression"
 FLAG_DUPLICATE_ID: Final = "duplicate-id"
+# Registered in a source file that the project's build does not compile (its CMake lists
+# the sources of every target, and not this one): not one of the project's nodes.
+FLAG_NOT_BUILT: Final = "not-built"
 # The flags that make a node advisory: every one (a default written as an expression is
 # text bt-lsp cannot show as BehaviorTree.CPP would).
 _ADVISORY: Final = frozenset(
-    {FLAG_KIND_UNKNOWN, FLAG_PORTS_INCOMPLETE, FLAG_DUPLICATE_ID, FLAG_DEFAULT_EXPRESSION}
+    {
+        FLAG_KIND_UNKNOWN,
+        FLAG_PORTS_INCOMPLETE,
+        FLAG_DUPLICATE_ID,
+        FLAG_DEFAULT_EXPRESSION,
+        FLAG_NOT_BUILT,
+    }
 )
+# Files compiled on their own (a class defined in one is seen by no other file).
+_SOURCE_SUFFIXES: Final = (".cpp", ".cc", ".cxx", ".c++")
 
 # BehaviorTree.CPP's base classes (4.x and 3.x names) and the kind each gives.
 LIBRARY_KINDS: Final[dict[str, str]] = {
@@ -182,6 +194,7 @@ class LinkMemo:
 
     def __init__(self) -> None:
         self.facts: dict[str, FileFacts] = {}
+        self.not_built: Mapping[str, str] = {}
         # (path, index of the registration) -> (registration, ID, node, names, missing)
         self.nodes: dict[tuple[str, int], _Made] = {}
         self.made = 0  # nodes made (not kept) by the last link, for tests and benchmarks
@@ -210,14 +223,18 @@ def link(
     files: Iterable[tuple[str, FileFacts]],
     library: Iterable[tuple[str, FileFacts]] = (),
     memo: LinkMemo | None = None,
+    not_built: Mapping[str, str] | None = None,
 ) -> Catalog:
     """The catalog of the nodes registered in ``files``.
 
     ``library`` files (known bases of libraries that are not in the sources) resolve
     classes after the project's own and never register anything.  With a ``memo`` of
     the last link, the nodes no change touches are kept (and the memo is updated).
+    ``not_built`` are the files the build does not compile, each with why: their
+    registrations come after the others' and are flagged :data:`FLAG_NOT_BUILT`, and
+    their classes and port lists are used only when no compiled file has one.
     """
-    return _Linker(list(files), list(library), memo).run()
+    return _Linker(list(files), list(library), memo, not_built or {}).run()
 
 
 class _Linker:
@@ -226,9 +243,14 @@ class _Linker:
         files: list[tuple[str, FileFacts]],
         library: list[tuple[str, FileFacts]],
         memo: LinkMemo | None = None,
+        not_built: Mapping[str, str] | None = None,
     ) -> None:
-        self.files = files
+        self.not_built: Mapping[str, str] = not_built or {}
+        # The compiled files' registrations first: an ID is theirs before an unbuilt copy's.
+        self.files = sorted(files, key=lambda pf: pf[0] in self.not_built)
         self.memo = memo
+        if memo is not None and memo.not_built != self.not_built:
+            memo.nodes = {}  # what is built changed: every node is made again
         # The names the node being made looked up, and those it found missing.
         self._names: set[str] = set()
         self._missing: set[str] = set()
@@ -293,10 +315,11 @@ class _Linker:
                 elif first is not None:
                     note = f"ID {id_!r} is also registered at {_where(first.path, first.id_span)}"
                     node = _with_flag(node, FLAG_DUPLICATE_ID, note)
+                    unbuilt = " (a file that is not built)" if path in self.not_built else ""
                     by_id[id_] = _with_flag(
                         first,
                         FLAG_DUPLICATE_ID,
-                        f"ID {id_!r} is also registered at {_where(path, reg.id_span)}",
+                        f"ID {id_!r} is also registered at {_where(path, reg.id_span)}{unbuilt}",
                     )
                     nodes[nodes.index(first)] = by_id[id_]
                 else:
@@ -311,6 +334,7 @@ class _Linker:
         if self.memo is not None:
             self.memo.facts = dict(self.files)
             self.memo.nodes = made
+            self.memo.not_built = dict(self.not_built)
         return Catalog(tuple(nodes), tuple(unresolved), by_id, frozenset(self.missing))
 
     def _kept_or_made(
@@ -394,7 +418,7 @@ class _Linker:
             if isinstance(target, _Class):
                 cls_name = target.facts.qualname
                 class_path, class_span = target.path, target.facts.span
-                kind, why = self._kind(target, 0)
+                kind, why = self._kind(target, 0, subst)
                 if kind is None:
                     flags.append(FLAG_KIND_UNKNOWN)
                     notes.append(why)
@@ -417,6 +441,9 @@ class _Linker:
             notes.append(
                 "a default is an expression: its value is known only when the program runs"
             )
+        if path in self.not_built:
+            flags.append(FLAG_NOT_BUILT)
+            notes.append(self.not_built[path])
         return CppNode(
             id_,
             kind,
@@ -481,17 +508,30 @@ class _Linker:
             if same:
                 cands = same
         same_file = [c for c in cands if c.path == path]
-        return (same_file or cands)[0]
+        if same_file:
+            return same_file[0]
+        # A class defined in another source file is not seen from this one (but through
+        # a header); one the build compiles before one it does not.
+        seen = [c for c in cands if not c.path.endswith(_SOURCE_SUFFIXES)] or cands
+        built = [c for c in seen if c.path not in self.not_built] or seen
+        return built[0]
 
-    def _lineage(self, cls: _Class, depth: int) -> tuple[_Class | _Lib | None, dict[str, str], str]:
-        """The base through which ``cls`` descends from a BehaviorTree.CPP node class."""
+    def _lineage(
+        self, cls: _Class, depth: int, outer: dict[str, str] | None = None
+    ) -> tuple[_Class | _Lib | None, dict[str, str], str]:
+        """The base through which ``cls`` descends from a BehaviorTree.CPP node class.
+
+        ``outer`` gives ``cls``'s template arguments: a base that is a template parameter
+        (``template <class B> class Logged : public B``) is the argument given.
+        """
         unknown: list[str] = []
         for b in cls.facts.bases:
-            target, subst = self._resolve(b, cls, cls.path)
+            ref = _substitute(b, outer) if outer else b
+            target, subst = self._resolve(ref, cls, cls.path)
             if isinstance(target, _Lib):
                 return target, subst, ""
             if isinstance(target, _Class) and target.facts is not cls.facts and depth < _MAX_DEPTH:
-                k, _ = self._kind(target, depth + 1)
+                k, _ = self._kind(target, depth + 1, _compose(subst, outer or {}))
                 if k is not None:
                     return target, subst, ""
                 unknown.append(b)
@@ -502,14 +542,16 @@ class _Linker:
         bases = ", ".join(unknown) or cls.facts.bases[0]
         return None, {}, f"base class {bases} of {cls.facts.qualname} is not in the sources read"
 
-    def _kind(self, cls: _Class, depth: int) -> tuple[str | None, str]:
+    def _kind(
+        self, cls: _Class, depth: int, subst: dict[str, str] | None = None
+    ) -> tuple[str | None, str]:
         if depth > _MAX_DEPTH:
             return None, "base classes nest too deep"
-        target, _, why = self._lineage(cls, depth)
+        target, s2, why = self._lineage(cls, depth, subst)
         if isinstance(target, _Lib):
             return target.kind, ""
         if isinstance(target, _Class):
-            return self._kind(target, depth + 1)
+            return self._kind(target, depth + 1, _compose(s2, subst or {}))
         return None, why
 
     def _fn(self, cls: _Class, name: str) -> tuple[str, PortsFn] | None:
@@ -521,11 +563,29 @@ class _Linker:
         self._note(f"f:{cls.facts.name}::{name}")
         found = self.fns.get((cls.facts.name, name), [])
         q = cls.facts.qualname
-        return [
+        out = [
             (path, fn)
             for path, fn in found
-            if fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q)
+            if (fn.owner == q or q.endswith("::" + fn.owner) or fn.owner.endswith("::" + q))
+            and (path == cls.path or not self._defines_other(path, cls))
         ]
+        if cls.path.endswith(_SOURCE_SUFFIXES) and any(path == cls.path for path, _ in out):
+            # A class defined in a source file: its functions are defined there (no other
+            # file sees the class).
+            out = [(path, fn) for path, fn in out if path == cls.path]
+        # A definition in a file the build compiles wins over one in a file it does not.
+        built = [(path, fn) for path, fn in out if path not in self.not_built]
+        return built or out
+
+    def _defines_other(self, path: str, cls: _Class) -> bool:
+        """Whether the source file ``path`` defines another class of ``cls``'s name (whose
+        own functions its definitions there are: no other file sees that class).  Two
+        headers that define one class differently stay two definitions of it: which one
+        a registering file includes is not read."""
+        return path.endswith(_SOURCE_SUFFIXES) and any(
+            c.path == path and c.facts is not cls.facts and c.facts.qualname == cls.facts.qualname
+            for c in self.classes.get(cls.facts.name, ())
+        )
 
     def _other_definition(self, cls: _Class, name: str, first: tuple[str, PortsFn]) -> str | None:
         """Where another definition of ``cls::name`` that reads differently is, if any."""
@@ -560,10 +620,11 @@ class _Linker:
             )
             return out
         if cls.facts.using_ports:
-            target, s2 = self._resolve(cls.facts.using_ports, cls, cls.path)
+            using = _substitute(cls.facts.using_ports, subst)
+            target, s2 = self._resolve(using, cls, cls.path)
             self._ports_from(target, _compose(s2, subst), out, cls.facts.using_ports, depth)
             return out
-        target, s2, why = self._lineage(cls, depth)
+        target, s2, why = self._lineage(cls, depth, subst)
         if target is None:
             out.missing.append(why)
             return out
@@ -579,13 +640,15 @@ class _Linker:
             out.missing.append(f"{ref}::providedPorts() is not in the sources read")
 
     def _basic(
-        self, cls: _Class | None, ref: str, depth: int
+        self, cls: _Class | None, ref: str, depth: int, outer: dict[str, str]
     ) -> tuple[_Class, tuple[str, PortsFn], dict[str, str]] | None:
-        """The ``providedBasicPorts`` that a call in ``cls`` reaches, with its substitution."""
+        """The ``providedBasicPorts`` that a call in ``cls`` (whose template arguments
+        ``outer`` gives) reaches, with the substitution of its class."""
         start: _Class | None = cls
-        subst: dict[str, str] = {}
+        subst = dict(outer)
         if ref and cls is not None:
-            t, subst = self._resolve(ref, cls, cls.path)
+            t, s2 = self._resolve(_substitute(ref, outer), cls, cls.path)
+            subst = _compose(s2, outer)
             start = t if isinstance(t, _Class) else None
         cur = start
         for _ in range(_MAX_DEPTH):
@@ -596,7 +659,7 @@ class _Linker:
                 return cur, fn, subst
             if "providedBasicPorts" in cur.facts.declared:
                 return None  # defined out of line in a file that was not read
-            target, s2, _ = self._lineage(cur, depth)
+            target, s2, _ = self._lineage(cur, depth, subst)
             if not isinstance(target, _Class):
                 return None
             subst = _compose(s2, subst)
@@ -626,19 +689,19 @@ class _Linker:
                 if cls is None:
                     out.missing.append(f"{op.ref}::providedPorts() is not in the sources read")
                 elif not op.ref:
-                    target, s2, why = self._lineage(cls, depth)
+                    target, s2, why = self._lineage(cls, depth, subst)
                     if target is None:
                         out.missing.append(why)
                     self._ports_from(target, _compose(s2, subst), out, cls.facts.qualname, depth)
                 else:
-                    target, s2 = self._resolve(op.ref, cls, path)
+                    target, s2 = self._resolve(_substitute(op.ref, subst), cls, path)
                     if isinstance(target, _Class) and target.facts is cls.facts:
-                        target, s2, _ = self._lineage(cls, depth)
+                        target, s2, _ = self._lineage(cls, depth, subst)
                     self._ports_from(target, _compose(s2, subst), out, op.ref, depth)
             elif op.kind == "basic":
                 inner = _Ports()
                 self._eval(op.ops, cls, subst, path, inner, arg, depth)
-                found = self._basic(cls, op.ref, depth) if depth < _MAX_DEPTH else None
+                found = self._basic(cls, op.ref, depth, subst) if depth < _MAX_DEPTH else None
                 if found is None:
                     out.merge(inner)
                     owner = op.ref or (cls.facts.qualname if cls else "")
@@ -647,7 +710,7 @@ class _Linker:
                     )
                 else:
                     bcls, (bpath, fn), s2 = found
-                    self._eval(fn.ops, bcls, _compose(s2, subst), bpath, out, inner, depth + 1)
+                    self._eval(fn.ops, bcls, s2, bpath, out, inner, depth + 1)
                     if not _uses_param(fn.ops):
                         # A body that was not read (a library base whose basic ports
                         # depend on its release): the node's own ports are still among
@@ -762,11 +825,15 @@ def _same(a: CppNode, b: CppNode) -> bool:
     def ports(n: CppNode) -> list[tuple[str, str, str, str | None]]:
         return [(p.name, p.direction, p.type, p.default) for p in n.ports]
 
+    def flags(n: CppNode) -> list[str]:
+        return [f for f in n.flags if f != FLAG_NOT_BUILT]
+
+    # Two simple registrations (no class) with the same port list: one manifest.
     return (
-        a.cls is not None
+        (a.cls is not None or a.form == b.form)
         and a.cls == b.cls
         and a.kind == b.kind
-        and a.flags == b.flags
+        and flags(a) == flags(b)
         and ports(a) == ports(b)
     )
 

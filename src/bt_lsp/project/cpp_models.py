@@ -31,7 +31,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Final, NamedTuple
 
-from bt_lsp.cpp.catalog import Catalog, CppNode
+from bt_lsp.cpp.catalog import FLAG_DUPLICATE_ID, FLAG_NOT_BUILT, Catalog, CppNode
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import Span
 from bt_lsp.project.cpp_scan import CPP_SUFFIXES, Scanner, cpp_sources, find_cpp_files, scan
@@ -41,6 +41,7 @@ from bt_lsp.rules.builtins import Category, Direction, PortModel
 from bt_lsp.rules.builtins_v3 import builtins_for
 from bt_lsp.rules.context import Context, ModelDecl, ModelSource
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
+from bt_lsp.rules.decls import NOT_BUILT
 from bt_lsp.rules.diagnostics import Diagnostic
 
 MAX_CPP_FILES: Final = 20000
@@ -408,10 +409,16 @@ class CppModels:
         builtins = builtins_for(ctx.btcpp_version)
         decls = self.decls(cat, ctx.btcpp_version)
         for id_, d in decls.items():
+            node = cat.by_id[id_]
             if id_ not in merged:
                 merged[id_] = d
-            elif cat.by_id[id_].authoritative:
+            elif node.authoritative:
                 merged[id_] = _with_catalog_types(d, merged[id_])
+            elif FLAG_DUPLICATE_ID in node.flags and merged[id_].authoritative:
+                # Two classes register the ID (one maybe in a program that is not built):
+                # which one the program that loads this tree registers is not known, so
+                # no port list of the ID is: a catalog says what one program registered.
+                merged[id_] = d
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
@@ -573,6 +580,8 @@ class CppModels:
         # with flags stays advisory.
         source: ModelSource = "cpp" if n.authoritative else "cpp-partial"
         where = f"{self.shown(Path(n.path))}:{n.id_span[0] + 1}"
+        if FLAG_NOT_BUILT in n.flags:
+            where += NOT_BUILT
         return ModelDecl(n.id, _category(n.kind), ports, n.path, start, end, source, where)
 
     def offsets(self, path: Path, span: Span) -> tuple[int, int]:

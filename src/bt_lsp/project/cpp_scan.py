@@ -30,6 +30,7 @@ from bt_lsp.cpp.catalog import Catalog, LinkMemo, link
 from bt_lsp.cpp.extract import extract, may_declare_nodes, parser
 from bt_lsp.cpp.facts import FileFacts, from_json, to_json
 from bt_lsp.cpp.library import library_facts
+from bt_lsp.project.cpp_cmake import CMakeReader
 
 CPP_SUFFIXES: Final = frozenset({".cpp", ".hpp", ".h", ".cc", ".cxx", ".hh", ".hxx", ".ipp"})
 SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modules", "__pycache__"})
@@ -133,6 +134,8 @@ class Scanner:
     # sees the same files and keeps what it can).
     memo: LinkMemo = field(default_factory=LinkMemo, repr=False)
     _lazy: set[str] = field(default_factory=set, repr=False)
+    # Which source files the projects' CMake builds (read again when a CMakeLists changes).
+    cmake: CMakeReader = field(default_factory=CMakeReader, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def facts(self, path: str, data: bytes) -> FileFacts:
@@ -246,21 +249,27 @@ def scan(
         read_facts[p] = sc.facts(p, texts[p])
         if progress is not None:
             progress(i + 1, total)
+    not_built = sc.cmake.not_built([Path(p) for p in texts], texts)
     # An edit that changes no fact (inside a function body, the same lines) keeps the
     # facts object, and so the catalog: nothing is linked again.
     key = (
         tuple((p, id(f)) for p, f in read_facts.items()),
         tuple((p, id(texts[p])) for p in rest),
+        tuple(sorted(not_built)),
     )
     if sc._linked is not None and sc._linked[0] == key:
         return sc._linked[1]
-    catalog = _link_lazily(sc, texts, read_facts, rest)
+    catalog = _link_lazily(sc, texts, read_facts, rest, not_built)
     sc._linked = (key, catalog)
     return catalog
 
 
 def _link_lazily(
-    sc: Scanner, texts: dict[str, bytes], read_facts: dict[str, FileFacts], rest: list[str]
+    sc: Scanner,
+    texts: dict[str, bytes],
+    read_facts: dict[str, FileFacts],
+    rest: list[str],
+    not_built: dict[str, str],
 ) -> Catalog:
     """Link, then read the other files that name what the catalog misses, and again."""
     eager = set(read_facts)
@@ -268,7 +277,7 @@ def _link_lazily(
     for p in again:
         read_facts[p] = sc.facts(p, texts[p])
     rest = [p for p in rest if p not in sc._lazy]
-    catalog = link(sorted(read_facts.items()), library_facts(), sc.memo)
+    catalog = link(sorted(read_facts.items()), library_facts(), sc.memo, not_built)
     for _ in range(_LAZY_ROUNDS):
         names = set(catalog.missing)
         names.update(m.name for f in read_facts.values() for m in f.macros)
@@ -285,6 +294,6 @@ def _link_lazily(
             read_facts[p] = sc.facts(p, texts[p])
         more_set = set(more)
         rest = [p for p in rest if p not in more_set]
-        catalog = link(sorted(read_facts.items()), library_facts(), sc.memo)
+        catalog = link(sorted(read_facts.items()), library_facts(), sc.memo, not_built)
     sc._lazy = {p for p in read_facts if p not in eager}
     return catalog

@@ -29,6 +29,8 @@ ModelSource = Literal[
     "tree", "palette", "generated", "catalog", "ros", "ros-workspace", "cpp", "cpp-partial"
 ]
 AUTHORITATIVE: Final[frozenset[str]] = frozenset({"generated", "catalog", "ros", "cpp"})
+#: Ends the ``where`` of a model learned from a C++ file that the build does not compile.
+NOT_BUILT: Final = " (not built)"
 _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
     {
         "tree": "the <TreeNodesModel> of a tree file (advisory: BehaviorTree.CPP reads the C++)",
@@ -77,6 +79,15 @@ class ModelDecl(NamedTuple):
     def authoritative(self) -> bool:
         """Whether BehaviorTree.CPP is known to register exactly this model."""
         return self.source in AUTHORITATIVE
+
+    @property
+    def registers(self) -> bool:
+        """Whether BehaviorTree.CPP is known to register the ID, if not exactly this model:
+        an authoritative model, or a C++ registration whose ports (or which of two
+        classes) a static reading could not know, in a file that the build compiles."""
+        return self.authoritative or (
+            self.source == "cpp-partial" and not self.where.endswith(NOT_BUILT)
+        )
 
     def port(self, name: str) -> PortModel | None:
         for p in self.ports:

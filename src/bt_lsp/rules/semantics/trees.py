@@ -132,11 +132,11 @@ def _where(st: State, decl: TreeDecl) -> str:
 
 def _surely_registered(st: State, tree_id: str) -> bool:
     """Whether a built-in or an authoritative model (a catalog, the C++) registers
-    ``tree_id``."""
+    ``tree_id`` (or a C++ registration whose port list is not all known)."""
     if tree_id in BUILTINS:
         return True
     decl = st.ctx.models.get(tree_id)
-    return decl is not None and decl.authoritative
+    return decl is not None and decl.registers
 
 
 def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) -> bool:
@@ -153,14 +153,28 @@ def _registered_name(st: State, tag: str, tree_id: str, start: int, end: int) ->
     decl = st.ctx.models.get(tree_id)
     if decl is not None:
         where = "" if st.ctx.is_own(decl) or not decl.path else f" in {os.path.basename(decl.path)}"
-        if decl.authoritative:
+        if decl.registers:
+            what = (
+                f"<{decl.category}> registered in {decl.where}"
+                if decl.where and not decl.authoritative
+                else f"<{decl.category}> in the node catalog{where}"
+            )
             st.add(
                 start,
                 end,
                 "registered-name-as-tree-id",
-                f"{quoted(tree_id)} is a registered node type (<{decl.category}> in the node "
-                f"catalog{where}); BehaviorTree.CPP refuses a <{tag}> ID that names a "
-                "registered node",
+                f"{quoted(tree_id)} is a registered node type ({what}); BehaviorTree.CPP "
+                f"refuses a <{tag}> ID that names a registered node",
+            )
+        elif decl.where:  # learned from C++ that the build does not compile
+            st.add(
+                start,
+                end,
+                "registered-name-as-tree-id",
+                f"{quoted(tree_id)} is a node type registered in {decl.where}; "
+                f"BehaviorTree.CPP refuses a <{tag}> ID that names a registered node, if the "
+                "program that loads this file registers it",
+                Severity.HINT,
             )
         else:
             st.add(

@@ -1,0 +1,7 @@
+#include <behaviortree_cpp/bt_factory.h>
+
+int main()
+{
+  BT::BehaviorTreeFactory factory;
+  factory.registerFromPlugin("libtakeoff.so");
+}
