@@ -245,3 +245,31 @@ def test_linux_package_runs_bt_lsp_from_its_wheels(
     )
     assert checked.returncode == 1, checked.stdout + checked.stderr
     assert "model-name-forbidden-char" in checked.stdout, checked.stdout
+
+
+# --- what the Marketplace and Open VSX show, and what the packages may hold -----------------
+
+
+def test_marketplace_metadata_is_complete() -> None:
+    manifest = json.loads((EXT / "package.json").read_text(encoding="utf-8"))
+    for key in ("icon", "galleryBanner", "categories", "keywords", "license", "repository"):
+        assert manifest.get(key), key
+    assert manifest["license"] == "Apache-2.0" and (EXT / "LICENSE").exists()
+    assert manifest["repository"]["url"].startswith("https://github.com/")
+    assert len(manifest["keywords"]) <= 30  # vsce refuses more
+    icon = (EXT / manifest["icon"]).read_bytes()
+    # A PNG of at least 128x128 pixels (the Marketplace's minimum).
+    assert icon[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = int.from_bytes(icon[16:20], "big"), int.from_bytes(icon[20:24], "big")
+    assert width >= 128 and height >= 128
+    # A workspace must not choose which program runs.
+    restricted = manifest["capabilities"]["untrustedWorkspaces"]["restrictedConfigurations"]
+    assert {"btLsp.server.command", "btLsp.interpreter", "btLsp.importStrategy"} <= set(restricted)
+
+
+def test_packages_take_the_bundle_and_git_does_not() -> None:
+    ignore = (EXT / ".vscodeignore").read_text(encoding="utf-8").splitlines()
+    for kept in ("!python/bootstrap.py", "!bundled/manifest.json", "!bundled/wheels/*.whl"):
+        assert kept in ignore
+    gitignore = (ROOT / ".gitignore").read_text(encoding="utf-8").splitlines()
+    assert {"editors/vscode/.wheels-cache/", "editors/vscode/bundled/"} <= set(gitignore)
