@@ -15,7 +15,7 @@ REPO = Path(__file__).resolve().parent.parent
 EXT = REPO / "editors" / "vscode"
 SETTINGS_PY = REPO / "src" / "bt_lsp" / "project" / "settings.py"
 # Read by the extension itself, not by the server.
-CLIENT_ONLY = {"server.command", "trace.server"}
+CLIENT_ONLY = {"server.command", "trace.server", "importStrategy", "interpreter"}
 JSON_TYPES = {"string", "number", "integer", "boolean", "array", "object", "null"}
 LEVELS = ["error", "warning", "information", "hint", "off"]
 
@@ -107,4 +107,6 @@ def test_open_settings_opens_where_the_server_command_can_be_set() -> None:
     assert "vscode.env.remoteName" in body
     assert "'workbench.action.openRemoteSettings'" in body
     assert "'workbench.action.openGlobalSettings'" in body
-    assert "{ query: 'btLsp.server.command' }" in body
+    # The setting that fixes it: the interpreter for the bundled server, else the command.
+    assert "query: bundle ? 'btLsp.interpreter' : 'btLsp.server.command'" in body
+    assert properties()["btLsp.interpreter"]["scope"] == "machine-overridable"

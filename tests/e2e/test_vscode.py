@@ -23,6 +23,7 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -137,11 +138,16 @@ class CodeServer:
 
 @contextmanager
 def _code_server(
-    tmp_path: Path, files: dict[str, str] | None = None, settings: Mapping[str, object] = {}
+    tmp_path: Path,
+    files: dict[str, str] | None = None,
+    settings: Mapping[str, object] = {},
+    vsix: Path = VSIX,
+    environ: Mapping[str, str] | None = None,
 ) -> Iterator[CodeServer]:
     """code-server on 127.0.0.1 with the extension, an isolated user-data dir and a workspace
     holding ``files`` (name -> text; by default tree.xml); ``settings`` override the user
-    settings."""
+    settings. ``environ`` replaces the process environment (then nothing is added to
+    PYTHONPATH), ``vsix`` is the package installed."""
     workspace = tmp_path / "ws"
     workspace.mkdir()
     for name, text in (files or {"tree.xml": TREE}).items():
@@ -171,13 +177,15 @@ def _code_server(
     user_settings.update(settings)
     (user_data / "User" / "settings.json").write_text(json.dumps(user_settings, indent=2))
 
-    env = dict(os.environ)
+    env = dict(os.environ if environ is None else environ)
     env.update(
         XDG_CONFIG_HOME=str(xdg / "config"),
         XDG_DATA_HOME=str(xdg / "data"),
         XDG_CACHE_HOME=str(xdg / "cache"),
-        PYTHONPATH=os.pathsep.join(filter(None, [str(REPO / "src"), env.get("PYTHONPATH")])),
     )
+    if environ is None:
+        paths = [str(REPO / "src"), env.get("PYTHONPATH")]
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, paths))
     env.pop("VSCODE_IPC_HOOK_CLI", None)
     base = [
         str(CODE_SERVER),
@@ -187,7 +195,7 @@ def _code_server(
         str(extensions),
     ]
     install = subprocess.run(
-        [*base, "--install-extension", str(VSIX)],
+        [*base, "--install-extension", str(vsix)],
         env=env,
         capture_output=True,
         text=True,
@@ -245,7 +253,10 @@ def test_vscode_squiggle_problems_quick_fix_hover(tmp_path: Path) -> None:
         _drive_and_check(code_server, tmp_path)
 
 
-def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
+def _drive_and_check(code_server: CodeServer, tmp_path: Path, prefix: str = "") -> dict[str, Any]:
+    """Squiggle, Problems entry, hover and quick fix; returns the driver's record. Screenshots
+    and the record go to ARTIFACTS with ``prefix`` before their names."""
+
     def logs() -> str:
         return _logs(code_server.user_data, code_server.log)
 
@@ -277,12 +288,12 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     finally:
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         for shot in shots.glob("*.png"):
-            shutil.copy(shot, ARTIFACTS / shot.name)
+            shutil.copy(shot, ARTIFACTS / f"{prefix}{shot.name}")
 
     lines = run.stdout.strip().splitlines()
     assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs()}"
-    result = json.loads(lines[-1])
-    (ARTIFACTS / "result.json").write_text(json.dumps(result, indent=1))
+    result: dict[str, Any] = json.loads(lines[-1])
+    (ARTIFACTS / f"{prefix}result.json").write_text(json.dumps(result, indent=1))
     context = (
         f"\ndriver result: {json.dumps(result, indent=1)}\ndriver stderr:\n{run.stderr[-2000:]}\n"
         f"{logs()}\nscreenshots: {ARTIFACTS}"
@@ -309,7 +320,8 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     assert (code_server.workspace / "tree.xml").read_text(encoding="utf-8") == FIXED, context
 
     for name in ("hover.png", "quickfix.png", "fixed.png"):
-        assert (ARTIFACTS / name).stat().st_size > 10_000, name
-    if os.environ.get("BT_LSP_E2E_UPDATE_IMAGES") == "1":
+        assert (ARTIFACTS / f"{prefix}{name}").stat().st_size > 10_000, name
+    if os.environ.get("BT_LSP_E2E_UPDATE_IMAGES") == "1" and not prefix:
         for name in ("hover.png", "quickfix.png"):
             shutil.copy(ARTIFACTS / name, README_IMAGES / name)
+    return result

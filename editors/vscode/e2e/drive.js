@@ -138,6 +138,9 @@ async function main(page) {
     .waitForSelector(`.tabs-container .tab.dirty[aria-label*="${config.file}"]`, { state: 'detached', timeout: STEP_TIMEOUT })
     .then(() => true, () => false);
   await page.screenshot({ path: path.join(config.shotDir, 'fixed.png') });
+  result.statusBar = await page.$$eval('.statusbar-item', (items) =>
+    items.filter((item) => item.innerText.includes('bt-lsp')).map((item) => item.innerText.trim()),
+  );
   mark('done');
 }
 

@@ -6,7 +6,10 @@
 #   1. Debian packages: chromium (the browser that drives VS Code), and what code-server's
 #      native modules build from: build-essential, pkg-config, libkrb5-dev; ripgrep (VS Code's
 #      search, whose npm package would download its binary from elsewhere).
-#   2. The extension: `npm ci` and `npm run package` in editors/vscode -> bt-lsp.vsix.
+#   2. The extension: `npm ci` and `npm run package` in editors/vscode -> bt-lsp.vsix; and the
+#      package for this machine that brings its own server, with bt-lsp and its dependencies
+#      as wheels (scripts/vscode_bundle.py; wheels cached in editors/vscode/.wheels-cache)
+#      -> bt-lsp-linux-x64.vsix (tests/e2e/test_vscode_bundled.py).
 #   3. code-server 4.100.3 (VS Code 1.100.3, the last release that runs on Node 20) into
 #      editors/vscode/.e2e/code-server, with its install script redone here so that native
 #      modules are built from source against the local Node headers and nothing is downloaded
@@ -17,6 +20,7 @@ set -euo pipefail
 CODE_SERVER_VERSION=4.100.3
 E2E_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 EXT_DIR=$(dirname "$E2E_DIR")
+REPO_DIR=$(dirname "$(dirname "$EXT_DIR")")
 CS_DIR="$EXT_DIR/.e2e/code-server"
 CS_MARKER="$CS_DIR/.installed-$CODE_SERVER_VERSION"
 
@@ -67,6 +71,22 @@ export npm_config_audit=false npm_config_fund=false npm_config_update_notifier=f
 say "extension: npm ci && npm run package"
 npm_ci "$EXT_DIR"
 (cd "$EXT_DIR" && npm run package)
+
+# The Python that builds bt-lsp's wheel and downloads the others: $BT_LSP_PYTHON, else the
+# repository's virtual environment (scripts/setup.sh makes it), else python3.
+PYTHON=${BT_LSP_PYTHON:-}
+if [ -z "$PYTHON" ]; then
+  if [ -x "$REPO_DIR/.venv/bin/python" ]; then PYTHON="$REPO_DIR/.venv/bin/python"; else PYTHON=python3; fi
+fi
+case "$(uname -s)-$(uname -m)" in
+  Linux-x86_64) TARGET=linux-x64 ;;
+  Linux-aarch64) TARGET=linux-arm64 ;;
+  *) TARGET= ;;
+esac
+if [ -n "$TARGET" ]; then
+  say "extension with its server: scripts/vscode_bundle.py --target $TARGET"
+  "$PYTHON" "$REPO_DIR/scripts/vscode_bundle.py" --target "$TARGET"
+fi
 
 # --- 3. code-server -----------------------------------------------------------------------
 if [ -f "$CS_MARKER" ] && [ -x "$CS_DIR/node_modules/.bin/code-server" ]; then

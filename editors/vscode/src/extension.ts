@@ -9,8 +9,11 @@ import {
   LanguageClient,
   LanguageClientOptions,
   ServerOptions,
+  State,
 } from 'vscode-languageclient/node';
+import { Bundle, findBundle } from './bundled';
 import { resolveServerCommand } from './serverCommand';
+import { ServerStatus } from './status';
 import { registerTreeView } from './treeView';
 
 const CLIENT_ID = 'btLsp'; // also the settings section; vscode-languageclient reads `btLsp.trace.server`
@@ -18,6 +21,10 @@ const CLIENT_NAME = 'bt-lsp';
 
 let log: vscode.LogOutputChannel;
 let client: LanguageClient | undefined;
+let status: ServerStatus;
+let bundle: Bundle | undefined;
+/** The settings that decide which server runs: a change restarts it. */
+const SERVER_CHOICE = ['btLsp.server.command', 'btLsp.importStrategy', 'btLsp.interpreter'];
 // Start, stop and restart run one after another, in the order they were asked for.
 let queue: Promise<void> = Promise.resolve();
 
@@ -60,13 +67,17 @@ function enqueue(work: () => Promise<void>): Promise<void> {
 
 export function activate(context: vscode.ExtensionContext): Promise<void> {
   log = vscode.window.createOutputChannel(CLIENT_NAME, { log: true });
+  bundle = findBundle(context);
+  status = new ServerStatus();
   context.subscriptions.push(
     log,
+    status,
     vscode.commands.registerCommand('btLsp.restartServer', () => restart()),
     vscode.commands.registerCommand('btLsp.showOutput', () => log.show()),
     vscode.workspace.onDidChangeConfiguration((event) => {
-      if (event.affectsConfiguration('btLsp.server.command')) {
-        log.info('btLsp.server.command changed: restarting the server');
+      const changed = SERVER_CHOICE.find((key) => event.affectsConfiguration(key));
+      if (changed) {
+        log.info(`${changed} changed: restarting the server`);
         void restart();
       }
     }),
@@ -113,10 +124,20 @@ async function startClient(): Promise<void> {
   const active = vscode.window.activeTextEditor?.document.uri;
   const resource =
     active && (active.scheme === 'file' || active.scheme === 'untitled') ? active : vscode.workspace.workspaceFolders?.[0]?.uri;
-  const { server, tried } = await resolveServerCommand(resource, log);
+  status.starting();
+  const { server, tried } = await resolveServerCommand(resource, log, bundle);
   tried.forEach((line) => log.info(line));
   if (!server) {
-    showInstallHelp('the bt-lsp language server was not found', tried);
+    const prefix = 'bundled server with ';
+    const attempts = tried.filter((line) => line.startsWith(prefix)).map((line) => line.slice(prefix.length));
+    showInstallHelp(
+      !bundle
+        ? 'the bt-lsp language server was not found'
+        : attempts.length > 0
+          ? `no Python could run the bundled bt-lsp language server (${attempts.join('; ')})`
+          : `no Python ${bundle.pythons.join(', ')} was found to run the bundled bt-lsp language server`,
+      tried,
+    );
     return;
   }
 
@@ -162,6 +183,14 @@ async function startClient(): Promise<void> {
     candidate.starting = false;
     client = candidate;
     log.info('The server is running.');
+    status.running(server.origin);
+    const running = candidate;
+    running.onDidChangeState((event) => {
+      // Stopped for good (it crashed too often), not stopped to restart.
+      if (event.newState === State.Stopped && client === running) {
+        status.notRunning('the bt-lsp server stopped', 'Run "bt-lsp: Restart server"; its messages are in the bt-lsp output.');
+      }
+    });
   } catch (error) {
     log.error(`The server did not start: ${errorText(error)}`);
     try {
@@ -205,17 +234,22 @@ function errorText(error: unknown): string {
  * goes in the remote machine's settings, where the server runs; elsewhere in the user settings. */
 function openServerCommandSetting(): Thenable<unknown> {
   const command = vscode.env.remoteName ? 'workbench.action.openRemoteSettings' : 'workbench.action.openGlobalSettings';
-  return vscode.commands.executeCommand(command, { query: 'btLsp.server.command' });
+  return vscode.commands.executeCommand(command, { query: bundle ? 'btLsp.interpreter' : 'btLsp.server.command' });
 }
 
 /** Logs why the server is not running and shows a notification saying how to install it. */
 function showInstallHelp(reason: string, tried: string[]): void {
-  const help =
-    'Install the server with `pip install bt-lsp` (or from a checkout of its repository: ' +
-    '`pip install /path/to/bt-lsp`) into a Python whose scripts folder is on PATH or that is ' +
-    'selected in the Python extension, or set `btLsp.server.command` to the command that starts it, ' +
-    'e.g. ["/path/to/python", "-m", "bt_lsp", "serve"]. Then run "bt-lsp: Restart server".';
+  const help = bundle
+    ? `The extension brings bt-lsp but needs Python ${bundle.pythons.join(', ')} to run it: install one ` +
+      'so that `python3` is on PATH (`py` on Windows), select it in the Python extension, or set ' +
+      '`btLsp.interpreter`, e.g. ["/usr/bin/python3.12"]. Or set `btLsp.server.command` to the command ' +
+      'that starts your own bt-lsp. Then run "bt-lsp: Restart server".'
+    : 'Install the server with `pip install bt-lsp` (or from a checkout of its repository: ' +
+      '`pip install /path/to/bt-lsp`) into a Python whose scripts folder is on PATH or that is ' +
+      'selected in the Python extension, or set `btLsp.server.command` to the command that starts it, ' +
+      'e.g. ["/path/to/python", "-m", "bt_lsp", "serve"]. Then run "bt-lsp: Restart server".';
   log.error(`${reason}. ${help}`);
+  status.notRunning(reason, help);
   if (tried.length > 0) {
     log.error(`Tried:\n  ${tried.join('\n  ')}`);
   }

@@ -1,12 +1,16 @@
 // Finding the command line that starts the bt-lsp language server.
 //
-// Order: the `btLsp.server.command` setting, then `bt-lsp` on PATH, then the interpreter
-// selected in the Python extension (`<python> -m bt_lsp serve`) if bt_lsp imports there.
+// The `btLsp.server.command` setting always wins. Otherwise `btLsp.importStrategy` orders two
+// ways: "bundled" (the default) runs the server this package brings (see bundled.ts) and
+// falls back to the environment; "fromEnvironment" looks for `bt-lsp` on PATH, then for the
+// bt_lsp module in the Python extension's selected interpreter, and falls back to the bundled
+// server. A package without a bundled server (the one built without a target) only has the
+// environment.
 
 import { spawnSync } from 'node:child_process';
-import * as fs from 'node:fs';
-import * as path from 'node:path';
 import * as vscode from 'vscode';
+import { Bundle, bundledServer } from './bundled';
+import { PYTHON_EXTENSION_ID, findOnPath, pythonExtensionInterpreter } from './pythonInterpreter';
 
 export interface ServerCommand {
   command: string;
@@ -21,11 +25,17 @@ export interface Resolution {
   tried: string[];
 }
 
-export const PYTHON_EXTENSION_ID = 'ms-python.python';
+export type ImportStrategy = 'bundled' | 'fromEnvironment';
+
+export function importStrategy(resource: vscode.Uri | undefined): ImportStrategy {
+  const value = vscode.workspace.getConfiguration('btLsp', resource).get<string>('importStrategy');
+  return value === 'fromEnvironment' ? 'fromEnvironment' : 'bundled';
+}
 
 export async function resolveServerCommand(
   resource: vscode.Uri | undefined,
   log: vscode.LogOutputChannel,
+  bundle: Bundle | undefined,
 ): Promise<Resolution> {
   const tried: string[] = [];
   const config = vscode.workspace.getConfiguration('btLsp', resource);
@@ -41,9 +51,31 @@ export async function resolveServerCommand(
   }
   tried.push('setting btLsp.server.command: not set');
 
+  const fromBundle = async (): Promise<ServerCommand | undefined> =>
+    bundle ? bundledServer(bundle, resource, log, tried) : undefined;
+  const fromEnv = (): Promise<ServerCommand | undefined> => environmentServer(resource, log, tried);
+  const order = importStrategy(resource) === 'fromEnvironment' ? [fromEnv, fromBundle] : [fromBundle, fromEnv];
+  if (!bundle) {
+    tried.push('bundled server: not in this package (it is in the platform-specific packages)');
+  }
+  for (const find of order) {
+    const server = await find();
+    if (server) {
+      return { server, tried };
+    }
+  }
+  return { tried };
+}
+
+/** `bt-lsp` on PATH, else `<python> -m bt_lsp serve` with the Python extension's interpreter. */
+async function environmentServer(
+  resource: vscode.Uri | undefined,
+  log: vscode.LogOutputChannel,
+  tried: string[],
+): Promise<ServerCommand | undefined> {
   const onPath = findOnPath('bt-lsp');
   if (onPath) {
-    return { server: { command: onPath, args: ['serve'], origin: 'bt-lsp on PATH' }, tried };
+    return { command: onPath, args: ['serve'], origin: 'bt-lsp on PATH' };
   }
   tried.push('bt-lsp on PATH: not found');
 
@@ -55,33 +87,10 @@ export async function resolveServerCommand(
   } else {
     const [command, ...args] = python;
     return {
-      server: {
-        command,
-        args: [...args, '-m', 'bt_lsp', 'serve'],
-        origin: `Python extension interpreter ${python.join(' ')}`,
-      },
-      tried,
+      command,
+      args: [...args, '-m', 'bt_lsp', 'serve'],
+      origin: `Python extension interpreter ${python.join(' ')}`,
     };
-  }
-  return { tried };
-}
-
-/** The full path of an executable named `name` on PATH, or undefined. */
-export function findOnPath(name: string, env: NodeJS.ProcessEnv = process.env): string | undefined {
-  const dirs = (env.PATH ?? env.Path ?? '').split(path.delimiter).filter((d) => d !== '');
-  const exts = process.platform === 'win32' ? (env.PATHEXT ?? '.EXE;.CMD;.BAT').split(';') : [''];
-  for (const dir of dirs) {
-    for (const ext of exts) {
-      const candidate = path.join(dir, name + ext);
-      try {
-        fs.accessSync(candidate, fs.constants.X_OK);
-        if (fs.statSync(candidate).isFile()) {
-          return candidate;
-        }
-      } catch {
-        // not here
-      }
-    }
   }
   return undefined;
 }
@@ -90,44 +99,4 @@ function canImportBtLsp(python: string[]): boolean {
   const [command, ...args] = python;
   const result = spawnSync(command, [...args, '-c', 'import bt_lsp'], { timeout: 15000, stdio: 'ignore' });
   return result.status === 0;
-}
-
-// The parts of the Python extension's API that are used here.
-interface PythonExtensionApi {
-  environments?: {
-    getActiveEnvironmentPath(resource?: vscode.Uri): { id: string; path: string };
-    resolveEnvironment(
-      env: { id: string; path: string } | string,
-    ): Promise<{ executable: { uri?: vscode.Uri } } | undefined>;
-  };
-  settings?: {
-    getExecutionDetails?(resource?: vscode.Uri): { execCommand: string[] | undefined };
-  };
-}
-
-/** The argv that runs the Python extension's selected interpreter, or undefined. */
-async function pythonExtensionInterpreter(
-  resource: vscode.Uri | undefined,
-  log: vscode.LogOutputChannel,
-): Promise<string[] | undefined> {
-  const extension = vscode.extensions.getExtension<PythonExtensionApi>(PYTHON_EXTENSION_ID);
-  if (!extension) {
-    return undefined;
-  }
-  try {
-    const api = extension.isActive ? extension.exports : await extension.activate();
-    if (api.environments) {
-      const env = await api.environments.resolveEnvironment(api.environments.getActiveEnvironmentPath(resource));
-      const executable = env?.executable.uri?.fsPath;
-      if (executable) {
-        return [executable];
-      }
-    }
-    // Older API; its argv may be a wrapper such as `conda run -n env python`.
-    const execCommand = api.settings?.getExecutionDetails?.(resource).execCommand;
-    return execCommand && execCommand.length > 0 ? execCommand : undefined;
-  } catch (error) {
-    log.warn(`Could not ask the Python extension for its interpreter: ${String(error)}`);
-    return undefined;
-  }
 }
