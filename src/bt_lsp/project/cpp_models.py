@@ -126,6 +126,9 @@ class CppModels:
             tuple[Path, tuple[str, ...], tuple[str, ...]], tuple[int, tuple[Path, ...]]
         ] = {}
         self._known: set[Path] = set()
+        # Per package: the C++ of the workspace packages it does not see (see
+        # other_packages_files), found again when a C++ file or a manifest appears or goes.
+        self._other_files: dict[tuple[Path, tuple[str, ...]], tuple[int, tuple[Path, ...]]] = {}
         # The folders searched for C++ files, with their modification times when searched:
         # without watched files, one that changed (a file created or deleted in it) means
         # the file lists are found again (see :meth:`revalidate`).
@@ -399,7 +402,12 @@ class CppModels:
         own = self._catalogs_with_cpp(ctx, files)
         merged = dict(ctx.models)
         _demote_own_catalogs(merged, own, cat)
-        if not cat.nodes and not known.complete:
+        others: list[ModelDecl] = []
+        if not known.complete:
+            # A node of another workspace package may be loaded by name at run time (Nav2's
+            # plugin libraries): known, but advisory.
+            others = self._other_packages_decls(path, settings, ctx.btcpp_version)
+        if not cat.nodes and not known.complete and not others:
             # No C++ nodes: the messages need not say what was not read.
             if not own:
                 return ctx
@@ -419,6 +427,8 @@ class CppModels:
                 # which one the program that loads this tree registers is not known, so
                 # no port list of the ID is: a catalog says what one program registered.
                 merged[id_] = d
+        for d in others:
+            merged.setdefault(d.id, d)
         registered: frozenset[str] | None = None
         if known.complete:
             # The C++ nodes (those of unknown kind too) and what catalogs say is registered
@@ -431,8 +441,52 @@ class CppModels:
             models=MappingProxyType(merged),
             registered=registered,
             incomplete=known.why,
-            sources=(*ctx.sources, ("cpp", id(decls), known)),
+            sources=(*ctx.sources, ("cpp", id(decls), known, tuple(others))),
         )
+
+    def other_packages_files(self, path: Path, settings: Settings) -> tuple[Path, ...]:
+        """The C++ files of the workspace packages that the package of ``path`` neither is
+        nor depends on (none outside a package, or with ``sources``: then every file read
+        is already seen)."""
+        pkgs = self.visible_packages(path)
+        if pkgs is None or settings.sources:
+            return ()
+        key = (pkgs[0].folder, tuple(settings.exclude))
+        with self._lock:
+            hit = self._other_files.get(key)
+            if hit is not None and hit[0] == self.tree_generation:
+                return hit[1]
+            generation = self.tree_generation
+        mine = {m.folder for m in pkgs}
+        others = [m for m in self.workspace_packages().values() if m.folder not in mine]
+        files: list[Path] = []
+        for m in sorted(others, key=lambda m: str(m.folder)):
+            files.extend(cpp_sources(m.folder, path))
+        if settings.exclude:
+            files = [f for f in files if not any(f.match(g) for g in settings.exclude)]
+        found = tuple(sorted(dict.fromkeys(files))[:MAX_CPP_FILES])
+        with self._lock:
+            if generation == self.tree_generation:
+                self._other_files[key] = (generation, found)
+                self._known.update(found)
+        return found
+
+    def _other_packages_decls(
+        self, path: Path, settings: Settings, version: str | None
+    ) -> list[ModelDecl]:
+        """The nodes of :meth:`other_packages_files` as advisory models."""
+        key = self.other_packages_files(path, settings)
+        if not key:
+            return []
+        if self.mode == "sync":
+            cat: Catalog | None = self.catalog(key)
+        else:  # read by the server in the background, with the file's own scope
+            cat, fresh = self._latest(key)
+            if not fresh and self.on_missing is not None:
+                self.on_missing(path)
+        if cat is None:
+            return []
+        return [d._replace(source="cpp-other-package") for d in self.decls(cat, version).values()]
 
     def _catalogs_with_cpp(self, ctx: Context, files: tuple[Path, ...]) -> frozenset[str]:
         """The shipped ROS catalogs among ``ctx``'s models whose package's C++ is among

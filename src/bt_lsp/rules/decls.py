@@ -26,7 +26,15 @@ from bt_lsp.syntax.sections import Section
 #: and ``ros-workspace`` (the shipped model of a workspace package whose C++ is read but
 #: does not register this node where it was read).
 ModelSource = Literal[
-    "tree", "palette", "generated", "catalog", "ros", "ros-workspace", "cpp", "cpp-partial"
+    "tree",
+    "palette",
+    "generated",
+    "catalog",
+    "ros",
+    "ros-workspace",
+    "cpp",
+    "cpp-partial",
+    "cpp-other-package",
 ]
 AUTHORITATIVE: Final[frozenset[str]] = frozenset({"generated", "catalog", "ros", "cpp"})
 #: Ends the ``where`` of a model learned from a C++ file that the build does not compile.
@@ -44,6 +52,9 @@ _SOURCE_LABELS: Final[Mapping[str, str]] = MappingProxyType(
         "cpp": "the project's C++ registration (authoritative)",
         "cpp-partial": "the project's C++ registration (advisory: a static reading could not "
         "know all of it)",
+        "cpp-other-package": "the C++ of another workspace package, which this file's package "
+        "does not depend on (advisory: BehaviorTree.CPP registers it only if the application "
+        "loads that package's nodes, as Nav2 loads its plugin libraries by name)",
     }
 )
 

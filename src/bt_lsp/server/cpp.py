@@ -118,6 +118,9 @@ class CppService:
                 for p in paths:
                     s = self.ls.project.settings_for(p)
                     scopes.setdefault(models.files_for(p, s.sources, s.exclude), p)
+                    other = models.other_packages_files(p, s)
+                    if other:
+                        scopes.setdefault(other, p)
                 for files in scopes:
                     report = self._reporter(loop, token)
                     before = models.latest(files)
