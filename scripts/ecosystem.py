@@ -461,6 +461,7 @@ def readme_table(
     for f in findings:
         if f.severity in ("error", "warning"):
             by_project.setdefault(f.project, Counter())[f.code] += 1
+    sources = _bt_files_of_sources()
     lines = [
         "| project | BT files | errors | warnings | hints | errors and warnings by code |",
         "|---|---|---|---|---|---|",
@@ -468,7 +469,7 @@ def readme_table(
     for project, c in sorted(report.counts_by_project.items()):
         counts = by_project.get(project, Counter())
         top = ", ".join(f"`{code}` {n}" for code, n in counts.most_common(4))
-        files = bt_files.get(project)
+        files = bt_files.get(project) or sources.get(project)
         lines.append(
             f"| {project.replace('__', '/', 1)} | {files if files is not None else '?'} | "
             f"{c['error']} | {c['warning']} | {c['hint']} | {top} |"
@@ -483,6 +484,21 @@ def readme_table(
         "warnings are false alarms of bt-lsp.",
     ]
     return "\n".join(lines) + "\n"
+
+
+def _bt_files_of_sources() -> dict[str, int]:
+    """The ``bt_xml_files`` column of the projects' ``SOURCES.tsv`` (XML files holding a
+    ``<BehaviorTree``), by project folder."""
+    path = DEFAULT_PROJECTS / "SOURCES.tsv"
+    out: dict[str, int] = {}
+    try:
+        with path.open(encoding="utf-8", newline="") as f:
+            for row in csv.DictReader(f, delimiter="\t"):
+                if row.get("bt_xml_files", "").isdigit():
+                    out[row["folder"]] = int(row["bt_xml_files"])
+    except OSError:
+        pass
+    return out
 
 
 def readme_region() -> str | None:
