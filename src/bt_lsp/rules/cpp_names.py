@@ -31,12 +31,41 @@ CPP_MODEL_NAME: Final = define(
     Severity.WARNING,
     "a node ID registered in C++ breaks the model name rules (usable only as `<Action ID=…>`)",
     NAMES,
+    doc="""
+        Reported on the project's C++ (`registerNodeType<T>("Dock Robot")` and the like), not
+        on a tree. BehaviorTree.CPP registers any ID without a check, but an ID that breaks the
+        model name rules (a space, a period, `Root`) cannot be written as an element name: XML
+        does not allow it, or BehaviorTree.CPP rejects it when it loads the tree. A tree can
+        use it only in explicit form, `<Action ID="Dock Robot"/>`. The message names the rule
+        broken. No example: it needs C++ code.
+        """,
+    why="""
+        Every tree using the node must use the explicit form, which Groot2 and the name rules
+        reject too; rename the ID (`DockRobot`).
+        """,
+    since=(
+        "BehaviorTree.CPP 4.8.4 and later reject such a name in a tree; registration accepts "
+        "it in every version."
+    ),
 )
 CPP_PORT_NAME: Final = define(
     "cpp-port-name",
     Severity.ERROR,
     "a C++ port name BehaviorTree.CPP rejects when the node is registered",
     NAMES,
+    doc="""
+        Reported on the project's C++: a port name in `InputPort`, `OutputPort` or
+        `BidirectionalPort` that BehaviorTree.CPP's `IsAllowedPortName` rejects (empty, not
+        starting with an ASCII letter, a forbidden character such as the period of
+        `goal.pose`, or a reserved attribute such as `name` or `ID`). `CreatePort` throws when
+        `providedPorts()` runs, which `registerNodeType` does: `The name of a port must not be
+        `name` or `ID` and must start with an alphabetic character. Underscore is reserved.`
+        No example: it needs C++ code.
+        """,
+    why="""
+        The program stops when it registers the node, before any tree is loaded.
+        """,
+    since="BehaviorTree.CPP 4 (the message quoted is that of 4.10).",
 )
 
 _CREATE_PORT_ERROR = (

@@ -56,6 +56,38 @@ XML_EXTRA_ROOT: Final = define(
     Severity.WARNING,
     "an element after the root element (tinyxml2 accepts it; BehaviorTree.CPP ignores it)",
     XML,
+    doc="""
+        tinyxml2, BehaviorTree.CPP's XML parser, accepts elements after the root element
+        (and stops quietly at a stray end tag), and BehaviorTree.CPP reads only the first
+        element, `<root>`: everything after it is ignored. bt-lsp reads it as written and warns:
+        `Extra top-level element '<BehaviorTree>' after the root: tinyxml2 accepts it, and
+        BehaviorTree.CPP reads the first element only, so this one is ignored`.
+        """,
+    why="""
+        The trees after the root are never loaded, though the author believes they are; often
+        a `</root>` too early or a comment broken by a nested `<!--`.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        <BehaviorTree ID="Other">
+          <AlwaysFailure/>
+        </BehaviorTree>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+          <BehaviorTree ID="Other">
+            <AlwaysFailure/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 XML_LENIENT: Final = define(
     "xml-lenient",
@@ -63,6 +95,20 @@ XML_LENIENT: Final = define(
     "not well-formed XML that tinyxml2, BehaviorTree.CPP's parser, accepts (text outside "
     "the root, attributes without white space between them)",
     XML,
+    doc="""
+        Not well-formed XML that tinyxml2, BehaviorTree.CPP's parser, reads anyway: text before
+        or after the root element (`Text outside the root element (tinyxml2 skips it; other XML
+        tools reject the file)`), or an attribute written right after the previous value with
+        no white space (`Missing whitespace before attribute 'name'`). BehaviorTree.CPP loads
+        the file, so it is a warning, not an error.
+        """,
+    why="""
+        Groot2, editors and every other XML tool reject the file; stray text is often a
+        leftover of an edit.
+        """,
+    bad='<Sleep msec="500"name="wait"/>',
+    good='<Sleep msec="500" name="wait"/>',
+    since="Every version.",
 )
 XML_UNESCAPED_CHAR: Final = define(
     "xml-unescaped-char",
@@ -71,30 +117,105 @@ XML_UNESCAPED_CHAR: Final = define(
     XML,
     # tinyxml2 reads the escaped character as it read the raw one: the value is the same.
     fixes={"escape": safe("Escape '{char}' as '{escaped}'")},
+    doc="""
+        XML requires `&lt;` and `&amp;` for `<` and `&` in an attribute value. tinyxml2,
+        BehaviorTree.CPP's parser, accepts them raw and reads the same value, so BehaviorTree.CPP
+        loads the file: `Raw '<' in an attribute value; XML requires '&lt;'`. The fix escapes
+        the character, which changes nothing for BehaviorTree.CPP. Most often in scripts and
+        conditions (`count < 3`, `a && b`).
+        """,
+    why="""
+        Groot2 and other XML tools reject the file.
+        """,
+    bad='<ScriptCondition code="count < 3"/>',
+    good='<ScriptCondition code="count &lt; 3"/>',
+    since="Every version.",
 )
 XML_DOCTYPE: Final = define(
     "xml-doctype",
     Severity.WARNING,
     "a DOCTYPE; its entities and external DTDs are never expanded or fetched",
     XML,
+    doc="""
+        A `<!DOCTYPE …>` declaration. tinyxml2, BehaviorTree.CPP's parser, skips it and
+        never expands the entities it defines nor fetches an external DTD, so an `&entity;`
+        it defines stays undefined. bt-lsp does the same, never fetching anything (no XML
+        external entity attack), and warns: `DOCTYPE ignored: its entities and external DTDs are
+        never expanded or fetched`.
+        """,
+    why="""
+        Whatever the DOCTYPE was meant to provide (entities, defaults) does not reach
+        BehaviorTree.CPP; delete it.
+        """,
+    bad="""
+        <?xml version="1.0"?>
+        <!DOCTYPE root>
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <?xml version="1.0"?>
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 DOCUMENT_TOO_LARGE: Final = define(
     "document-too-large",
     Severity.INFORMATION,
     "analysis limited because the document is larger than the configured maximum",
     XML,
+    doc="""
+        Not about BehaviorTree.CPP: a document larger than the editor setting
+        `btLsp.maxDocumentBytes` (8 MiB by default) gets only the XML and name checks, which
+        stay fast, so the editor stays responsive: `Document is … bytes, above
+        btLsp.maxDocumentBytes (…): only XML and name checks run`. Raise the setting to check
+        such a file fully.
+        """,
+    why="""
+        Unknown nodes, ports and subtrees of the file are not checked while it is reported.
+        """,
+    since="Every version of bt-lsp.",
 )
 TOO_MANY_ATTRIBUTES: Final = define(
     "too-many-attributes",
     Severity.INFORMATION,
     "a tag with more attributes than any node has ports; only the first 1000 are checked",
     XML,
+    doc="""
+        Not about BehaviorTree.CPP: a start tag with more than 1000 attributes (no node has
+        that many ports; a generated or damaged file) has only its first 1000 read: `Tag '<…'
+        has … attributes: only the first 1000 are read, the … from here are not checked`. It
+        bounds the time and memory one tag costs; the example would need 1001 attributes.
+        """,
+    why="""
+        The attributes beyond the first 1000 are not checked at all.
+        """,
+    since="Every version of bt-lsp.",
 )
 TOO_MANY_PROBLEMS: Final = define(
     "too-many-problems",
     Severity.INFORMATION,
     "more problems than a client can usefully show; only the most severe are reported",
     XML,
+    doc="""
+        Not about BehaviorTree.CPP: a document with more than 2000 problems gets the 2000 most
+        severe (errors first, then warnings, information and hints) and this one, at its
+        start: `… more problems are not shown (only 2000 are reported: errors first, then
+        warnings, information and hints)`. No editor shows more usefully, and a hostile
+        document would otherwise cost memory in proportion to its findings.
+        """,
+    why="""
+        Fix the first problems (often one XML error or a wrong catalog causes them all) and
+        the others appear.
+        """,
+    since="Every version of bt-lsp.",
 )
 
 

@@ -16,9 +16,30 @@ INCLUDE_NOT_FOUND: Final = define(
     Severity.ERROR,
     "an included file does not exist or cannot be read",
     BT,
+    doc="""
+        `<include path="…">` names a file BehaviorTree.CPP loads with the including one,
+        `path` relative to the including file's folder (or under the share folder of
+        `ros_pkg`). A file that does not exist or cannot be read makes loading fail: `Error
+        parsing the XML: Error=XML_ERROR_FILE_NOT_FOUND …`. bt-lsp resolves the path the same
+        way and says where it looked. No example: it depends on the files around the
+        document.
+        """,
+    why="The file does not load, and the trees of the missing file are unknown.",
+    since="Every version.",
 )
 INCLUDE_CYCLE: Final = define(
-    "include-cycle", Severity.ERROR, "files include each other in a cycle", BT
+    "include-cycle",
+    Severity.ERROR,
+    "files include each other in a cycle",
+    BT,
+    doc="""
+        Files that include each other in a cycle (`a.xml` → `b.xml` → `a.xml`).
+        BehaviorTree.CPP has no check: a file that includes itself recurses until the process
+        crashes, and a cycle through folders ends in a misleading `XML_ERROR_FILE_NOT_FOUND`
+        whose path keeps growing. No example: it takes several files.
+        """,
+    why="The program crashes or fails with an error that names the wrong cause.",
+    since="Every version.",
 )
 
 

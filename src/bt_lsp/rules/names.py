@@ -246,6 +246,38 @@ PORT_NAME_RESERVED_GROOT2: Final = define(
     "BehaviorTree.CPP does not read)",
     NAMES,
     fixes=NAME_FIX_TITLES,
+    doc="""
+        A `<TreeNodesModel>` port named `__shared_blackboard`, `_description` or after an
+        attribute BehaviorTree.CPP reserves, where BehaviorTree.CPP itself accepts it: it reads
+        only the `<SubTree>` entries of `<TreeNodesModel>` (3.x none), and 4.8.4 and later
+        throw only for `ID`, `name`, `_autoremap` and the pre/post conditions there
+        (`port-name-reserved`). The name rules (Groot2) reject every one of these names, and
+        the message says what BehaviorTree.CPP does with the port: a `<SubTree>` attribute
+        that does not start with a letter is never passed on as a remapping, so the port only
+        takes its default.
+        """,
+    why="""
+        Groot2 refuses the model, and the port can never be set from a `<SubTree>` call.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="_description"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="description"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since=_NAME_RULES_SINCE,
 )
 # Not a name-rule code: the name is right for Groot 1 and BehaviorTree.CPP 3, so no fix
 # renames it (the name fixes and ``check --fix`` act on every code of the NAMES family).
@@ -255,6 +287,38 @@ PORT_NAME_GROOT1: Final = define(
     "`__shared_blackboard` declared as a port of a `<SubTree>` model, Groot 1's way of "
     "writing BehaviorTree.CPP 3's shared blackboard, in a file not checked as version 4",
     BT,
+    doc="""
+        Groot 1 writes BehaviorTree.CPP 3's `__shared_blackboard="true"` attribute of a
+        `<SubTree>` call as a port of its `<SubTree>` model. BehaviorTree.CPP 3 does not read
+        `<TreeNodesModel>`, so in a file not known to be for version 4 (no `BTCPP_format="4"`
+        and no build saying so) this is only a hint: the name is right for Groot 1. In a
+        version 4 file it is `port-name-reserved-groot2`: BehaviorTree.CPP 4 ignores a
+        `__shared_blackboard` attribute and shares the blackboard with `_autoremap="true"`.
+        """,
+    why="""
+        When the project moves to version 4, the subtree silently stops sharing the parent's
+        blackboard.
+        """,
+    bad="""
+        <root>
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="__shared_blackboard"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock" _autoremap="true"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="BehaviorTree.CPP 3 and Groot 1 (version 4 reads `_autoremap` instead).",
 )
 
 #: The name codes that depend on the project's BehaviorTree.CPP version and on the model

@@ -26,6 +26,36 @@ MISSING_ID: Final = define(
     Severity.ERROR,
     "a `<BehaviorTree>`, explicit node, `<SubTree>` or model entry has no `ID`",
     BT,
+    doc="""
+        BehaviorTree.CPP needs an `ID` on a `<SubTree>` call (the tree to call), on a node
+        in explicit form (`<Action ID="Dock"/>`), on a `<TreeNodesModel>` `<SubTree>` entry,
+        and on a `<BehaviorTree>` when `<root>` has more than one child element. It refuses
+        the file when it loads it: `The tag <SubTree> must have the attribute [ID]`,
+        `Missing attribute 'ID' in SubTree element within TreeNodesModel`. (An empty
+        `ID=""` is `model-name-empty`.)
+        """,
+    why="The file does not load.",
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 
 

@@ -86,27 +86,172 @@ MISSING_FORMAT: Final = define(
             'Add BTCPP_format="4" to <root>', "no BehaviorTree.CPP version was detected"
         ),
     },
+    doc="""
+        BehaviorTree.CPP 4 reads a `<root>` without `BTCPP_format` as version 4, and prints
+        `Warnings: The first tag of the XML (<root>) should contain the attribute
+        [BTCPP_format="4"]`. A warning when the project builds against version 4; a hint when
+        its version is not detected or unclear (the file may be for 3, which has no such
+        attribute); not reported for a version 3 project nor for a file that is only a
+        `<TreeNodesModel>` (a palette).
+        """,
+    why="""
+        Groot2 and bt-lsp read the attribute to know the format; without it a version 3 file
+        and a version 4 file look the same.
+        """,
+    bad="""
+        <root>
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="BehaviorTree.CPP 4.",
 )
 DUPLICATE_MODEL_SECTION: Final = define(
-    "duplicate-model-section", Severity.ERROR, "a second `<TreeNodesModel>` section", BT
+    "duplicate-model-section",
+    Severity.ERROR,
+    "a second `<TreeNodesModel>` section",
+    BT,
+    doc="""
+        A document may have one `<TreeNodesModel>` only: BehaviorTree.CPP 4 checks it when it
+        loads the XML and throws (`Only a single node <TreeNodesModel> is supported`). Every
+        section after the first is reported.
+        """,
+    why="The file does not load; merge the sections into one.",
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <Action ID="Dock"/>
+          </TreeNodesModel>
+          <TreeNodesModel>
+            <Action ID="Undock"/>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <Action ID="Dock"/>
+            <Action ID="Undock"/>
+          </TreeNodesModel>
+        </root>
+        """,
+    since="BehaviorTree.CPP 4 (3.x does not read `<TreeNodesModel>`).",
 )
 INCLUDE_MISSING_PATH: Final = define(
-    "include-missing-path", Severity.ERROR, "an `<include>` without `path`", BT
+    "include-missing-path",
+    Severity.ERROR,
+    "an `<include>` without `path`",
+    BT,
+    doc="""
+        An `<include>` names the file it loads in `path` (relative to the including file, or
+        under the ROS package of `ros_pkg`). BehaviorTree.CPP throws when it loads a document
+        with an `<include>` that has none: `Invalid <include> tag: missing 'path'
+        attribute`.
+        """,
+    why="The file does not load.",
+    bad="""
+        <root BTCPP_format="4">
+          <include ros_pkg="dock_bt"/>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <include path="dock.xml"/>
+        </root>
+        """,
+    since="Every version.",
 )
 INCLUDE_ROS_PKG: Final = define(
     "include-ros-pkg",
     Severity.WARNING,
     "an `<include ros_pkg>` whose package bt-lsp cannot resolve",
     BT,
+    doc="""
+        `<include ros_pkg="dock_bt" path="trees/dock.xml"/>` loads `path` under the package's
+        share folder; BehaviorTree.CPP resolves it only when built with ROS support, and
+        otherwise fails: `Using attribute [ros_pkg] in <include>, but this library was
+        compiled without ROS support`. bt-lsp finds the packages of the workspace; for
+        another, map it to its share folder in the `rosPackages` setting (`ros-packages` in
+        `bt-lsp.toml`), or the included trees stay unknown. Not reported for an absolute
+        `path`, where BehaviorTree.CPP ignores `ros_pkg`. The example is reported outside a
+        workspace that holds `dock_bt`.
+        """,
+    why="""
+        The trees of the included file are not known: its SubTree calls cannot be checked.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <include ros_pkg="dock_bt" path="trees/dock.xml"/>
+        </root>
+        """,
+    since="Every version built with ROS support.",
 )
 NO_MAIN_TREE: Final = define(
-    "no-main-tree", Severity.INFORMATION, "several trees and no `main_tree_to_execute`", BT
+    "no-main-tree",
+    Severity.INFORMATION,
+    "several trees and no `main_tree_to_execute`",
+    BT,
+    doc="""
+        A document with several trees and no `main_tree_to_execute` on `<root>`:
+        `createTreeFromFile` and `createTreeFromText` on it throw (`[main_tree_to_execute] was not
+        specified correctly`), but an application that names the tree
+        (`createTree("Main")`) is fine, so it is information only. Not reported for a document
+        another one of the workspace includes.
+        """,
+    why="""
+        Which tree runs is then decided only in the C++; naming it in the file documents it.
+        """,
+    bad="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 NO_TREE: Final = define(
     "no-tree",
     Severity.WARNING,
     "a `<root>` with no tree, no node models and no include: nothing to create",
     BT,
+    doc="""
+        A `<root>` with no `<BehaviorTree>`, no `<TreeNodesModel>` and no `<include>`.
+        BehaviorTree.CPP loads it without complaint and registers nothing; creating a tree
+        from it alone fails (`Can't find a tree`). A warning, not an error: an application may
+        load it beside the files that hold its trees.
+        """,
+    why="Most often an empty or truncated file, or trees written outside `<root>`.",
+    bad='<root BTCPP_format="4"/>',
+    good="""
+        <root BTCPP_format="4">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 NESTING_DEPTH: Final = define(
     "nesting-depth",
@@ -114,6 +259,18 @@ NESTING_DEPTH: Final = define(
     "a tree nested deeper than 256 levels (rejected by BehaviorTree.CPP 4 releases from "
     "February 2026 on)",
     BT,
+    doc="""
+        An element more than 256 levels below its `<BehaviorTree>`. BehaviorTree.CPP releases
+        from February 2026 on (pull request 1091) throw when they load it (`Maximum XML
+        nesting depth exceeded (limit: 256)`); earlier ones, those of ROS 2 Humble and Jazzy
+        among them, recurse without a limit, so it is a warning naming the release. The first
+        such element of each tree is reported. (No example: it takes 257 levels.)
+        """,
+    why="""
+        The file stops loading when the project moves to a newer release; so deep a tree is
+        almost always generated or broken.
+        """,
+    since="BehaviorTree.CPP 4 releases from February 2026 on.",
 )
 
 

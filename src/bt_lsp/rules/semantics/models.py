@@ -36,7 +36,35 @@ from bt_lsp.syntax.model import Model
 
 # The codes of these rules (see bt_lsp.rules.registry).
 MISSING_PORT_NAME: Final = define(
-    "missing-port-name", Severity.ERROR, "a SubTree model port has no `name`", BT
+    "missing-port-name",
+    Severity.ERROR,
+    "a SubTree model port has no `name`",
+    BT,
+    doc="""
+        A port of a `<TreeNodesModel>` `<SubTree>` entry must have a `name`. BehaviorTree.CPP
+        reads these entries when it loads the XML and refuses one without:
+        `Missing attribute [name] in port (SubTree model)`.
+        """,
+    why="The file does not load.",
+    bad="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port type="double"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4">
+          <TreeNodesModel>
+            <SubTree ID="Dock">
+              <input_port name="speed" type="double"/>
+            </SubTree>
+          </TreeNodesModel>
+        </root>
+        """,
+    since="BehaviorTree.CPP 4 (3.x does not read `<TreeNodesModel>`).",
 )
 
 

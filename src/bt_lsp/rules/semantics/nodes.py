@@ -95,6 +95,16 @@ ID_ON_COMPACT_NODE: Final = define(
     BT,
     # The element name is the node type either way: only the refused attribute goes.
     fixes={"remove": safe("Remove ID from <{element}>")},
+    doc="""
+        In compact form the element name is the node type, so an `ID` attribute is refused:
+        BehaviorTree.CPP throws when it creates the tree (`Attribute [ID] is not allowed in
+        <Sleep>`). The fix removes the attribute; write `<Action ID="Sleep"/>` for the
+        explicit form.
+        """,
+    why="The tree is not created.",
+    bad='<Sleep ID="Sleep" msec="500"/>',
+    good='<Sleep msec="500"/>',
+    since="BehaviorTree.CPP 4 (the message quoted); bt-lsp reports it for every version.",
 )
 UNKNOWN_NODE: Final = define(
     "unknown-node",
@@ -182,18 +192,79 @@ REACTIVE_ASYNC_CHILDREN: Final = define(
     Severity.ERROR,
     "a `ReactiveSequence` with more than one `AsyncSequence` child",
     BT,
+    doc="""
+        A `ReactiveSequence` ticks all its children again on every tick, so it allows at most
+        one asynchronous child. BehaviorTree.CPP counts the `AsyncSequence` children when it
+        loads the XML and refuses more than one: `A ReactiveSequence cannot have more than one
+        async child.`
+        """,
+    why="The file does not load.",
+    bad="""
+        <ReactiveSequence>
+          <AsyncSequence><AlwaysSuccess/></AsyncSequence>
+          <AsyncSequence><AlwaysSuccess/></AsyncSequence>
+        </ReactiveSequence>
+        """,
+    good="""
+        <ReactiveSequence>
+          <AsyncSequence><AlwaysSuccess/></AsyncSequence>
+          <Sequence><AlwaysSuccess/></Sequence>
+        </ReactiveSequence>
+        """,
+    since="BehaviorTree.CPP 4 (`AsyncSequence` is a version 4 node).",
 )
 REACTIVE_EXPLICIT_CHILD: Final = define(
     "reactive-explicit-child",
     Severity.ERROR,
     "a `ReactiveSequence` child written in explicit form (`<Action ID=…>`)",
     BT,
+    doc="""
+        When it checks a `ReactiveSequence`'s children, BehaviorTree.CPP looks up each child's
+        element name as a node type, so a child in explicit form fails when the XML is loaded:
+        `Unknown node type: Action`. Write the child in compact form. Not reported for a
+        version 3 project, whose parser does not look the children up.
+        """,
+    why="The file does not load, though the same child is fine under any other node.",
+    bad="""
+        <ReactiveSequence>
+          <Condition ID="AlwaysSuccess"/>
+          <Action ID="AlwaysSuccess"/>
+        </ReactiveSequence>
+        """,
+    good="""
+        <ReactiveSequence>
+          <AlwaysSuccess/>
+          <AlwaysSuccess/>
+        </ReactiveSequence>
+        """,
+    since="BehaviorTree.CPP 4.",
 )
 PARALLEL_THRESHOLD: Final = define(
     "parallel-threshold",
     Severity.ERROR,
     "a `Parallel` threshold larger than its number of children",
     BT,
+    doc="""
+        A `Parallel` succeeds when `success_count` children succeed and fails when
+        `failure_count` fail; a literal count larger than its number of children can never
+        be reached. BehaviorTree.CPP fails when the node is ticked: `Number of children is
+        less than threshold. Can never succeed.` (or `fail`). Negative counts count from the
+        end and are never too large.
+        """,
+    why="The node fails on its first tick, on the robot.",
+    bad="""
+        <Parallel success_count="3" failure_count="1">
+          <AlwaysSuccess/>
+          <AlwaysSuccess/>
+        </Parallel>
+        """,
+    good="""
+        <Parallel success_count="2" failure_count="1">
+          <AlwaysSuccess/>
+          <AlwaysSuccess/>
+        </Parallel>
+        """,
+    since="Every version.",
 )
 
 

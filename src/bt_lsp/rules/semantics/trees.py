@@ -59,6 +59,26 @@ TREE_CHILD_COUNT: Final = define(
     Severity.ERROR,
     "a `<BehaviorTree>` does not have exactly one child element",
     BT,
+    doc="""
+        A `<BehaviorTree>` holds exactly one node, its root. BehaviorTree.CPP checks it when it
+        loads the XML: `The tag <BehaviorTree> with ID 'Main' must have exactly 1 child`.
+        """,
+    why="The file does not load; wrap several nodes in a `<Sequence>` or another control node.",
+    bad="""
+        <BehaviorTree ID="Main">
+          <AlwaysSuccess/>
+          <AlwaysFailure/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="Main">
+          <Sequence>
+            <AlwaysSuccess/>
+            <AlwaysFailure/>
+          </Sequence>
+        </BehaviorTree>
+        """,
+    since="Every version.",
 )
 UNKNOWN_SUBTREE: Final = define(
     "unknown-subtree",
@@ -101,19 +121,123 @@ UNKNOWN_SUBTREE: Final = define(
     since="Every version.",
 )
 UNKNOWN_MAIN_TREE: Final = define(
-    "unknown-main-tree", Severity.ERROR, "`main_tree_to_execute` names no tree", BT
+    "unknown-main-tree",
+    Severity.ERROR,
+    "`main_tree_to_execute` names no tree",
+    BT,
+    doc="""
+        `main_tree_to_execute` on `<root>` names the tree `createTreeFromFile` creates; when no
+        tree has that ID, creating it fails: `Can't find a tree with name: Mian`. bt-lsp looks
+        in the document, the files it includes and the other tree files of the workspace; a
+        tree found only in a file this one does not include makes it a hint (applications
+        often register every file).
+        """,
+    why="The tree is never created; most often a typo or a tree renamed.",
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Mian">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 DUPLICATE_TREE_ID: Final = define(
-    "duplicate-tree-id", Severity.WARNING, "two trees with the same `ID`", BT
+    "duplicate-tree-id",
+    Severity.WARNING,
+    "two trees with the same `ID`",
+    BT,
+    doc="""
+        Two trees with the same `ID`, in one document or across the files it includes.
+        BehaviorTree.CPP reports nothing: all trees share one namespace, and the last
+        definition loaded silently replaces the others.
+        """,
+    why="""
+        A `<SubTree>` call runs a tree other than the one its author was reading.
+        """,
+    bad="""
+        <BehaviorTree ID="Main">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        <BehaviorTree ID="Main">
+          <AlwaysFailure/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="Main">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        <BehaviorTree ID="Fallback">
+          <AlwaysFailure/>
+        </BehaviorTree>
+        """,
+    since="Every version.",
 )
 REGISTERED_NAME_AS_TREE_ID: Final = define(
     "registered-name-as-tree-id",
     Severity.ERROR,
     "a tree ID that is the name of a registered node type",
     BT,
+    doc="""
+        A tree ID must not be the name of a registered node type (a built-in, a node of the
+        catalog or of the C++). BehaviorTree.CPP refuses it when it loads the XML: `The
+        attribute [ID] of tag <BehaviorTree> must not use the name of a registered Node`. A
+        node only a tree file's `<TreeNodesModel>` declares makes it a hint: BehaviorTree.CPP
+        refuses it only if the C++ registers that node.
+        """,
+    why="The file does not load.",
+    bad="""
+        <BehaviorTree ID="Sleep">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    good="""
+        <BehaviorTree ID="Nap">
+          <AlwaysSuccess/>
+        </BehaviorTree>
+        """,
+    since="Every version.",
 )
 SUBTREE_RECURSION: Final = define(
-    "subtree-recursion", Severity.ERROR, "trees that call each other in a cycle", BT
+    "subtree-recursion",
+    Severity.ERROR,
+    "trees that call each other in a cycle",
+    BT,
+    doc="""
+        Trees that call each other through `<SubTree>` in a cycle (`Main → Dock → Main`).
+        BehaviorTree.CPP refuses it when it creates the tree: `Recursive behavior tree cycle
+        detected: tree 'Main' references itself (directly or indirectly)`. The call that
+        closes the cycle is reported.
+        """,
+    why="The tree is never created (it would be infinite).",
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <SubTree ID="Main"/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <SubTree ID="Dock"/>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="Every version.",
 )
 DUPLICATE_SUBTREE_NAME: Final = define(
     "duplicate-subtree-name",
@@ -121,6 +245,45 @@ DUPLICATE_SUBTREE_NAME: Final = define(
     "two `<SubTree>` calls with the same `name` in one tree (rejected by BehaviorTree.CPP "
     "4 releases from January 2026 on)",
     BT,
+    doc="""
+        Two `<SubTree>` calls with the same `name` in one tree give two subtrees the same
+        path. BehaviorTree.CPP 4 releases from January 2026 on (pull request 1053) refuse it
+        when they create the tree: `Duplicate SubTree path detected: '…'. Multiple SubTree
+        nodes with the same 'name' attribute under the same parent are not allowed`. Earlier
+        releases, those of ROS 2 Humble and Jazzy among them, and 3.8 create the tree, so it
+        is a warning naming the release; not reported for a version 3 project.
+        """,
+    why="""
+        The tree stops loading with a newer release, and loggers and Groot2 cannot tell the
+        two subtrees apart. Use unique names, or omit `name`.
+        """,
+    bad="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <Sequence>
+              <SubTree ID="Dock" name="dock"/>
+              <SubTree ID="Dock" name="dock"/>
+            </Sequence>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    good="""
+        <root BTCPP_format="4" main_tree_to_execute="Main">
+          <BehaviorTree ID="Main">
+            <Sequence>
+              <SubTree ID="Dock" name="dock"/>
+              <SubTree ID="Dock" name="dock_again"/>
+            </Sequence>
+          </BehaviorTree>
+          <BehaviorTree ID="Dock">
+            <AlwaysSuccess/>
+          </BehaviorTree>
+        </root>
+        """,
+    since="BehaviorTree.CPP 4 releases from January 2026 on.",
 )
 
 
