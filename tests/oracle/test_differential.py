@@ -25,7 +25,7 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, seed, settings
 
 from tests.oracle.adapter import Oracle, Verdict
-from tests.oracle.btlsp import NAME_CODES, check_files
+from tests.oracle.btlsp import NAME_CODES, Workspace
 from tests.oracle.strategies import Generated, documents
 
 HERE = Path(__file__).parent
@@ -177,7 +177,14 @@ def oracle() -> Iterator[Oracle]:
         yield o
 
 
-def test_bt_lsp_agrees_with_behaviortree_cpp(oracle: Oracle) -> None:
+@pytest.fixture(scope="module")
+def workspace() -> Iterator[Workspace]:
+    # A memory-backed folder where there is one: the cases are written and removed there.
+    with Workspace("/dev/shm" if os.access("/dev/shm", os.W_OK) else None) as ws:
+        yield ws
+
+
+def test_bt_lsp_agrees_with_behaviortree_cpp(oracle: Oracle, workspace: Workspace) -> None:
     @seed(20250704)
     @settings(
         max_examples=EXAMPLES,
@@ -191,7 +198,7 @@ def test_bt_lsp_agrees_with_behaviortree_cpp(oracle: Oracle) -> None:
     @given(documents())
     def agree(g: Generated) -> None:
         oracle.submit(g.case)  # the library works while bt-lsp does
-        diags = check_files(g.case.files, g.case.actions, g.case.conditions)
+        diags = workspace.check(g.case.files, g.case.actions, g.case.conditions)
         verdict = oracle.result()
         why = disagreement(g, verdict, diags)
         if why is None or known_shape(g, verdict, diags) is not None:
