@@ -397,6 +397,21 @@ CASES: list[tuple[str, str, Expected]] = [
         ),
         [],
     ),
+    (
+        "ParallelAll max_failures larger than the child count",
+        # 4.8.2: "Number of children is less than threshold. Can never fail." at tick.
+        T('<ParallelAll max_failures="⟦3⟧"><AlwaysSuccess/><AlwaysSuccess/></ParallelAll>'),
+        [("parallel-threshold", E)],
+    ),
+    (
+        "ParallelAll max_failures up to the child count, from the end or the blackboard",
+        T(
+            '<Sequence><ParallelAll max_failures="2"><AlwaysSuccess/><AlwaysSuccess/>'
+            '</ParallelAll><ParallelAll max_failures="-9"><AlwaysSuccess/></ParallelAll>'
+            '<ParallelAll max_failures="{m}"><AlwaysSuccess/></ParallelAll></Sequence>'
+        ),
+        [],
+    ),
     # --- §f Ports and attributes ------------------------------------------------------------
     (
         "undeclared port of a built-in",
@@ -423,6 +438,54 @@ CASES: list[tuple[str, str, Expected]] = [
     ),
     ("blackboard value never converted", T('<Sleep msec="{delay}"/>'), []),
     (
+        "a key with spaces around the braces is converted as a literal at creation",
+        # 4.8.2: 'The port with name "msec" and value " {delay} " can not be converted';
+        # only exactly {key} (or {=}) is left to the blackboard when the tree is created.
+        T('<Sequence><Sleep msec="⟦ {delay} ⟧"/><Sleep msec="⟦=⟧"/><Sleep msec="{=}"/></Sequence>'),
+        [("invalid-port-value", E), ("invalid-port-value", E)],
+    ),
+    (
+        "a key with spaces around the braces for a port of any text",
+        T(
+            '<Sequence><UnsetBlackboard key=" {k} "/>'
+            '<SetBlackboard value="=" output_key="v"/></Sequence>'
+        ),
+        [],
+    ),
+    ("empty braces are a literal", T('<Sleep msec="⟦{}⟧"/>'), [("invalid-port-value", E)]),
+    (
+        "literal queue of a Loop node, item by item",
+        # 4.8.2: 'value "1;x;3" can not be converted to std::shared_ptr<std::deque<int>>'.
+        T(
+            '<Sequence><LoopInt queue="⟦1;x;3⟧"><AlwaysSuccess/></LoopInt>'
+            '<LoopDouble queue="⟦{}⟧"><AlwaysSuccess/></LoopDouble>'
+            '<LoopBool queue="⟦1;;0⟧"><AlwaysSuccess/></LoopBool></Sequence>'
+        ),
+        [("invalid-port-value", E)] * 3,
+    ),
+    (
+        "literal queues that convert, a queue from the blackboard, any text",
+        T(
+            '<Sequence><LoopInt queue="1;2;3"><AlwaysSuccess/></LoopInt>'
+            '<LoopBool queue="1;0;true;"><AlwaysSuccess/></LoopBool>'
+            '<LoopDouble queue=""><AlwaysSuccess/></LoopDouble>'
+            '<LoopInt queue="{q}"><AlwaysSuccess/></LoopInt>'
+            '<LoopString queue="{};a b"><AlwaysSuccess/></LoopString></Sequence>'
+        ),
+        [],
+    ),
+    (
+        "empty entry of the nodes that watch an entry",
+        # 4.8.2 and 4.10: "Missing port 'entry' in ..." from the node's constructor.
+        T(
+            '<Sequence><WasEntryUpdated entry="⟦⟧"/>'
+            '<SkipUnlessUpdated entry="⟦⟧"><AlwaysSuccess/></SkipUnlessUpdated>'
+            '<WaitValueUpdate entry="⟦⟧"><AlwaysSuccess/></WaitValueUpdate>'
+            '<WaitValueUpdate entry="x"><AlwaysSuccess/></WaitValueUpdate></Sequence>'
+        ),
+        [("invalid-port-value", E)] * 3,
+    ),
+    (
         "bool literal",
         T('<RunOnce then_skip="⟦yes⟧"><AlwaysSuccess/></RunOnce>'),
         [("invalid-port-value", E)],
@@ -440,6 +503,23 @@ CASES: list[tuple[str, str, Expected]] = [
             '<Sequence><Sleep msec="{t}"/><Repeat num_cycles="⟦{t}⟧"><AlwaysSuccess/></Repeat>'
             "</Sequence>"
         ),
+        [("blackboard-type-mismatch", E)],
+    ),
+    (
+        "spaces inside the braces make another key",
+        # { t } is the entry " t " (getRemappedKey trims only outside the braces): 4.8.2
+        # creates this tree.
+        T(
+            '<Sequence><Sleep msec="{t}"/><Repeat num_cycles="{ t }"><AlwaysSuccess/></Repeat>'
+            '<Repeat num_cycles=" {t} "><AlwaysSuccess/></Repeat></Sequence>'
+        ).replace('num_cycles=" {t} "', 'num_cycles="⟦ {t} ⟧"'),
+        [("invalid-port-value", E)],
+    ),
+    (
+        "spaces outside the braces name the same key",
+        # 4.8.2: "the port [t] was initially created with type [unsigned int] and, later
+        # type [std::string] was used somewhere else".
+        T('<Sequence><Sleep msec="{t}"/><UnsetBlackboard key="⟦ {t} ⟧"/></Sequence>'),
         [("blackboard-type-mismatch", E)],
     ),
     (

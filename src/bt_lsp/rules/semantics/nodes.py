@@ -31,8 +31,9 @@
   explicit form: BehaviorTree.CPP looks the child's element name up as a node type and
   fails with "Unknown node type: Action".  Range: the child's element name.
 * ``parallel-threshold`` (error): a literal ``success_count``/``failure_count`` of a
-  ``Parallel`` larger than its number of children (negative values count from the end and
-  never exceed it).  Range: the value.
+  ``Parallel``, or ``max_failures`` of a ``ParallelAll``, larger than its number of
+  children (negative values count from the end and never exceed it): the node throws at
+  its first tick.  Range: the value.
 """
 
 from __future__ import annotations
@@ -109,7 +110,7 @@ REACTIVE_EXPLICIT_CHILD: Final = define(
 PARALLEL_THRESHOLD: Final = define(
     "parallel-threshold",
     Severity.ERROR,
-    "a `Parallel` threshold larger than its number of children",
+    "a `Parallel`/`ParallelAll` threshold larger than its number of children",
     BT,
 )
 
@@ -180,6 +181,8 @@ def check_node(st: State, el: Element) -> Resolved | None:
         _reactive(st, el)
     elif res.id == "Parallel":
         _parallel(st, el)
+    elif res.id == "ParallelAll":
+        _parallel_all(st, el)
     return res
 
 
@@ -421,3 +424,26 @@ def _parallel(st: State, el: Element) -> None:
                 f"{port} is {value} but the Parallel has {_count(n)}, so it can never "
                 f"{outcome} (BehaviorTree.CPP: Number of children is less than threshold)",
             )
+
+
+def _parallel_all(st: State, el: Element) -> None:
+    """ParallelAll checks ``max_failures`` against its children at every tick
+    (``ParallelAllNode::tick``), and throws when it could never fail."""
+    n = len(el.children)
+    a = el.attr("max_failures")
+    if a is None or a.value is None or is_blackboard_reference(a.value):
+        return
+    m = _LEADING_INT.match(a.value)
+    if m is None:
+        return  # invalid-port-value reports it
+    value = int(m.group(0))
+    if value > n:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "parallel-threshold",
+            f"max_failures is {value} but the ParallelAll has {_count(n)}, so it can never "
+            "fail; BehaviorTree.CPP throws at its first tick: Number of children is less "
+            "than threshold. Can never fail.",
+        )

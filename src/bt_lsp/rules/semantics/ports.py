@@ -62,7 +62,13 @@ from typing import Final
 from bt_lsp.rules import port_types
 from bt_lsp.rules.builtins import PortModel
 from bt_lsp.rules.codes import BT, FixData, Severity, define
-from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
+from bt_lsp.rules.conversions import (
+    blackboard_key,
+    convert_literal,
+    convert_queue,
+    is_blackboard_reference,
+    is_converted_as_reference,
+)
 from bt_lsp.rules.names import (
     POSTCONDITIONS,
     PRECONDITIONS,
@@ -296,7 +302,14 @@ def _check_port(
         if not is_blackboard_reference(value):
             scripts.check(st, el, a)
         return
-    if is_blackboard_reference(value):
+    if res.origin == "builtin" and not st.v3 and _check_builtin_value(st, el, a, value, res):
+        return
+    if is_blackboard_reference(value) and (
+        st.v3 or is_converted_as_reference(value) or _convert(value, port.type) is None
+    ):
+        # Version 4 converts a typed port's value at tree creation unless it is exactly
+        # {key}: " {key} " and "=" reach getInput's reference only for a port that takes
+        # any text.
         _blackboard_use(st, el, a, value, port, res, scope)
         return
     if not port.type or (st.v3 and not value):
@@ -319,7 +332,52 @@ def _check_port(
             severity = Severity.WARNING if res.origin == "builtin" else Severity.HINT
         else:
             message += "; BehaviorTree.CPP 4 converts it when it creates the tree"
+            if is_blackboard_reference(value):
+                message += (
+                    ", and only a value that is exactly {key}, without spaces around the "
+                    "braces, is left to the blackboard there"
+                    if value != "="
+                    else ", where only {=} stands for the key named like the port"
+                )
         st.add(s, e, "invalid-port-value", message, severity)
+
+
+# The item type of the literal queue of a Loop node (LoopString takes any text).
+_LOOP_ITEMS: Final = {"LoopInt": "int", "LoopDouble": "double", "LoopBool": "bool"}
+# The built-ins that read port ``entry`` in their constructor.
+_ENTRY_NODES: Final = frozenset({"WaitValueUpdate", "SkipUnlessUpdated", "WasEntryUpdated"})
+
+
+def _check_builtin_value(st: State, el: Element, a: Attr, value: str, res: Resolved) -> bool:
+    """The values of version 4 built-ins that their constructor reads itself (the port's
+    type says nothing of them); whether the value was checked here."""
+    if a.name == "queue" and res.id in _LOOP_ITEMS:
+        if is_blackboard_reference(value):
+            return False
+        problem = convert_queue(value, _LOOP_ITEMS[res.id])
+        if problem is not None:
+            s, e = el.span_of_value(a)
+            st.add(
+                s,
+                e,
+                "invalid-port-value",
+                f"The value of port 'queue' cannot be converted to a queue of "
+                f"{_LOOP_ITEMS[res.id]}: {problem}; BehaviorTree.CPP converts a literal queue "
+                f"('1;2;3') item by item when it creates {quoted(res.id)}",
+            )
+        return True
+    if a.name == "entry" and res.id in _ENTRY_NODES and not value:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "invalid-port-value",
+            f"Port 'entry' of {quoted(res.id)} is empty; BehaviorTree.CPP fails when it "
+            f"creates the node: \"Missing port 'entry'\" (give the blackboard entry to "
+            "watch, as {key} or key)",
+        )
+        return True
+    return False
 
 
 def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
@@ -440,8 +498,9 @@ def _blackboard_use(
     canon = canonical_type(port.type)
     if canon is None:
         return
-    key = value.strip(" ")
-    key = a.name if key in ("=", "{=}") else key[1:-1].strip(" ")
+    key = blackboard_key(a.name, value)
+    if key is None:
+        return
     first = scope.keys.get(key)
     if first is None:
         scope.keys[key] = BlackboardUse(
