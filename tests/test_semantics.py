@@ -547,13 +547,28 @@ CASES: list[tuple[str, str, Expected]] = [
         [("script-syntax", E)],
     ),
     ("Script code syntax", T('<Script code="x := ⟦)⟧"/>'), [("script-syntax", E)]),
+    (
+        "an empty Script does nothing, a blank one does not parse",
+        # 4.8.2: code="" creates and ticks (SUCCESS); code=" " throws "Empty Script".
+        T('<Sequence><Script code=""/><Script code="⟦ ⟧"/></Sequence>'),
+        [("script-syntax", E)],
+    ),
+    (
+        "empty code of ScriptCondition and Precondition",
+        # 4.8.2: created, then bad_function_call at the first tick.
+        T(
+            '<Sequence><ScriptCondition code="⟦⟧"/>'
+            '<Precondition if="⟦⟧" else="FAILURE"><AlwaysSuccess/></Precondition></Sequence>'
+        ),
+        [("script-syntax", E), ("script-syntax", E)],
+    ),
     ("ScriptCondition code syntax", T('<ScriptCondition code="⟦;⟧a"/>'), [("script-syntax", E)]),
     (
         "Precondition if syntax",
         T('<Precondition if="a &amp;&amp; ⟦%⟧"><AlwaysSuccess/></Precondition>'),
         [("script-syntax", E)],
     ),
-    ("empty script", T('<Script code="⟦⟧"/>'), [("script-syntax", E)]),
+    ("empty script", T('<AlwaysSuccess _post="⟦⟧"/>'), [("script-syntax", E)]),
     ("script ending too early", T('<AlwaysSuccess _post="x :⟦=⟧  "/>'), [("script-syntax", E)]),
     (
         "script in 4.0-4.9 syntax",

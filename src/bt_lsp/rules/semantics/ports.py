@@ -299,7 +299,9 @@ def _check_port(
     if res.origin == "subtree":
         return  # a literal remapping of a subtree port is stored as text, never converted
     if (res.id, a.name) in SCRIPT_PORTS and res.origin == "builtin":
-        if not is_blackboard_reference(value):
+        # An empty Script is no script: its constructor parses the code only when it
+        # differs from the last one parsed, which starts empty (script_node.h).
+        if not is_blackboard_reference(value) and (value or res.id != "Script"):
             scripts.check(st, el, a)
         return
     if res.origin == "builtin" and not st.v3 and _check_builtin_value(st, el, a, value, res):

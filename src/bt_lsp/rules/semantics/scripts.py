@@ -8,7 +8,9 @@ post-condition attributes (``_skipIf`` … ``_post``) on any node.
   value back through entity references (``&amp;&amp;`` is one ``&&`` operator of the
   script but 10 characters of the file); an error at the end of the script covers its
   last character, an empty script the (empty) value.  A ``code``/``if`` port given as a
-  blackboard reference (``{key}``) is not a script here and is not checked.
+  blackboard reference (``{key}``) is not a script here and is not checked, nor is an
+  empty ``code`` of ``Script`` (its constructor parses the code only when it differs from
+  the last code parsed, which starts empty: the node does nothing).
 """
 
 from __future__ import annotations
