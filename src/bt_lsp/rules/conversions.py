@@ -134,6 +134,15 @@ def is_converted_as_reference(value: str) -> bool:
     return len(value) >= 3 and value[0] == "{" and value[-1] == "}"
 
 
+def converted_at_creation(type_: str) -> bool:
+    """Whether BehaviorTree.CPP 4 converts a literal of a port of ``type_`` when it
+    creates the tree.  An enum port (``NodeStatus``) has no string converter in its
+    ``PortInfo``: its literal is converted (through the registered enums) only when the
+    node reads the port, where a bad one fails the node (4.8.2: ``else="xyz"`` of
+    ``Precondition`` is "Missing parameter [else]" at tick)."""
+    return _normalize_type(type_) != "NodeStatus"
+
+
 def blackboard_key(port: str, value: str) -> str | None:
     """The blackboard key a port given ``value`` uses (``TreeNode::getRemappedKey``), or
     ``None`` for a literal: the port's own name for ``=`` and ``{=}``, else the text

@@ -66,6 +66,7 @@ from bt_lsp.rules.conversions import (
     blackboard_key,
     convert_literal,
     convert_queue,
+    converted_at_creation,
     is_blackboard_reference,
     is_converted_as_reference,
 )
@@ -306,14 +307,18 @@ def _check_port(
         return
     if res.origin == "builtin" and not st.v3 and _check_builtin_value(st, el, a, value, res):
         return
-    if is_blackboard_reference(value) and (
-        st.v3 or is_converted_as_reference(value) or _convert(value, port.type) is None
-    ):
-        # Version 4 converts a typed port's value at tree creation unless it is exactly
-        # {key}: " {key} " and "=" reach getInput's reference only for a port that takes
-        # any text.
+    if is_blackboard_reference(value):
+        # The tree's entry is made with the port's type either way (getRemappedKey); but
+        # version 4 also converts a typed port's value at tree creation unless it is
+        # exactly {key}: " {key} " and "=" are keys only for a port that takes any text.
         _blackboard_use(st, el, a, value, port, res, scope)
-        return
+        if (
+            st.v3
+            or is_converted_as_reference(value)
+            or not converted_at_creation(port.type)
+            or _convert(value, port.type) is None
+        ):
+            return
     if not port.type or (st.v3 and not value):
         # BehaviorTree.CPP 3.8 reads an empty value as not given (the default applies).
         return
@@ -332,6 +337,11 @@ def _check_port(
                 "(the node then fails)" if res.origin == "builtin" else "(getInput fails)"
             )
             severity = Severity.WARNING if res.origin == "builtin" else Severity.HINT
+        elif not converted_at_creation(port.type):
+            message += (
+                "; BehaviorTree.CPP converts an enum port only when the node reads it "
+                "(the node then fails)"
+            )
         else:
             message += "; BehaviorTree.CPP 4 converts it when it creates the tree"
             if is_blackboard_reference(value):
@@ -354,20 +364,27 @@ def _check_builtin_value(st: State, el: Element, a: Attr, value: str, res: Resol
     """The values of version 4 built-ins that their constructor reads itself (the port's
     type says nothing of them); whether the value was checked here."""
     if a.name == "queue" and res.id in _LOOP_ITEMS:
-        if is_blackboard_reference(value):
+        # Before 4.10 the port is typed (SharedQueue<T>): the tree's creation converts
+        # all but an exact {key}.  4.10's port takes anything, and the node's constructor
+        # converts what isBlackboardPointer does not take for a key (" {q} " is one).
+        if is_converted_as_reference(value):
             return False
         problem = convert_queue(value, _LOOP_ITEMS[res.id])
+        reference = is_blackboard_reference(value) and value != "="
         if problem is not None:
             s, e = el.span_of_value(a)
-            st.add(
-                s,
-                e,
-                "invalid-port-value",
+            message = (
                 f"The value of port 'queue' cannot be converted to a queue of "
                 f"{_LOOP_ITEMS[res.id]}: {problem}; BehaviorTree.CPP converts a literal queue "
-                f"('1;2;3') item by item when it creates {quoted(res.id)}",
+                f"('1;2;3') item by item when it creates {quoted(res.id)}"
             )
-        return True
+            if reference:
+                message += (
+                    " (before 4.10, where only an exact {key} is left to the blackboard; "
+                    "4.10 reads a key with spaces around the braces as the key)"
+                )
+            st.add(s, e, "invalid-port-value", message, Severity.WARNING if reference else None)
+        return not reference
     if a.name == "entry" and res.id in _ENTRY_NODES and not value:
         s, e = el.span_of_value(a)
         st.add(

@@ -55,6 +55,12 @@ def check(st: State, el: Element, a: Attr) -> None:
     st.pure = False  # reads the text (two spellings of one value may be one token)
     rs, re_ = raw_span(st.text[vs:ve], start, end)
     message = f"Script error in {a.name}: {err.message}"
+    if not code and a.name in ("code", "if"):
+        # ScriptCondition/Precondition skip parsing a code equal to the last one parsed,
+        # which starts empty: they are created, and call their empty executor.
+        message += (
+            "; BehaviorTree.CPP creates the node, which fails when it ticks (bad_function_call)"
+        )
     if legacy_ok:
         message += " (BehaviorTree.CPP 4.0-4.9 accepted this; 4.10 does not)"
     st.add(vs + rs, vs + re_, "script-syntax", message, Severity.WARNING if legacy_ok else None)
