@@ -933,3 +933,41 @@ def test_v3_document_gets_warnings_not_errors() -> None:
     )
     found = semantic(doc)
     assert found and all(sev != E for _, _, _, sev in found)
+
+
+@pytest.mark.parametrize(
+    ("body", "says"),
+    [
+        # BehaviorTree.CPP 4.8.2's own words, and when it says them.
+        (
+            "<Sleep/>",
+            "creates the tree, and the node throws at its first tick: 'Missing parameter [msec]'",
+        ),
+        ('<Script code=""/><Script/>', "fails when it creates the node: 'Missing port [code]'"),
+        (
+            "<LoopInt><AlwaysSuccess/></LoopInt>",
+            "fails when it creates the node: '[queue] not found'",
+        ),
+    ],
+)
+def test_a_missing_builtin_port_says_when_and_how_the_library_fails(body: str, says: str) -> None:
+    doc = Document(T(f"<Sequence>{body}</Sequence>"))
+    messages = [
+        d.message for d in semantics.check(doc, Context()) if d.code == "missing-required-port"
+    ]
+    assert len(messages) == 1 and messages[0].endswith(says), messages
+
+
+def test_an_enum_literal_is_converted_when_the_node_reads_it() -> None:
+    doc = Document(T('<Precondition if="a" else="xyz"><AlwaysSuccess/></Precondition>'))
+    (d,) = semantics.check(doc, Context())
+    assert d.code == "invalid-port-value" and "only when the node reads it" in d.message
+
+
+def test_controls_that_count_children_at_tick_say_so() -> None:
+    """4.8.2 loads <IfThenElse> with one child and throws at its first tick."""
+    doc = Document(T("<IfThenElse><AlwaysSuccess/></IfThenElse>"))
+    (d,) = semantics.check(doc, Context())
+    assert d.code == "child-count" and d.message.endswith(
+        "throws at its first tick: 'IfThenElseNode must have either 2 or 3 children'"
+    )

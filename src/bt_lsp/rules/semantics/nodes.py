@@ -369,13 +369,29 @@ def _children(st: State, el: Element, res: Resolved) -> None:
             f"must have {lo} or {hi} children" if hi == lo + 1 else f"must have {lo}-{hi} children"
         )
     what = {"custom": f"a {res.category} declared in <TreeNodesModel>"}.get(res.origin, "")
-    st.add(
-        el.name_start,
-        el.name_end,
-        "child-count",
+    message = (
         f"The node {quoted(res.id)}{' (' + what + ')' if what else ''} {need}; it has "
-        f"{_count(n) if n else 'none'}",
+        f"{_count(n) if n else 'none'}"
     )
+    words = _TICK_CHILD_COUNT.get("Switch" if _is_switch(res.id) else res.id)
+    if res.origin == "builtin" and words is not None and n:
+        # Loading checks only that a control node has children; these count them at tick.
+        message += (
+            f"; BehaviorTree.CPP creates the tree, and the node throws at its first tick: '{words}'"
+        )
+    st.add(el.name_start, el.name_end, "child-count", message)
+
+
+# The controls that count their children only when they tick, in BehaviorTree.CPP's words.
+_TICK_CHILD_COUNT: Final = {
+    "IfThenElse": "IfThenElseNode must have either 2 or 3 children",
+    "WhileDoElse": "WhileDoElseNode must have either 2 or 3 children",
+    "Switch": "Wrong number of children in SwitchNode; must be (num_cases + default)",
+}
+
+
+def _is_switch(type_id: str) -> bool:
+    return type_id.startswith("Switch") and type_id[6:].isdigit()
 
 
 def _reactive(st: State, el: Element) -> None:

@@ -472,9 +472,8 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         )
         severity = Severity.WARNING
     elif res.origin == "builtin":
-        message = (
-            f"{quoted(res.id)} needs port{plural} {shown} (no default); the node fails when "
-            "it reads a missing port"
+        message = f"{quoted(res.id)} needs port{plural} {shown} (no default); " + _missing_effect(
+            res.id, missing[0]
         )
         severity = None
     else:
@@ -493,6 +492,36 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         severity,
         MissingPorts(tuple(missing)),
     )
+
+
+# When a built-in reads a port it was not given, and what BehaviorTree.CPP then says
+# (4.8.2 and 4.10): True when it is read as the node is created, else at its first tick.
+_MISSING_WORDS: Final[dict[tuple[str, str], tuple[bool, str]]] = {
+    ("Script", "code"): (True, "Missing port [code]"),
+    ("ScriptCondition", "code"): (True, "Missing port [code]"),
+    ("Precondition", "if"): (True, "Missing parameter [if]"),
+    **{(n, "entry"): (True, "Missing port 'entry'") for n in sorted(_ENTRY_NODES)},
+    **{(f"Loop{t}", "queue"): (True, "[queue] not found") for t in ("Int", "Double", "Bool")},
+    ("LoopString", "queue"): (True, "[queue] not found"),
+    ("Sleep", "msec"): (False, "Missing parameter [msec]"),
+    ("Timeout", "msec"): (False, "Missing parameter [msec]"),
+    ("Delay", "delay_msec"): (False, "Missing parameter [delay_msec]"),
+    ("Repeat", "num_cycles"): (False, "Missing parameter [num_cycles]"),
+    ("RetryUntilSuccessful", "num_attempts"): (False, "Missing parameter [num_attempts]"),
+    ("SetBlackboard", "output_key"): (False, "missing port [output_key]"),
+    ("UnsetBlackboard", "key"): (False, "missing input port [key]"),
+}
+
+
+def _missing_effect(node: str, port: str) -> str:
+    """What BehaviorTree.CPP does with a built-in that misses ``port``, in its words."""
+    known = _MISSING_WORDS.get((node, port))
+    if known is None:
+        return "the node fails when it reads a missing port"
+    at_creation, words = known
+    if at_creation:
+        return f"BehaviorTree.CPP fails when it creates the node: '{words}'"
+    return f"BehaviorTree.CPP creates the tree, and the node throws at its first tick: '{words}'"
 
 
 def _closed(canon: str, res: Resolved) -> bool:
