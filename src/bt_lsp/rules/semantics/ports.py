@@ -19,27 +19,37 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   reported when the model is unknown, or for a ``<SubTree>`` call without a model.
   Range: the attribute name.
 * ``missing-required-port``: a port without a default that is not given.  Built-ins:
-  input and inout ports, an error (the node fails when it reads it).  Custom models: a
+  input and inout ports, an error (the node fails when it reads it; the message says
+  whether that is at creation or at the first tick, in BehaviorTree.CPP's words).  Custom models: a
   hint at most, since BehaviorTree.CPP never checks ports when it loads or creates a tree
   and a node's code often reads a port without a default as optional (``getInput``
   returning an error).  ``<SubTree>`` models: every port whose ``default`` is absent or
   empty, an error unless ``_autoremap`` is true ("is defining a mandatory port … but you
   are not remapping it").  Range: the element name.
-* ``invalid-port-value``: a literal that does not convert to the declared type (values in
-  ``{…}`` are blackboard references and never checked); an error for an exact model
-  (BehaviorTree.CPP converts the literal at tree creation for a strongly typed port with
-  a converter), a warning for an advisory one; ``_autoremap`` on ``<SubTree>`` must be a
-  bool literal.  Range: the value.
-* ``blackboard-type-mismatch``: within one tree, a ``{key}`` used by ports of two
-  different strong types (the first use fixes the entry's type; a ``std::string`` entry
-  accepts anything).  Types are compared as C++ types (:mod:`bt_lsp.rules.port_types`:
-  spellings of one built-in type, ``std::`` forms, top-level ``const`` and references are
-  one), and only when every name in both is known not to be an alias (built-in, standard
-  library, ROS interface types): any other name may be a ``using`` from a header bt-lsp
-  did not read, so it proves nothing.  An error when both models are exact, else a warning.  Shared
-  pointers of two classes read by an input port are a hint: BehaviorTree.CPP accepts the
-  connection when the application registers a polymorphic cast between them (input ports
-  only; an inout or output port must match exactly).  Range: the later value.
+* ``invalid-port-value``: a literal that does not convert to the declared type; an error
+  for an exact model (BehaviorTree.CPP 4 converts the literal at tree creation for a
+  strongly typed port with a converter), a warning for an advisory one.  Only a value
+  that is exactly ``{…}`` (three characters at least) is left to the blackboard there:
+  ``" {a} "`` and ``"="`` are keys to ``getInput`` but literals to that conversion, so
+  they fail for an ``int`` port; ``{}`` is a literal.  An enum port (``NodeStatus``) is
+  converted only when the node reads it (the message says so).  Built-ins whose
+  constructor reads a port itself: the literal ``queue`` of ``LoopInt``/``LoopDouble``/
+  ``LoopBool`` is converted item by item (``" {q} "`` is a warning: a literal before
+  4.10, the key in 4.10), an empty ``entry`` of ``WaitValueUpdate``/
+  ``SkipUnlessUpdated``/``WasEntryUpdated`` fails ("Missing port 'entry'");
+  ``_autoremap`` on ``<SubTree>`` must be a bool literal.  Range: the value.
+* ``blackboard-type-mismatch``: within one tree, a key used by ports of two different
+  strong types (the key as ``getRemappedKey`` reads it: spaces inside the braces belong
+  to it, ``{ a }`` is the entry ``" a "``; the first use fixes the entry's type; a
+  ``std::string`` entry accepts anything). Types are compared as C++ types
+  (:mod:`bt_lsp.rules.port_types`: spellings of one built-in type, ``std::`` forms,
+  top-level ``const`` and references are one), and only when every name in both is known
+  not to be an alias (built-in, standard library, ROS interface types): any other name
+  may be a ``using`` from a header bt-lsp did not read, so it proves nothing. An error
+  when both models are exact, else a warning. Shared pointers of two classes read by an
+  input port are a hint: BehaviorTree.CPP accepts the connection when the application
+  registers a polymorphic cast between them (input ports only; an inout or output port
+  must match exactly). Range: the later value.
 * ``port-name-not-remappable`` (warning): an attribute that passes the name rules but
   not ``is_allowed_port_name`` and does not start with ``_`` (``检查``, ``-x``): never a
   port.  Range: the attribute name.
