@@ -18,7 +18,13 @@ from bt_lsp.rules.builtins import (
     PortModel,
     is_builtin,
 )
-from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
+from bt_lsp.rules.conversions import (
+    blackboard_key,
+    convert_literal,
+    convert_queue,
+    is_blackboard_reference,
+    is_converted_as_reference,
+)
 
 _SPEC = Path(__file__).parent / "data" / "spec" / "bt-xml.md"
 
@@ -345,12 +351,11 @@ _OK: list[tuple[str, str]] = [
     ("0.5;1", "std::vector<double>"),
     ("true;0", "std::vector<bool>"),
     ("a;b", "std::vector<std::string>"),
-    # Not literals at all.
+    # Not converted when version 4 creates the tree: exactly {key}.
     ("{goal}", "unsigned int"),
-    ("  {goal}  ", "int"),
     ("{@root}", "bool"),
     ("{=}", "double"),
-    ("=", "NodeStatus"),
+    ("{ goal }", "int"),
     ('json:{"x": 1}', "int"),
 ]
 
@@ -398,6 +403,15 @@ _BAD: list[tuple[str, str, str]] = [
     ("9" * 5000, "long", f"'{'9' * 5000}' is out of range for a 64-bit integer"),
     ("{}", "int", "'{}' is not an integer"),  # too short to be a blackboard reference
     ("{x", "int", "'{x' is not an integer"),
+    # A reference to getInput, but converted as a literal at tree creation (4.8.2 throws
+    # "can not be converted"): only an exact {key} is skipped there.
+    ("  {goal}  ", "int", "'  {goal}  ' is not an integer"),
+    ("{goal} ", "double", "'{goal} ' is not a number"),
+    (
+        "=",
+        "NodeStatus",
+        "'=' is not a NodeStatus (use one of SUCCESS, FAILURE, RUNNING, IDLE, SKIPPED)",
+    ),
 ]
 
 
@@ -450,6 +464,52 @@ def test_is_blackboard_reference() -> None:
     assert not is_blackboard_reference("{}")
     assert not is_blackboard_reference("a{b}")
     assert not is_blackboard_reference("\t{a}")
+    assert not is_blackboard_reference(" = ")  # getRemappedKey wants exactly "=" or "{=}"
+
+
+def test_blackboard_key_keeps_the_spaces_inside_the_braces() -> None:
+    """BehaviorTree.CPP 4.8.2: output_key=" a " then {a} is 'Missing parameter', while
+    output_key=" a " then { a } reads the entry: the key is what is between the braces."""
+    assert blackboard_key("goal", "{ a }") == " a "
+    assert blackboard_key("goal", "  {a}  ") == "a"
+    assert blackboard_key("goal", "{=}") == "goal"
+    assert blackboard_key("goal", "=") == "goal"
+    assert blackboard_key("goal", " {=} ") == "="
+    assert blackboard_key("goal", "{}") is None
+    assert blackboard_key("goal", "a") is None
+
+
+def test_only_an_exact_key_is_left_out_of_the_conversion_at_creation() -> None:
+    assert is_converted_as_reference("{a}") and is_converted_as_reference("{ a }")
+    assert not is_converted_as_reference(" {a}")
+    assert not is_converted_as_reference("=")
+    assert not is_converted_as_reference("{}")
+
+
+_BOOLS = "(use true/false, True/False, TRUE/FALSE, 1 or 0)"
+
+
+@pytest.mark.parametrize(
+    ("value", "item", "message"),
+    [
+        ("1;2;3", "int", None),
+        ("1;2;", "int", None),  # no item after the last ';'
+        ("", "int", None),  # an empty queue
+        ("1.5;3x", "int", None),  # from_chars reads the leading integer
+        ("1;0;true", "bool", None),
+        (" 2; 3", "double", None),  # strtod skips leading spaces
+        ("1;;2", "int", "item '' is not an integer"),
+        (" 1", "int", "item ' 1' is not an integer"),
+        ("yes", "bool", "item 'yes' is not a bool " + _BOOLS),
+        ("1.5;x", "double", "item 'x' is not a number"),
+        ("{}", "int", "item '{}' is not an integer"),
+        ("json:[1,2]", "int", "item 'json:[1,2]' is not an integer"),
+        ("a;{}", "std::string", None),
+    ],
+)
+def test_convert_queue_converts_each_item(value: str, item: str, message: str | None) -> None:
+    """What BehaviorTree.CPP 4.8.2 does with LoopInt/LoopDouble/LoopBool queue="..."."""
+    assert convert_queue(value, item) == message
 
 
 @given(st.text(), st.sampled_from(sorted({p.type for m in BUILTINS.values() for p in m.ports})))

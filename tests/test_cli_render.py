@@ -178,10 +178,10 @@ ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "docs" / "tree" / "mission.xml"
 
 
-def test_readme_pictures_are_current(capsys: pytest.CaptureFixture[str]) -> None:
-    """The README's Mermaid block is what `render --format mermaid` prints for it, and the
-    SVG it shows has the nodes `render` draws now."""
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+def test_documented_pictures_are_current(capsys: pytest.CaptureFixture[str]) -> None:
+    """The pictures page's Mermaid block is what `render --format mermaid` prints for it, and
+    the SVG it shows has the nodes `render` draws now."""
+    readme = (ROOT / "docs" / "pictures.md").read_text(encoding="utf-8")
     assert main(["render", str(EXAMPLE), "--tree", "Dock", "--format", "mermaid"]) == 0
     mermaid = capsys.readouterr().out
     assert f"```mermaid\n{mermaid}```\n" in readme
@@ -189,4 +189,5 @@ def test_readme_pictures_are_current(capsys: pytest.CaptureFixture[str]) -> None
     now = _nodes(_svg(capsys.readouterr().out))
     shown = _nodes(etree.parse(str(EXAMPLE.with_suffix(".svg"))).getroot())
     assert shown == now and ("subtree", "Dock") in now and ("action", "Align") in now
-    assert "](docs/tree/mission.svg)" in readme and "](editors/vscode/images/tree.png)" in readme
+    assert "](tree/mission.svg)" in readme and "/editors/vscode/images/tree.png)" in readme
+    assert (ROOT / "editors" / "vscode" / "images" / "tree.png").is_file()

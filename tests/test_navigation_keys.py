@@ -15,8 +15,9 @@ from bt_lsp.syntax.edits import apply_edits
 from tests.marks import cursor
 from tests.test_navigation import at
 
-# Tree "Main" uses the key "target" in port values and in every kind of script; tree
-# "Other" uses a key of the same name in its own blackboard.
+# Tree "Main" uses the key "target" in port values and in every kind of script, and the
+# other key " target " ("{ target }": the spaces inside the braces are part of the key);
+# tree "Other" uses a key "target" in its own blackboard.
 KEYS = """\
 <root BTCPP_format="4" main_tree_to_execute="Main">
   <BehaviorTree ID="Main">
@@ -24,7 +25,7 @@ KEYS = """\
       <Script code="⟦target⟧ := 'target: ' .. ⟦target⟧; done := true"/>
       <ScriptCondition code="⟦target⟧ != &quot;target&quot; &amp;&amp; !done"/>
       <Precondition if="⟦target⟧&gt;1" else="FAILURE">
-        <MoveBase goal="{ ⟦target⟧ }" _onSuccess="⟦target⟧ += 1" _post="x:=⟦target⟧"/>
+        <MoveBase goal="{ target }" _onSuccess="⟦target⟧ += 1" _post="x:=⟦target⟧"/>
       </Precondition>
       <MoveBase goal="{⟦target⟧}" speed="1" note="Go to {target}" _while="target_2 || _target"/>
       <Fallback _failureIf="⟦target⟧" _onFailure="⟦target⟧=0" _onHalted="⟦target⟧-=1">
@@ -75,8 +76,9 @@ def test_a_key_is_a_whole_port_value_or_a_script_identifier() -> None:
     assert [(k.start, k.end) for k in uses] == spans
     assert all(text[k.start : k.end] == "target" for k in uses)
     # "Go to {target}" is a literal text, as BehaviorTree.CPP reads it.
-    assert sorted(k.key for k in blackboard_keys(doc, main)) == ["script", "target", "target"]
+    assert sorted(k.key for k in blackboard_keys(doc, main)) == [" target ", "script", "target"]
     assert {k.key for k in key_uses(doc, main)} == {
+        " target ",
         "done",
         "script",
         "target",
@@ -88,7 +90,7 @@ def test_a_key_is_a_whole_port_value_or_a_script_identifier() -> None:
 
 def test_same_key_as_the_port() -> None:
     doc, off, spans = at(
-        '<root><BehaviorTree ID="T"><Nav goal="{⟦‸=⟧}" speed=" ⟦=⟧ "/></BehaviorTree></root>'
+        '<root><BehaviorTree ID="T"><Nav goal="{⟦‸=⟧}" speed="⟦=⟧" to=" = "/></BehaviorTree></root>'
     )
     found = key_at(doc, off)
     assert found is not None and found.key == "goal" and found.form == KeyForm.SAME
@@ -133,9 +135,21 @@ def test_a_key_in_a_script_of_many_statements() -> None:
 # --- prepare ------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    ("needle", "into"), [("{ ⟦target", 4), ('if="⟦target', 10), ("{⟦target⟧}", 8)]
-)
+def test_spaces_inside_the_braces_are_part_of_the_key() -> None:
+    """``{ target }`` is the entry " target " to BehaviorTree.CPP (getRemappedKey trims
+    only the spaces outside the braces): its own key, renamed on its own."""
+    text, off, _ = cursor(marked_at(KEYS, "{ target", 3))
+    doc = Document(text)
+    target = prepare_rename(doc, off)
+    assert target is not None and target.placeholder == " target "
+    start = text.index("{ target }") + 1
+    assert (target.start, target.end) == (start, start + 8)
+    plan = rename(doc, off, "pose")
+    assert plan is not None and [(e.start, e.end) for e in plan.edits] == [(start, start + 8)]
+    assert 'goal="{pose}"' in apply_edits(text, plan.edits)
+
+
+@pytest.mark.parametrize(("needle", "into"), [('if="⟦target', 10), ("{⟦target⟧}", 8)])
 def test_prepare_rename_of_a_key_gives_its_span_and_text(needle: str, into: int) -> None:
     text, off, _ = cursor(marked_at(KEYS, needle, into))
     target = prepare_rename(Document(text), off)
@@ -213,7 +227,7 @@ def test_rename_changes_the_key_in_ports_and_scripts_of_its_tree_only(
     assert "'target: '" in new and "&quot;target&quot;" in new and "== 'target'" in new
     assert 'note="Go to {target}"' in new and "target_2 || _target" in new
     assert '<MoveBase goal="{target}" _skipIf="target == 0"/>' in new
-    assert 'name="target"' in new
+    assert 'name="target"' in new and 'goal="{ target }"' in new
     # The renamed document uses the new key exactly where the old one was.
     renamed = Document(new)
     main = next(i for i, el in enumerate(renamed.model.elements) if el.value("ID") == "Main")
@@ -237,7 +251,7 @@ def test_edits_keep_entity_references_around_the_key() -> None:
     marked = (
         '<root><BehaviorTree ID="T">'
         "<Nav _skipIf=\"&apos;&lt;&amp;&apos; == ⟦k‸ey⟧ &amp;&amp; ⟦key⟧&lt;3\" a='{⟦key⟧}'"
-        ' b="{&#32;⟦key⟧ }" name="&#x1F680;"/>'
+        ' b="{&#32;key }" name="&#x1F680;"/>'
         "</BehaviorTree></root>"
     )
     doc, off, spans = at(marked)
@@ -247,7 +261,7 @@ def test_edits_keep_entity_references_around_the_key() -> None:
     new = apply_edits(doc.text, plan.edits)
     el = etree.fromstring(new.encode())[0][0]
     assert el.get("_skipIf") == "'<&' == k2 && k2<3"
-    assert el.get("a") == "{k2}" and el.get("b") == "{ k2 }"
+    assert el.get("a") == "{k2}" and el.get("b") == "{ key }"  # the key " key "
 
 
 def test_rename_escapes_a_key_that_is_not_in_a_script() -> None:
@@ -286,8 +300,8 @@ def test_rename_of_a_key_to_the_same_name_changes_nothing() -> None:
         ("", "cannot be empty"),
         ("a{b", "cannot contain '{' or '}'"),
         ("ab}", "cannot contain '{' or '}'"),
-        (" ab", "trims the white space"),
-        ("ab\t", "trims the white space"),
+        (" ab", "keeps the white space inside the braces"),
+        ("ab\t", "keeps the white space inside the braces"),
         ("=", r"stands for the key named like its port"),
         ("@ab", "root blackboard"),
         ("a\x07b", "control characters"),

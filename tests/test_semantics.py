@@ -424,6 +424,21 @@ CASES: list[tuple[str, str, Expected]] = [
         ),
         [],
     ),
+    (
+        "ParallelAll max_failures larger than the child count",
+        # 4.8.2: "Number of children is less than threshold. Can never fail." at tick.
+        T('<ParallelAll max_failures="⟦3⟧"><AlwaysSuccess/><AlwaysSuccess/></ParallelAll>'),
+        [("parallel-threshold", E)],
+    ),
+    (
+        "ParallelAll max_failures up to the child count, from the end or the blackboard",
+        T(
+            '<Sequence><ParallelAll max_failures="2"><AlwaysSuccess/><AlwaysSuccess/>'
+            '</ParallelAll><ParallelAll max_failures="-9"><AlwaysSuccess/></ParallelAll>'
+            '<ParallelAll max_failures="{m}"><AlwaysSuccess/></ParallelAll></Sequence>'
+        ),
+        [],
+    ),
     # --- §f Ports and attributes ------------------------------------------------------------
     (
         "undeclared port of a built-in",
@@ -459,8 +474,76 @@ CASES: list[tuple[str, str, Expected]] = [
     ),
     ("blackboard value never converted", T('<Sleep msec="{delay}"/>'), []),
     (
+        "a key with spaces around the braces is converted as a literal at creation",
+        # 4.8.2: 'The port with name "msec" and value " {delay} " can not be converted';
+        # only exactly {key} (or {=}) is left to the blackboard when the tree is created.
+        T('<Sequence><Sleep msec="⟦ {delay} ⟧"/><Sleep msec="⟦=⟧"/><Sleep msec="{=}"/></Sequence>'),
+        [("invalid-port-value", E), ("invalid-port-value", E)],
+    ),
+    (
+        "a key with spaces around the braces for a port of any text",
+        T(
+            '<Sequence><UnsetBlackboard key=" {k} "/>'
+            '<SetBlackboard value="=" output_key="v"/></Sequence>'
+        ),
+        [],
+    ),
+    ("empty braces are a literal", T('<Sleep msec="⟦{}⟧"/>'), [("invalid-port-value", E)]),
+    (
+        "literal queue of a Loop node, item by item",
+        # 4.8.2: 'value "1;x;3" can not be converted to std::shared_ptr<std::deque<int>>'.
+        T(
+            '<Sequence><LoopInt queue="⟦1;x;3⟧"><AlwaysSuccess/></LoopInt>'
+            '<LoopDouble queue="⟦{}⟧"><AlwaysSuccess/></LoopDouble>'
+            '<LoopBool queue="⟦1;;0⟧"><AlwaysSuccess/></LoopBool></Sequence>'
+        ),
+        [("invalid-port-value", E)] * 3,
+    ),
+    (
+        "literal queues that convert, a queue from the blackboard, any text",
+        T(
+            '<Sequence><LoopInt queue="1;2;3"><AlwaysSuccess/></LoopInt>'
+            '<LoopBool queue="1;0;true;"><AlwaysSuccess/></LoopBool>'
+            '<LoopDouble queue=""><AlwaysSuccess/></LoopDouble>'
+            '<LoopInt queue="{q}"><AlwaysSuccess/></LoopInt>'
+            '<LoopString queue="{};a b"><AlwaysSuccess/></LoopString></Sequence>'
+        ),
+        [],
+    ),
+    (
+        "a queue key with spaces around the braces, a bare =",
+        # Before 4.10 (4.8.2) the typed queue port converts " {q} " as a literal and fails;
+        # 4.10's constructor reads it as the key q.  "=" fails in both.
+        T(
+            '<Sequence><LoopInt queue="⟦ {q} ⟧"><AlwaysSuccess/></LoopInt>'
+            '<LoopBool queue="⟦=⟧"><AlwaysSuccess/></LoopBool></Sequence>'
+        ),
+        [("invalid-port-value", W), ("invalid-port-value", E)],
+    ),
+    (
+        "empty entry of the nodes that watch an entry",
+        # 4.8.2 and 4.10: "Missing port 'entry' in ..." from the node's constructor.
+        T(
+            '<Sequence><WasEntryUpdated entry="⟦⟧"/>'
+            '<SkipUnlessUpdated entry="⟦⟧"><AlwaysSuccess/></SkipUnlessUpdated>'
+            '<WaitValueUpdate entry="⟦⟧"><AlwaysSuccess/></WaitValueUpdate>'
+            '<WaitValueUpdate entry="x"><AlwaysSuccess/></WaitValueUpdate></Sequence>'
+        ),
+        [("invalid-port-value", E)] * 3,
+    ),
+    (
         "bool literal",
         T('<RunOnce then_skip="⟦yes⟧"><AlwaysSuccess/></RunOnce>'),
+        [("invalid-port-value", E)],
+    ),
+    (
+        "an enum port is converted when the node reads it: a key with spaces is a key",
+        # 4.8.2: if_empty=" {a} " reads the entry a at tick; else="xyz" fails at tick
+        # ("Missing parameter [else]"), not when the tree is created.
+        T(
+            '<Sequence><LoopInt queue="1" if_empty=" {a} "><AlwaysSuccess/></LoopInt>'
+            '<Precondition if="a" else="⟦xyz⟧"><AlwaysSuccess/></Precondition></Sequence>'
+        ),
         [("invalid-port-value", E)],
     ),
     (
@@ -476,6 +559,23 @@ CASES: list[tuple[str, str, Expected]] = [
             '<Sequence><Sleep msec="{t}"/><Repeat num_cycles="⟦{t}⟧"><AlwaysSuccess/></Repeat>'
             "</Sequence>"
         ),
+        [("blackboard-type-mismatch", E)],
+    ),
+    (
+        "spaces inside the braces make another key",
+        # { t } is the entry " t " (getRemappedKey trims only outside the braces): 4.8.2
+        # creates this tree.
+        T(
+            '<Sequence><Sleep msec="{t}"/><Repeat num_cycles="{ t }"><AlwaysSuccess/></Repeat>'
+            "</Sequence>"
+        ),
+        [],
+    ),
+    (
+        "spaces outside the braces name the same key",
+        # 4.8.2: "the port [t] was initially created with type [unsigned int] and, later
+        # type [std::string] was used somewhere else".
+        T('<Sequence><Sleep msec="{t}"/><UnsetBlackboard key="⟦ {t} ⟧"/></Sequence>'),
         [("blackboard-type-mismatch", E)],
     ),
     (
@@ -503,13 +603,28 @@ CASES: list[tuple[str, str, Expected]] = [
         [("script-syntax", E)],
     ),
     ("Script code syntax", T('<Script code="x := ⟦)⟧"/>'), [("script-syntax", E)]),
+    (
+        "an empty Script does nothing, a blank one does not parse",
+        # 4.8.2: code="" creates and ticks (SUCCESS); code=" " throws "Empty Script".
+        T('<Sequence><Script code=""/><Script code="⟦ ⟧"/></Sequence>'),
+        [("script-syntax", E)],
+    ),
+    (
+        "empty code of ScriptCondition and Precondition",
+        # 4.8.2: created, then bad_function_call at the first tick.
+        T(
+            '<Sequence><ScriptCondition code="⟦⟧"/>'
+            '<Precondition if="⟦⟧" else="FAILURE"><AlwaysSuccess/></Precondition></Sequence>'
+        ),
+        [("script-syntax", E), ("script-syntax", E)],
+    ),
     ("ScriptCondition code syntax", T('<ScriptCondition code="⟦;⟧a"/>'), [("script-syntax", E)]),
     (
         "Precondition if syntax",
         T('<Precondition if="a &amp;&amp; ⟦%⟧"><AlwaysSuccess/></Precondition>'),
         [("script-syntax", E)],
     ),
-    ("empty script", T('<Script code="⟦⟧"/>'), [("script-syntax", E)]),
+    ("empty script", T('<AlwaysSuccess _post="⟦⟧"/>'), [("script-syntax", E)]),
     ("script ending too early", T('<AlwaysSuccess _post="x :⟦=⟧  "/>'), [("script-syntax", E)]),
     (
         "script in 4.0-4.9 syntax",
@@ -862,3 +977,41 @@ def test_v3_document_gets_warnings_not_errors() -> None:
     )
     found = semantic(doc)
     assert found and all(sev != E for _, _, _, sev in found)
+
+
+@pytest.mark.parametrize(
+    ("body", "says"),
+    [
+        # BehaviorTree.CPP 4.8.2's own words, and when it says them.
+        (
+            "<Sleep/>",
+            "creates the tree, and the node throws at its first tick: 'Missing parameter [msec]'",
+        ),
+        ('<Script code=""/><Script/>', "fails when it creates the node: 'Missing port [code]'"),
+        (
+            "<LoopInt><AlwaysSuccess/></LoopInt>",
+            "fails when it creates the node: '[queue] not found'",
+        ),
+    ],
+)
+def test_a_missing_builtin_port_says_when_and_how_the_library_fails(body: str, says: str) -> None:
+    doc = Document(T(f"<Sequence>{body}</Sequence>"))
+    messages = [
+        d.message for d in semantics.check(doc, Context()) if d.code == "missing-required-port"
+    ]
+    assert len(messages) == 1 and messages[0].endswith(says), messages
+
+
+def test_an_enum_literal_is_converted_when_the_node_reads_it() -> None:
+    doc = Document(T('<Precondition if="a" else="xyz"><AlwaysSuccess/></Precondition>'))
+    (d,) = semantics.check(doc, Context())
+    assert d.code == "invalid-port-value" and "only when the node reads it" in d.message
+
+
+def test_controls_that_count_children_at_tick_say_so() -> None:
+    """4.8.2 loads <IfThenElse> with one child and throws at its first tick."""
+    doc = Document(T("<IfThenElse><AlwaysSuccess/></IfThenElse>"))
+    (d,) = semantics.check(doc, Context())
+    assert d.code == "child-count" and d.message.endswith(
+        "throws at its first tick: 'IfThenElseNode must have either 2 or 3 children'"
+    )

@@ -8,6 +8,7 @@ import json
 import os
 import tempfile
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import Any, Final
 
 from bt_lsp.cli import check
@@ -52,20 +53,48 @@ def catalog(actions: Sequence[str], conditions: Sequence[str]) -> str:
     return "\n".join(lines)
 
 
-def check_files(
-    files: Sequence[tuple[str, str]], actions: Sequence[str], conditions: Sequence[str]
-) -> list[dict[str, Any]]:
-    """bt-lsp's diagnostics of ``files`` (the first includes the others) checked as one
-    workspace, with the custom nodes as the authoritative catalog; each with its file's
-    name as ``file``."""
-    with tempfile.TemporaryDirectory(prefix="bt-lsp-oracle-") as tmp:
-        folder = os.path.join(tmp, "ws")
+@dataclass(slots=True)
+class Workspace:
+    """One folder that every case is written into in turn (the previous case's files
+    removed first): creating and removing a temporary folder per case costs more than
+    bt-lsp's check of it.  bt-lsp builds a fresh workspace index on each check, so
+    nothing of one case is seen by the next.  Use as a context manager."""
+
+    base: str | None = None  # where to make the folder (default: the system's)
+    _tmp: tempfile.TemporaryDirectory[str] | None = field(default=None, init=False)
+    _written: list[str] = field(default_factory=list, init=False)
+
+    def __enter__(self) -> Workspace:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+    def _root(self) -> str:
+        if self._tmp is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="bt-lsp-oracle-", dir=self.base)
+        return self._tmp.name
+
+    def check(
+        self, files: Sequence[tuple[str, str]], actions: Sequence[str], conditions: Sequence[str]
+    ) -> list[dict[str, Any]]:
+        """bt-lsp's diagnostics of ``files`` (the first includes the others) checked as
+        one workspace, with the custom nodes as the authoritative catalog; each with its
+        file's name as ``file``."""
+        root = self._root()
+        folder = os.path.join(root, "ws")
+        for path in self._written:
+            os.unlink(path)
+        self._written.clear()
         for name, text in files:
             path = os.path.join(folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "w", encoding="utf-8", newline="") as fh:
                 fh.write(text)
-        models = os.path.join(tmp, "models.xml")
+            self._written.append(path)
+        models = os.path.join(root, "models.xml")
         with open(models, "w", encoding="utf-8") as fh:
             fh.write(catalog(actions, conditions))
         found = check_folder(folder, models)
@@ -73,3 +102,11 @@ def check_files(
         for d in found:
             d["file"] = os.path.relpath(d["path"], folder)
         return found
+
+
+def check_files(
+    files: Sequence[tuple[str, str]], actions: Sequence[str], conditions: Sequence[str]
+) -> list[dict[str, Any]]:
+    """:meth:`Workspace.check` in a folder of its own."""
+    with Workspace() as ws:
+        return ws.check(files, actions, conditions)

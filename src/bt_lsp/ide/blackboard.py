@@ -4,8 +4,9 @@ BehaviorTree.CPP gives every tree instance a blackboard of its own, so a key bel
 tree.  A tree uses a key
 
 * as a port value that is a blackboard reference: ``goal="{key}"`` (spaces around the
-  braces and inside them are trimmed), ``goal="{=}"`` or ``goal="="`` (the key named like
-  the port), exactly when BehaviorTree.CPP's ``isBlackboardPointer`` reads the whole value
+  braces are trimmed, those inside are part of the key: ``{ key }`` is the key
+  ``" key "``, another entry than ``key``), ``goal="{=}"`` or ``goal="="`` (the key named
+  like the port), exactly when BehaviorTree.CPP's ``getRemappedKey`` reads the whole value
   as one (``"Hello {name}"`` is a literal text, not a key);
 * as an identifier in a script: the pre- and post-condition attributes (``_skipIf`` …
   ``_post``) of any node, ``code`` of ``<Script>`` and ``<ScriptCondition>`` and ``if`` of
@@ -72,11 +73,11 @@ class KeyForm(StrEnum):
 
 @dataclass(frozen=True, slots=True)
 class KeyRef:
-    """A use of a blackboard key: ``start``/``end`` span the key as written (without braces
-    and surrounding spaces; the ``=`` of ``{=}``), ``element`` is the element index of its
-    node and ``tree`` of its ``<BehaviorTree>``.  ``attr`` is the attribute it is written
-    in, ``quote`` that attribute's quote, ``entities`` whether the key's own characters
-    are written with entity or character references."""
+    """A use of a blackboard key: ``start``/``end`` span the key as written (between the
+    braces, spaces inside them included; the ``=`` of ``{=}``), ``element`` is the element
+    index of its node and ``tree`` of its ``<BehaviorTree>``.  ``attr`` is the attribute
+    it is written in, ``quote`` that attribute's quote, ``entities`` whether the key's own
+    characters are written with entity or character references."""
 
     key: str
     start: int
@@ -122,9 +123,6 @@ def subtree_range(model: Model, index: int) -> range:
     return range(index, stop)
 
 
-_SPACES = " \t\r\n"
-
-
 class _Value:
     """An attribute value: decoded, and how its code points map to the raw text."""
 
@@ -156,21 +154,21 @@ def _is_script_port(el: Element, a: Attr) -> bool:
 def _port_key(
     doc: Document, el: Element, a: Attr, idx: int, tree: int, value: str
 ) -> KeyRef | None:
+    """The key of a port value that is a blackboard reference, as ``getRemappedKey``
+    reads it: ``=`` and ``{=}`` name the port's own key; else the key is all that is
+    between the braces, spaces included (only those outside the braces are trimmed)."""
     v = _Value(doc, el, a)
-    stripped = value.strip(" ")
-    lead = len(value) - len(value.lstrip(" "))
-    if stripped == "=":
-        s, e, _ = v.span(lead, lead + 1)
+    if value == "=":
+        s, e, _ = v.span(0, 1)
         return KeyRef(a.name, s, e, idx, tree, KeyForm.BARE_SAME, a.name, a.quote)
-    inner = stripped[1:-1]
-    if inner == "=":
-        s, e, _ = v.span(lead + 1, lead + 2)
+    if value == "{=}":
+        s, e, _ = v.span(1, 2)
         return KeyRef(a.name, s, e, idx, tree, KeyForm.SAME, a.name, a.quote)
-    key = inner.strip(_SPACES)
+    lead = len(value) - len(value.lstrip(" "))
+    key = value.strip(" ")[1:-1]
     if not key:
         return None
-    ks = lead + 1 + len(inner) - len(inner.lstrip(_SPACES))
-    s, e, ent = v.span(ks, ks + len(key))
+    s, e, ent = v.span(lead + 1, lead + 1 + len(key))
     return KeyRef(key, s, e, idx, tree, KeyForm.BRACES, a.name, a.quote, ent)
 
 

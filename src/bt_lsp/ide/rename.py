@@ -201,7 +201,11 @@ def _check_key_name(new_name: str, in_script: bool) -> None:
             "a blackboard key cannot contain '{' or '}', which delimit it in a port value",
         )
     if new_name != new_name.strip(" \t\r\n"):
-        _refuse_new_name(new_name, "BehaviorTree.CPP trims the white space around a key")
+        _refuse_new_name(
+            new_name,
+            "BehaviorTree.CPP keeps the white space inside the braces as part of the key "
+            "('{ key }' is another entry than 'key')",
+        )
     if new_name == "=":
         _refuse_new_name(new_name, "'{=}' stands for the key named like its port")
     if new_name.startswith("@"):

@@ -111,16 +111,49 @@ def _normalize_type(type_: str) -> str | None:
 
 
 def is_blackboard_reference(value: str) -> bool:
-    """Whether BehaviorTree.CPP reads ``value`` as a blackboard key rather than a literal.
+    """Whether BehaviorTree.CPP reads ``value`` as a blackboard key rather than a literal
+    when a node reads the port (``getInput``) and when it creates the tree's entries.
 
-    Mirrors ``TreeNode::isBlackboardPointer``: after trimming spaces the text has at least
-    three characters and is wrapped in ``{`` ``}``. A bare ``=`` (same key as the port) also
-    counts.
+    Mirrors ``TreeNode::getRemappedKey``: exactly ``=`` or ``{=}`` (the key named like the
+    port), or ``isBlackboardPointer``: after trimming the spaces around it the text has at least
+    three characters and is wrapped in ``{`` ``}`` (``{}`` is a literal).  Version 4 also
+    converts every literal of a typed port when it creates the tree, and there only the
+    exact form ``{…}`` is a reference (:func:`is_converted_as_reference`).
     """
-    stripped = value.strip(" ")
-    if stripped == "=":
+    if value == "=":
         return True
+    stripped = value.strip(" ")
     return len(stripped) >= 3 and stripped[0] == "{" and stripped[-1] == "}"
+
+
+def is_converted_as_reference(value: str) -> bool:
+    """Whether BehaviorTree.CPP 4 skips ``value`` when it converts the literals of typed
+    ports at tree creation: exactly ``{…}``, three characters at least, nothing around the
+    braces (``XMLParser``'s own test, not ``isBlackboardPointer``).  So ``" {a} "`` and
+    ``"="``, references to a string port, fail to convert for an ``int`` port."""
+    return len(value) >= 3 and value[0] == "{" and value[-1] == "}"
+
+
+def converted_at_creation(type_: str) -> bool:
+    """Whether BehaviorTree.CPP 4 converts a literal of a port of ``type_`` when it
+    creates the tree.  An enum port (``NodeStatus``) has no string converter in its
+    ``PortInfo``: its literal is converted (through the registered enums) only when the
+    node reads the port, where a bad one fails the node (4.8.2: ``else="xyz"`` of
+    ``Precondition`` is "Missing parameter [else]" at tick)."""
+    return _normalize_type(type_) != "NodeStatus"
+
+
+def blackboard_key(port: str, value: str) -> str | None:
+    """The blackboard key a port given ``value`` uses (``TreeNode::getRemappedKey``), or
+    ``None`` for a literal: the port's own name for ``=`` and ``{=}``, else the text
+    between the braces exactly as written (``{ a }`` is the key ``" a "``, not ``"a"``:
+    only the spaces outside the braces are trimmed)."""
+    if value in ("=", "{=}"):
+        return port
+    stripped = value.strip(" ")
+    if len(stripped) >= 3 and stripped[0] == "{" and stripped[-1] == "}":
+        return stripped[1:-1]
+    return None
 
 
 def _leading_int(value: str, unsigned_parse: bool) -> tuple[int | None, bool]:
@@ -222,10 +255,10 @@ def convert_literal(value: str, type: str, *, strict: bool = False) -> str | Non
     * ``std::vector<int|double|bool|std::string>``: each ``;``-separated item as above;
     * ``std::string``, ``any`` and every type not listed: always fine.
 
-    Values that are blackboard references (``{key}``, ``{=}``, ``=``) and ``json:`` values
-    are not literals and give ``None``.
+    Values that version 4 does not convert at tree creation (``{key}``, ``{=}``: see
+    :func:`is_converted_as_reference`) and ``json:`` values give ``None``.
     """
-    if is_blackboard_reference(value) or value.startswith("json:"):
+    if is_converted_as_reference(value) or value.startswith("json:"):
         return None
     kind = _normalize_type(type)
     if kind is None or kind in ("string", "any"):
@@ -238,6 +271,20 @@ def convert_literal(value: str, type: str, *, strict: bool = False) -> str | Non
                 return f"item {problem}"
         return None
     return _convert_scalar(value, kind, strict)
+
+
+def convert_queue(value: str, item_type: str) -> str | None:
+    """Why a literal ``queue`` of ``LoopInt``/``LoopDouble``/``LoopBool`` cannot be
+    converted to ``SharedQueue<item_type>``, or ``None`` if it can: each ``;``-separated
+    item goes through ``convertFromString<item_type>`` (``json:`` is not special here)."""
+    kind = _normalize_type(item_type)
+    if kind is None or kind in ("string", "any"):
+        return None
+    for item in _split_items(value):
+        problem = _convert_scalar(item, kind, False)
+        if problem is not None:
+            return f"item {problem}"
+    return None
 
 
 def _split_items(value: str) -> list[str]:

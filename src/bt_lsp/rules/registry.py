@@ -1,8 +1,8 @@
 """The one table of every diagnostic code.
 
 Each rule defines its codes beside itself (:func:`bt_lsp.rules.codes.define`); this module
-imports every module that defines one, so :data:`CODES` is complete: the README's code
-table (``scripts/codes_doc.py``), the server's ``codeDescription`` links, SARIF rules and
+imports every module that defines one, so :data:`CODES` is complete: the documentation's code
+table and pages (``scripts/docs_gen.py``), the server's ``codeDescription`` links, SARIF rules and
 the severity settings read it.  Ordered by family, then by name.
 """
 
@@ -32,7 +32,7 @@ from bt_lsp.rules.semantics import (  # noqa: F401  (they define codes)
 
 freeze()  # every module that defines a code is imported: none is defined later
 
-#: The families in the order the README lists them, with their headings.
+#: The families in the order the documentation lists them, with their headings.
 FAMILIES: Final[Mapping[str, str]] = MappingProxyType(
     {NAMES: "Name rules", XML: "XML", BT: "BehaviorTree.CPP semantics", PROJECT: "Project"}
 )

@@ -32,8 +32,9 @@
   fails with "Unknown node type: Action".  Not reported in a BehaviorTree.CPP 3 project:
   3.8's parser does not look the children up.  Range: the child's element name.
 * ``parallel-threshold`` (error): a literal ``success_count``/``failure_count`` of a
-  ``Parallel`` larger than its number of children (negative values count from the end and
-  never exceed it).  Range: the value.
+  ``Parallel``, or ``max_failures`` of a ``ParallelAll``, larger than its number of
+  children (negative values count from the end and never exceed it): the node throws at
+  its first tick.  Range: the value.
 """
 
 from __future__ import annotations
@@ -242,7 +243,7 @@ REACTIVE_EXPLICIT_CHILD: Final = define(
 PARALLEL_THRESHOLD: Final = define(
     "parallel-threshold",
     Severity.ERROR,
-    "a `Parallel` threshold larger than its number of children",
+    "a `Parallel`/`ParallelAll` threshold larger than its number of children",
     BT,
     doc="""
         A `Parallel` succeeds when `success_count` children succeed and fails when
@@ -336,6 +337,8 @@ def check_node(st: State, el: Element) -> Resolved | None:
         _reactive(st, el)
     elif res.id == "Parallel":
         _parallel(st, el)
+    elif res.id == "ParallelAll":
+        _parallel_all(st, el)
     return res
 
 
@@ -542,13 +545,31 @@ def _children(st: State, el: Element, res: Resolved) -> None:
             f"must have {lo} or {hi} children" if hi == lo + 1 else f"must have {lo}-{hi} children"
         )
     what = {"custom": f"a {res.category} declared in <TreeNodesModel>"}.get(res.origin, "")
-    st.add(
-        el.name_start,
-        el.name_end,
-        "child-count",
+    message = (
         f"The node {quoted(res.id)}{' (' + what + ')' if what else ''} {need}; it has "
-        f"{_count(n) if n else 'none'}",
+        f"{_count(n) if n else 'none'}"
     )
+    words = _TICK_CHILD_COUNT.get("Switch" if _is_switch(res.id) else res.id)
+    if res.origin == "builtin" and words is not None and n:
+        # Loading checks only that a control node has children; these count them at tick.
+        message += (
+            f"; BehaviorTree.CPP creates the tree, and the node throws at its first tick: '{words}'"
+        )
+    st.add(el.name_start, el.name_end, "child-count", message)
+
+
+# The controls that count their children only when they tick, in BehaviorTree.CPP's words.
+_TICK_CHILD_COUNT: Final = MappingProxyType(
+    {
+        "IfThenElse": "IfThenElseNode must have either 2 or 3 children",
+        "WhileDoElse": "WhileDoElseNode must have either 2 or 3 children",
+        "Switch": "Wrong number of children in SwitchNode; must be (num_cases + default)",
+    }
+)
+
+
+def _is_switch(type_id: str) -> bool:
+    return type_id.startswith("Switch") and type_id[6:].isdigit()
 
 
 def _reactive(st: State, el: Element) -> None:
@@ -598,3 +619,26 @@ def _parallel(st: State, el: Element) -> None:
                 f"{port} is {value} but the Parallel has {_count(n)}, so it can never "
                 f"{outcome} (BehaviorTree.CPP: Number of children is less than threshold)",
             )
+
+
+def _parallel_all(st: State, el: Element) -> None:
+    """ParallelAll checks ``max_failures`` against its children at every tick
+    (``ParallelAllNode::tick``), and throws when it could never fail."""
+    n = len(el.children)
+    a = el.attr("max_failures")
+    if a is None or a.value is None or is_blackboard_reference(a.value):
+        return
+    m = _LEADING_INT.match(a.value)
+    if m is None:
+        return  # invalid-port-value reports it
+    value = int(m.group(0))
+    if value > n:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "parallel-threshold",
+            f"max_failures is {value} but the ParallelAll has {_count(n)}, so it can never "
+            "fail; BehaviorTree.CPP throws at its first tick: Number of children is less "
+            "than threshold. Can never fail.",
+        )

@@ -29,23 +29,31 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
   creates a tree, and a node's code often reads a port without a default as optional
   (``getInput`` returning an error, Nav2's fallbacks to parameters).  Range: the element
   name.
-* ``invalid-port-value``: a literal that does not convert to the declared type (values in
-  ``{…}`` are blackboard references and never checked); an error for an exact model
-  (BehaviorTree.CPP converts the literal at tree creation for a strongly typed port with
-  a converter), a warning for an advisory one; ``_autoremap`` on ``<SubTree>`` must be a
-  bool literal.  Range: the value.
-* ``blackboard-type-mismatch``: within one tree, a ``{key}`` used by ports of two
-  different strong types (the first use fixes the entry's type; a ``std::string`` entry
-  accepts anything).  Types are compared as C++ types (:mod:`bt_lsp.rules.port_types`:
+* ``invalid-port-value``: a literal that does not convert to the declared type; an error
+  for an exact model (BehaviorTree.CPP 4 converts the literal at tree creation for a
+  strongly typed port with a converter), a warning for an advisory one.  Only a value
+  that is exactly ``{…}`` (three characters at least) is left to the blackboard there:
+  ``" {a} "`` and ``"="`` are keys to ``getInput`` but literals to that conversion, so
+  they fail for an ``int`` port; ``{}`` is a literal.  An enum port (``NodeStatus``) is
+  converted only when the node reads it (the message says so).  Built-ins whose
+  constructor reads a port itself: the literal ``queue`` of ``LoopInt``/``LoopDouble``/
+  ``LoopBool`` is converted item by item (``" {q} "`` is a warning: a literal before
+  4.10, the key in 4.10), an empty ``entry`` of ``WaitValueUpdate``/
+  ``SkipUnlessUpdated``/``WasEntryUpdated`` fails ("Missing port 'entry'");
+  ``_autoremap`` on ``<SubTree>`` must be a bool literal.  Range: the value.
+* ``blackboard-type-mismatch``: within one tree, a key used by ports of two different strong
+  types (the key as ``getRemappedKey`` reads it: spaces inside the braces belong to it, ``{
+  a }`` is the entry ``" a "``; the first use fixes the entry's type; a ``std::string``
+  entry accepts anything).  Types are compared as C++ types (:mod:`bt_lsp.rules.port_types`:
   spellings of one built-in type, ``std::`` forms, top-level ``const`` and references are
-  one; a type read from C++ with the project's own aliases followed, :mod:`bt_lsp.cpp.types`),
-  and only when every name in both is known not to be an alias (built-in, standard
-  library, ROS interface types, classes the project's C++ defines): any other name may be
-  a ``using`` from a header bt-lsp did not read, so it proves nothing.  An error when both
-  models are exact, else a warning.  Shared
-  pointers of two classes read by an input port are a hint: BehaviorTree.CPP accepts the
-  connection when the application registers a polymorphic cast between them (input ports
-  only; an inout or output port must match exactly).  Range: the later value.
+  one; a type read from C++ with the project's own aliases followed,
+  :mod:`bt_lsp.cpp.types`), and only when every name in both is known not to be an alias
+  (built-in, standard library, ROS interface types, classes the project's C++ defines): any
+  other name may be a ``using`` from a header bt-lsp did not read, so it proves nothing.  An
+  error when both models are exact, else a warning.  Shared pointers of two classes read by
+  an input port are a hint: BehaviorTree.CPP accepts the connection when the application
+  registers a polymorphic cast between them (input ports only; an inout or output port must
+  match exactly).  Range: the later value.
 * ``port-name-not-remappable`` (warning): an attribute that passes the name rules but
   not ``is_allowed_port_name`` and does not start with ``_`` (``检查``, ``-x``): never a
   port.  Range: the attribute name.
@@ -61,14 +69,23 @@ advisory (BehaviorTree.CPP reads the C++ registration, not it).
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
+from types import MappingProxyType
 from typing import Final
 
 from bt_lsp.rules import port_types
 from bt_lsp.rules.builtins import PortModel
 from bt_lsp.rules.codes import BT, FixData, Severity, define, display_only, unsafe
-from bt_lsp.rules.conversions import convert_literal, is_blackboard_reference
+from bt_lsp.rules.conversions import (
+    blackboard_key,
+    convert_literal,
+    convert_queue,
+    converted_at_creation,
+    is_blackboard_reference,
+    is_converted_as_reference,
+)
 from bt_lsp.rules.names import (
     POSTCONDITIONS,
     PRECONDITIONS,
@@ -427,12 +444,25 @@ def _check_port(
     if res.origin == "subtree":
         return  # a literal remapping of a subtree port is stored as text, never converted
     if (res.id, a.name) in SCRIPT_PORTS and res.origin == "builtin":
-        if not is_blackboard_reference(value):
+        # An empty Script is no script: its constructor parses the code only when it
+        # differs from the last one parsed, which starts empty (script_node.h).
+        if not is_blackboard_reference(value) and (value or res.id != "Script"):
             scripts.check(st, el, a)
         return
-    if is_blackboard_reference(value):
-        _blackboard_use(st, el, a, value, port, res, scope)
+    if res.origin == "builtin" and not st.v3 and _check_builtin_value(st, el, a, value, res):
         return
+    if is_blackboard_reference(value):
+        # The tree's entry is made with the port's type either way (getRemappedKey); but
+        # version 4 also converts a typed port's value at tree creation unless it is
+        # exactly {key}: " {key} " and "=" are keys only for a port that takes any text.
+        _blackboard_use(st, el, a, value, port, res, scope)
+        if (
+            st.v3
+            or is_converted_as_reference(value)
+            or not converted_at_creation(port.type)
+            or _convert(value, port.type) is None
+        ):
+            return
     if not port.type or (st.v3 and not value):
         # BehaviorTree.CPP 3.8 reads an empty value as not given (the default applies).
         return
@@ -455,9 +485,68 @@ def _check_port(
                 "(the node then fails)" if res.origin == "builtin" else "(getInput fails)"
             )
             severity = Severity.WARNING if res.origin == "builtin" else Severity.HINT
+        elif not converted_at_creation(port.type):
+            message += (
+                "; BehaviorTree.CPP converts an enum port only when the node reads it "
+                "(the node then fails)"
+            )
         else:
             message += "; BehaviorTree.CPP 4 converts it when it creates the tree"
+            if is_blackboard_reference(value):
+                message += (
+                    ", and only a value that is exactly {key}, without spaces around the "
+                    "braces, is left to the blackboard there"
+                    if value != "="
+                    else ", where only {=} stands for the key named like the port"
+                )
         st.add(s, e, "invalid-port-value", message, severity)
+
+
+# The item type of the literal queue of a Loop node (LoopString takes any text).
+_LOOP_ITEMS: Final = MappingProxyType(
+    {"LoopInt": "int", "LoopDouble": "double", "LoopBool": "bool"}
+)
+# The built-ins that read port ``entry`` in their constructor.
+_ENTRY_NODES: Final = frozenset({"WaitValueUpdate", "SkipUnlessUpdated", "WasEntryUpdated"})
+
+
+def _check_builtin_value(st: State, el: Element, a: Attr, value: str, res: Resolved) -> bool:
+    """The values of version 4 built-ins that their constructor reads itself (the port's
+    type says nothing of them); whether the value was checked here."""
+    if a.name == "queue" and res.id in _LOOP_ITEMS:
+        # Before 4.10 the port is typed (SharedQueue<T>): the tree's creation converts
+        # all but an exact {key}.  4.10's port takes anything, and the node's constructor
+        # converts what isBlackboardPointer does not take for a key (" {q} " is one).
+        if is_converted_as_reference(value):
+            return False
+        problem = convert_queue(value, _LOOP_ITEMS[res.id])
+        reference = is_blackboard_reference(value) and value != "="
+        if problem is not None:
+            s, e = el.span_of_value(a)
+            message = (
+                f"The value of port 'queue' cannot be converted to a queue of "
+                f"{_LOOP_ITEMS[res.id]}: {problem}; BehaviorTree.CPP converts a literal queue "
+                f"('1;2;3') item by item when it creates {quoted(res.id)}"
+            )
+            if reference:
+                message += (
+                    " (before 4.10, where only an exact {key} is left to the blackboard; "
+                    "4.10 reads a key with spaces around the braces as the key)"
+                )
+            st.add(s, e, "invalid-port-value", message, Severity.WARNING if reference else None)
+        return not reference
+    if a.name == "entry" and res.id in _ENTRY_NODES and not value:
+        s, e = el.span_of_value(a)
+        st.add(
+            s,
+            e,
+            "invalid-port-value",
+            f"Port 'entry' of {quoted(res.id)} is empty; BehaviorTree.CPP fails when it "
+            f"creates the node: \"Missing port 'entry'\" (give the blackboard entry to "
+            "watch, as {key} or key)",
+        )
+        return True
+    return False
 
 
 def _undeclared(st: State, el: Element, a: Attr, res: Resolved) -> None:
@@ -537,9 +626,8 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         )
         severity = Severity.WARNING
     elif res.origin == "builtin":
-        message = (
-            f"{quoted(res.id)} needs port{plural} {shown} (no default); the node fails when "
-            "it reads a missing port"
+        message = f"{quoted(res.id)} needs port{plural} {shown} (no default); " + _missing_effect(
+            res.id, missing[0]
         )
         severity = None
     else:
@@ -566,6 +654,38 @@ def _missing(st: State, el: Element, res: Resolved, given: set[str], autoremap: 
         severity,
         MissingPorts(tuple(missing)),
     )
+
+
+# When a built-in reads a port it was not given, and what BehaviorTree.CPP then says
+# (4.8.2 and 4.10): True when it is read as the node is created, else at its first tick.
+_MISSING_WORDS: Final[Mapping[tuple[str, str], tuple[bool, str]]] = MappingProxyType(
+    {
+        ("Script", "code"): (True, "Missing port [code]"),
+        ("ScriptCondition", "code"): (True, "Missing port [code]"),
+        ("Precondition", "if"): (True, "Missing parameter [if]"),
+        **{(n, "entry"): (True, "Missing port 'entry'") for n in sorted(_ENTRY_NODES)},
+        **{(f"Loop{t}", "queue"): (True, "[queue] not found") for t in ("Int", "Double", "Bool")},
+        ("LoopString", "queue"): (True, "[queue] not found"),
+        ("Sleep", "msec"): (False, "Missing parameter [msec]"),
+        ("Timeout", "msec"): (False, "Missing parameter [msec]"),
+        ("Delay", "delay_msec"): (False, "Missing parameter [delay_msec]"),
+        ("Repeat", "num_cycles"): (False, "Missing parameter [num_cycles]"),
+        ("RetryUntilSuccessful", "num_attempts"): (False, "Missing parameter [num_attempts]"),
+        ("SetBlackboard", "output_key"): (False, "missing port [output_key]"),
+        ("UnsetBlackboard", "key"): (False, "missing input port [key]"),
+    }
+)
+
+
+def _missing_effect(node: str, port: str) -> str:
+    """What BehaviorTree.CPP does with a built-in that misses ``port``, in its words."""
+    known = _MISSING_WORDS.get((node, port))
+    if known is None:
+        return "the node fails when it reads a missing port"
+    at_creation, words = known
+    if at_creation:
+        return f"BehaviorTree.CPP fails when it creates the node: '{words}'"
+    return f"BehaviorTree.CPP creates the tree, and the node throws at its first tick: '{words}'"
 
 
 def _closed(canon: str, res: Resolved, port: PortModel) -> bool:
@@ -602,8 +722,9 @@ def _blackboard_use(
     canon, shown = _port_type(port)
     if canon is None:
         return
-    key = value.strip(" ")
-    key = a.name if key in ("=", "{=}") else key[1:-1].strip(" ")
+    key = blackboard_key(a.name, value)
+    if key is None:
+        return
     first = scope.keys.get(key)
     if first is None:
         scope.keys[key] = BlackboardUse(

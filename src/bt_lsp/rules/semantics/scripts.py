@@ -8,7 +8,9 @@ post-condition attributes (``_skipIf`` … ``_post``) on any node.
   value back through entity references (``&amp;&amp;`` is one ``&&`` operator of the
   script but 10 characters of the file); an error at the end of the script covers its
   last character, an empty script the (empty) value.  A ``code``/``if`` port given as a
-  blackboard reference (``{key}``) is not a script here and is not checked.
+  blackboard reference (``{key}``) is not a script here and is not checked, nor is an
+  empty ``code`` of ``Script`` (its constructor parses the code only when it differs from
+  the last code parsed, which starts empty: the node does nothing).
 """
 
 from __future__ import annotations
@@ -72,6 +74,12 @@ def check(st: State, el: Element, a: Attr) -> None:
     st.pure = False  # reads the text (two spellings of one value may be one token)
     rs, re_ = raw_span(st.text[vs:ve], start, end)
     message = f"Script error in {a.name}: {err.message}"
+    if not code and a.name in ("code", "if"):
+        # ScriptCondition/Precondition skip parsing a code equal to the last one parsed,
+        # which starts empty: they are created, and call their empty executor.
+        message += (
+            "; BehaviorTree.CPP creates the node, which fails when it ticks (bad_function_call)"
+        )
     if legacy_ok:
         message += " (BehaviorTree.CPP 4.0-4.9 accepted this; 4.10 does not)"
     st.add(vs + rs, vs + re_, "script-syntax", message, Severity.WARNING if legacy_ok else None)

@@ -561,7 +561,9 @@ def check_recursion(st: State) -> None:
             decl.start + s,
             decl.start + e,
             "subtree-recursion",
-            f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP refuses recursive trees",
+            f"This SubTree call closes a cycle ({shown}); BehaviorTree.CPP 4.10 refuses it "
+            "when it creates the tree ('Recursive behavior tree cycle detected'), earlier "
+            "versions recurse until the stack overflows (a crash)",
         )
 
 
