@@ -84,6 +84,16 @@ def test_the_common_codes_have_their_prose(code: str) -> None:
         assert part in page
 
 
+@pytest.mark.parametrize("code", list(CODES))
+def test_every_code_has_its_prose(code: str) -> None:
+    """Every code's page says what BehaviorTree.CPP does, why it matters and since when: a
+    new code without that prose fails here."""
+    c = CODES[code]
+    assert c.doc and c.why and c.since, code
+    page = (ROOT / "docs" / "rules" / f"{code}.md").read_text(encoding="utf-8")
+    assert c.doc in page and c.why in page, code
+
+
 def _document(example: str) -> str:
     """An example as a whole document: it is one (``<?xml``, ``<root``), a set of trees, or
     a tree's body."""

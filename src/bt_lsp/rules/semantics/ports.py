@@ -275,6 +275,19 @@ PORT_NAME_NOT_REMAPPABLE: Final = define(
     Severity.WARNING,
     "a port name that does not start with an ASCII letter, so XML cannot set it",
     BT,
+    doc="""
+        BehaviorTree.CPP treats an attribute as a port only when its name starts with an ASCII
+        letter (`IsAllowedPortName`). A name that passes the name rules but starts otherwise
+        (`检查`, `-x`) is silently ignored on a node, is never passed on as a remapping by a
+        `<SubTree>` call (its model's port then only takes its default or comes from
+        `_autoremap`), and cannot be declared by a C++ node at all (`CreatePort` throws).
+        """,
+    why="""
+        The node never gets the value written for it, and nothing says so at run time.
+        """,
+    bad='<Sleep msec="500" 检查="1"/>',
+    good='<Sleep msec="500" name="检查"/>',
+    since="BehaviorTree.CPP 4.",
 )
 UNKNOWN_ATTRIBUTE: Final = define(
     "unknown-attribute",
@@ -290,6 +303,23 @@ UNKNOWN_ATTRIBUTE: Final = define(
         ),
         "guess": display_only("Did you mean '{suggestion}'? Rename '{old}'", "a guess"),
     },
+    doc="""
+        An attribute starting with `_` is never a port, and BehaviorTree.CPP reads only the
+        reserved ones itself (`_autoremap`, the pre- and post-conditions `_skipIf`,
+        `_successIf`, `_failureIf`, `_while`, `_onSuccess`, `_onFailure`, `_onHalted`,
+        `_post`; `_description`, `_uid` and `_fullpath` are allowed too). Any other is kept
+        in the node's `other_attributes`, which only the node's own C++ reads. A warning when
+        it looks like a misspelled reserved name (`_skipif`: the fix renames it), else a
+        hint. `__shared_blackboard` and `__autoremap` are version 3 spellings of
+        `_autoremap`.
+        """,
+    why="""
+        A misspelt precondition never runs: the node is ticked when it should have been
+        skipped, with no error.
+        """,
+    bad='<Sleep msec="500" _skipif="done"/>',
+    good='<Sleep msec="500" _skipIf="done"/>',
+    since="BehaviorTree.CPP 4 (the pre- and post-conditions are version 4 attributes).",
 )
 
 
