@@ -419,8 +419,9 @@ K_USES = [
     ('code="target', 6),
     ("'target' .. target", 12),
     ('goal="{target}"', 7),
-    ("{ target }", 2),
 ]
+# `{ target }` is another key, " target " (spaces inside the braces belong to the key, as
+# BehaviorTree.CPP 4 reads it): a rename of "target" leaves it alone.
 
 
 def key_spans() -> list[tuple[int, int]]:
@@ -464,7 +465,8 @@ async def test_rename_a_blackboard_key_in_its_tree(lsp: NavClient) -> None:
         got = list(edit.changes[uri])
     assert sorted(got, key=lambda e: (e.range.start.line, e.range.start.character)) == expected
     new = apply(lsp, K_XML, got)
-    assert new.count("goal_pose") == 5
+    assert new.count("goal_pose") == 4
+    assert '"{ target }"' in new
     assert "'🚀 target'" in new and "'target'" in new
     assert '<MoveBase goal="{target}"/>' in new  # tree "Other"
 
