@@ -147,13 +147,15 @@ def read_triage(paths: Iterable[Path]) -> list[TriageLine]:
 
 
 def parse_check_output(project: str, root: Path, text: str) -> list[Finding]:
-    """The findings of ``bt-lsp check --format json``, with paths relative to ``root``."""
+    """The findings of ``bt-lsp check --format json``, with paths relative to ``root``.
+
+    ``check`` prints a path as given on its command line: relative to the working directory
+    when ``root`` is relative (``--projects ../shared/projects``), so both are made absolute
+    from there."""
     out = []
+    base = os.path.abspath(root)
     for item in json.loads(text or "[]"):
-        path = Path(item["path"])
-        if not path.is_absolute():
-            path = root / path
-        rel = os.path.relpath(path, root).replace(os.sep, "/")
+        rel = os.path.relpath(os.path.abspath(item["path"]), base).replace(os.sep, "/")
         out.append(
             Finding(
                 project=project,

@@ -188,3 +188,30 @@ def test_whole_run_on_a_fake_projects_dir(tmp_path: Path) -> None:
     assert "demo\tconfig.xml\t1\tmissing-required-port\tTODO" in template.read_text(
         encoding="utf-8"
     )
+
+
+def test_a_relative_projects_dir_keys_findings_by_their_path_in_the_project(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--projects ../shared/projects`` (as CI passes it): ``check`` prints paths relative
+    to the working directory, and the triage key is still the path inside the project."""
+    project = tmp_path / "projects" / "demo"
+    (project / "trees").mkdir(parents=True)
+    (project / "trees" / "config.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Sleepy"><Sleep/></BehaviorTree></root>\n',
+        encoding="utf-8",
+    )
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    triage = tmp_path / "triage.tsv"
+    triage.write_text(
+        HEADER + "demo\ttrees/config.xml\t1\tmissing-required-port\ttrue\ta test\n",
+        encoding="utf-8",
+    )
+    summary = tmp_path / "summary.json"
+    args = ["--projects", "../projects", "--triage", str(triage), "--json", str(summary)]
+    assert eco.main(args) == 0
+    data = json.loads(summary.read_text(encoding="utf-8"))
+    assert data["untriaged"] == []
+    assert data["true_errors"] == 1
