@@ -92,14 +92,40 @@ def test_sniffing() -> None:
 
 def test_broken_bt_files_are_still_checked(tmp_path: Path) -> None:
     """A file that tries to be BT (trees under a misspelt top element, a truncated tree)
-    is checked; other XML, a generic <root> of another tool, an empty file are not."""
+    is checked, and so is a file that is not XML at all (empty, blank, text, a first tag
+    that never closes: every reader fails on it); other XML and a generic <root> of
+    another tool are not."""
     p = tmp_path / "t.xml"
-    for text in ("<Root><BehaviorTree ID='M'/></Root>", "<roo BTCPP_format='4'>"):
+    for text in (
+        "<Root><BehaviorTree ID='M'/></Root>",
+        "<roo BTCPP_format='4'>",
+        "",
+        " \n\t",
+        "\ufeff",
+        "not xml",
+        "<root",
+        "<not valid xml!!!",
+        "<?xml version='1.0'?><!-- unterminated",
+    ):
         p.write_text(text)
-        assert is_bt_file(p), text
-    for text in ("", "<Root/>", "<root", "<root><item/></root>", "<root><Tree", "<server/>"):
+        assert is_bt_file(p), repr(text)
+    for text in ("<Root/>", "<root><item/></root>", "<root><Tree", "<server/>", "<a b='>'"):
         p.write_text(text)
         assert not is_bt_file(p), text
+
+
+def test_a_file_that_is_not_xml_is_an_error_in_a_walk(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """BehaviorTree.CPP's own tests (MalformedXML_CompletelyEmpty, _InvalidRoot): loading
+    an empty file or ``<not valid xml!!!`` throws; a walk over the folder says so."""
+    (tmp_path / "empty.xml").write_text("")
+    (tmp_path / "broken.xml").write_text("<not valid xml!!!")
+    code, out, _ = run(capsys, str(tmp_path))
+    assert code == 1
+    assert f"{tmp_path / 'empty.xml'}:1:1: error root-element " in out
+    assert "BehaviorTree.CPP fails to load it" in out
+    assert f"{tmp_path / 'broken.xml'}:1:2: error xml-syntax " in out
 
 
 def test_utf16_files_are_sniffed(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Final
 
 from bt_lsp.project.fileio import FileError, read_head
-from bt_lsp.syntax.kind import HEAD_CHARS, looks_like_bt, top_element
+from bt_lsp.syntax.kind import HEAD_CHARS, looks_like_bt, not_xml, top_element
 
 __all__ = ["SNIFF_BYTES", "head_of", "is_bt_file", "top_element"]
 
@@ -45,8 +45,9 @@ def is_bt_file(path: Path | str) -> bool:
     """Whether the file is to be checked as BehaviorTree.CPP XML when a folder is walked:
     what its content says (:func:`bt_lsp.syntax.kind.looks_like_bt`, the decision the
     workspace and the editor make too).  A file that cannot be read counts as one, so
-    that reading it reports the error."""
+    that reading it reports the error, and so does a file that is not XML at all
+    (:func:`bt_lsp.syntax.kind.not_xml`: empty, or broken before its first tag closes)."""
     head = head_of(path, 4 * HEAD_CHARS)
     if head is None:
         return True
-    return looks_like_bt(head)
+    return looks_like_bt(head) or not_xml(head)

@@ -26,7 +26,14 @@ from __future__ import annotations
 import re
 from typing import Final
 
-__all__ = ["HEAD_CHARS", "bt_evidence_end", "looks_like_bt", "top_element", "top_element_span"]
+__all__ = [
+    "HEAD_CHARS",
+    "bt_evidence_end",
+    "looks_like_bt",
+    "not_xml",
+    "top_element",
+    "top_element_span",
+]
 
 # How many characters of a text the decision looks at; a file is sniffed from its first
 # 4 * HEAD_CHARS bytes (at most 4 bytes a character in every encoding XML uses).
@@ -72,3 +79,20 @@ def bt_evidence_end(text: str) -> int:
 def looks_like_bt(text: str) -> bool:
     """Whether a text is BehaviorTree.CPP XML (see the module)."""
     return bt_evidence_end(text) >= 0
+
+
+def not_xml(text: str) -> bool:
+    """Whether a text is not XML at all: empty or blank, with no element, or whose top
+    element's start tag never closes in the head (``<not valid xml!!!``).
+
+    Such a file belongs to no tool, and every reader fails on it (BehaviorTree.CPP's
+    ``loadFromText`` throws "Error parsing the XML"), so a folder walk checks it rather
+    than skipping it silently.  The editor does not use this: a file the user has just
+    created is empty, and it is not an error yet."""
+    head = text[:HEAD_CHARS]
+    if not head.strip() or head.strip() == "\ufeff":
+        return True
+    top = top_element_span(head)
+    if top is None:
+        return True
+    return ">" not in head[top[1] :]

@@ -285,7 +285,13 @@ _ID_TAGS: Final = EXPLICIT_TAGS | {"SubTree"}
 def check_root(st: State) -> None:
     root = st.model.root  # the first element, when there is one
     if root is None:
-        st.add(0, 0, "root-element", "The document has no <root> element")
+        st.add(
+            0,
+            0,
+            "root-element",
+            "The document has no <root> element; BehaviorTree.CPP fails to load it "
+            "('Error parsing the XML')",
+        )
         return
     if root.name != "root":
         st.add(
