@@ -37,14 +37,6 @@ _MUTABLE: tuple[type, ...] = (
 ALLOWED: dict[str, str] = {
     # (The registry of diagnostic codes, rules.codes._DEFINED, is filled while the rule
     # modules are imported and made a read-only view once rules.registry imported them.)
-    # Constant tables, never written after import, in files other changes are editing:
-    # to be made MappingProxyType once those are merged.
-    "bt_lsp.rules.names.NAME_FIX_TITLES": "constant table",
-    "bt_lsp.rules.names._REASONS": "constant table",
-    "bt_lsp.rules.names._CHAR_INFO": "constant table, completed at import",
-    "bt_lsp.rules.names.RULES": "constant table",
-    "bt_lsp.rules.semantics.ports._RESERVED_LOWER": "constant table",
-    "bt_lsp.rules.semantics.ports.V3_ATTRIBUTES": "constant table",
     # The one empty result, shared by every section without findings; it refuses to grow.
     "bt_lsp.rules.diagnostics.NO_DIAGNOSTICS": "empty, immutable in effect",
     # Memos of pure functions of strings with immutable results, bounded:

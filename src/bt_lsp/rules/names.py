@@ -48,14 +48,16 @@ class NameData(FixData):
 #: is renamed with it.  A name whose target bt-lsp cannot rename with it (a node type
 #: registered in C++ or in an installed catalog) is offered in the editor only: applied
 #: alone, the rename would break the reference.
-NAME_FIX_TITLES: Final = {
-    "rename": safe("Rename '{old}' to '{new}' ({where})"),
-    "clear": safe("Clear '{old}' ({where})"),
-    "rename-elsewhere": display_only(
-        "Rename '{old}' to '{new}' ({where}); {caution}",
-        "a node type registered in C++ or in an installed catalog, which bt-lsp cannot rename",
-    ),
-}
+NAME_FIX_TITLES: Final = MappingProxyType(
+    {
+        "rename": safe("Rename '{old}' to '{new}' ({where})"),
+        "clear": safe("Clear '{old}' ({where})"),
+        "rename-elsewhere": display_only(
+            "Rename '{old}' to '{new}' ({where}); {caution}",
+            "a node type registered in C++ or in an installed catalog, which bt-lsp cannot rename",
+        ),
+    }
+)
 
 # The versions the name rules apply to (the ``since`` of each code's page).
 _NAME_RULES_SINCE: Final = (
@@ -414,23 +416,25 @@ _PERIOD = "period"
 _CONTROL = "control character"
 
 # category -> (the seed table's reason, a clause explaining it in a message)
-_REASONS: Final[dict[str, tuple[str, str]]] = {
-    _WHITESPACE: (
-        "breaks XML element/attribute names",
-        "whitespace breaks XML element/attribute names",
-    ),
-    _XML_SPECIAL: ("reserved in XML", "XML special characters are reserved in XML"),
-    _PATH: ("filesystem conflicts", "path separators cause filesystem conflicts"),
-    _WILDCARD: ("shell/glob conflicts", "wildcards cause shell/glob conflicts"),
-    _PERIOD: (
-        "ambiguous in port names (e.g. request.name)",
-        "a period is ambiguous in names (e.g. request.name)",
-    ),
-    _CONTROL: ("non-printable", "control characters are non-printable"),
-}
+_REASONS: Final[Mapping[str, tuple[str, str]]] = MappingProxyType(
+    {
+        _WHITESPACE: (
+            "breaks XML element/attribute names",
+            "whitespace breaks XML element/attribute names",
+        ),
+        _XML_SPECIAL: ("reserved in XML", "XML special characters are reserved in XML"),
+        _PATH: ("filesystem conflicts", "path separators cause filesystem conflicts"),
+        _WILDCARD: ("shell/glob conflicts", "wildcards cause shell/glob conflicts"),
+        _PERIOD: (
+            "ambiguous in port names (e.g. request.name)",
+            "a period is ambiguous in names (e.g. request.name)",
+        ),
+        _CONTROL: ("non-printable", "control characters are non-printable"),
+    }
+)
 
 # char -> (category, visible name)
-_CHAR_INFO: Final[dict[str, tuple[str, str]]] = {
+_CHAR_INFO_TABLE: dict[str, tuple[str, str]] = {
     " ": (_WHITESPACE, "space"),
     "\t": (_WHITESPACE, "tab"),
     "\n": (_WHITESPACE, "line feed"),
@@ -449,8 +453,10 @@ _CHAR_INFO: Final[dict[str, tuple[str, str]]] = {
     ".": (_PERIOD, "period"),
 }
 for _code in (*range(0x20), 0x7F):
-    _CHAR_INFO.setdefault(chr(_code), (_CONTROL, "control character"))
+    _CHAR_INFO_TABLE.setdefault(chr(_code), (_CONTROL, "control character"))
 del _code
+_CHAR_INFO: Final[Mapping[str, tuple[str, str]]] = MappingProxyType(_CHAR_INFO_TABLE)
+del _CHAR_INFO_TABLE
 
 # Any character forbidden in a model or port name (ASCII 0-31, 127 and the 16).
 _FORBIDDEN_RE: Final = re.compile(r"[\x00-\x1f\x7f \"&'./:<>?\\|*]")
@@ -541,26 +547,28 @@ _RULE_INSTANCE_CONTROL: Final = (
 )
 
 #: The rule each name code stands for, as stated in hover.
-RULES: Final[dict[str, str]] = {
-    "model-name-empty": _RULE_MODEL_EMPTY,
-    "model-name-reserved": _RULE_MODEL_RESERVED,
-    "model-name-forbidden-char": _RULE_MODEL_FORBIDDEN,
-    "port-name-empty": _RULE_PORT_EMPTY,
-    "port-name-leading-digit": _RULE_PORT_LEADING_DIGIT,
-    "port-name-reserved": _RULE_PORT_RESERVED_BTCPP,
-    "port-name-reserved-groot2": _RULE_PORT_RESERVED,
-    "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
-    "instance-name-control-char": _RULE_INSTANCE_CONTROL,
-    # Where names are born (bt_lsp.rules.cpp_names).
-    "cpp-model-name": (
-        "A node ID registered in C++ follows the model name rules, or a tree can name it "
-        "only in the explicit form <Action ID=...>."
-    ),
-    "cpp-port-name": (
-        "A port name in C++ starts with an ASCII letter, has no forbidden character and is "
-        "not a reserved attribute (BehaviorTree.CPP's IsAllowedPortName)."
-    ),
-}
+RULES: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        "model-name-empty": _RULE_MODEL_EMPTY,
+        "model-name-reserved": _RULE_MODEL_RESERVED,
+        "model-name-forbidden-char": _RULE_MODEL_FORBIDDEN,
+        "port-name-empty": _RULE_PORT_EMPTY,
+        "port-name-leading-digit": _RULE_PORT_LEADING_DIGIT,
+        "port-name-reserved": _RULE_PORT_RESERVED_BTCPP,
+        "port-name-reserved-groot2": _RULE_PORT_RESERVED,
+        "port-name-forbidden-char": _RULE_PORT_FORBIDDEN,
+        "instance-name-control-char": _RULE_INSTANCE_CONTROL,
+        # Where names are born (bt_lsp.rules.cpp_names).
+        "cpp-model-name": (
+            "A node ID registered in C++ follows the model name rules, or a tree can name it "
+            "only in the explicit form <Action ID=...>."
+        ),
+        "cpp-port-name": (
+            "A port name in C++ starts with an ASCII letter, has no forbidden character and is "
+            "not a reserved attribute (BehaviorTree.CPP's IsAllowedPortName)."
+        ),
+    }
+)
 
 
 # --- checks -------------------------------------------------------------------------------

@@ -329,11 +329,15 @@ SILENT_ATTRIBUTES: Final[frozenset[str]] = frozenset(
     {"_description", "_uid", "_fullpath", "_collapsed"}
 )
 _UNDERSCORE_RESERVED: Final[tuple[str, ...]] = (*PRECONDITIONS, *POSTCONDITIONS, "_autoremap")
-_RESERVED_LOWER: Final[dict[str, str]] = {n.lower(): n for n in _UNDERSCORE_RESERVED}
-V3_ATTRIBUTES: Final[dict[str, str]] = {
-    "__shared_blackboard": "_autoremap",
-    "__autoremap": "_autoremap",
-}
+_RESERVED_LOWER: Final[Mapping[str, str]] = MappingProxyType(
+    {n.lower(): n for n in _UNDERSCORE_RESERVED}
+)
+V3_ATTRIBUTES: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        "__shared_blackboard": "_autoremap",
+        "__autoremap": "_autoremap",
+    }
+)
 _BOOL_WORDS: Final = frozenset({"1", "0", "true", "false", "True", "False", "TRUE", "FALSE"})
 _TRUE_WORDS: Final = frozenset({"1", "true", "True", "TRUE"})
 
