@@ -140,6 +140,50 @@ def test_workspace_diagnostics_after_edits_equal_fresh_ones(seed: int, tmp_path:
             assert ws.diagnostics(path, doc) == fresh_ws.diagnostics(path, fresh[path])
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_workspace_diagnostics_of_snapshots_equal_fresh_ones(seed: int, tmp_path: Path) -> None:
+    """As the server analyses a large document: a snapshot of the open document, on which
+    the project's caches are kept, handed back to the open document afterwards; sometimes
+    the open document is edited again before (its snapshot's analysis is then of an older
+    text), and the other document's analysis follows an edit of either."""
+    rng = random.Random(400 + seed)
+    main, models = tmp_path / "main.xml", tmp_path / "models.xml"
+    main.write_text(MANY, encoding="utf-8")
+    models.write_text(MODELS, encoding="utf-8")
+    ws = ProjectIndex([tmp_path])
+    docs = {main: Document(MANY, str(main)), models: Document(MODELS, str(models))}
+    for path, doc in docs.items():
+        ws.open(path, doc)
+        ws.diagnostics(path, doc)
+    for _ in range(20):
+        edited = rng.choice((main, main, models))
+        doc = docs[edited]
+        _edit(rng, doc)
+        snap = doc.snapshot()
+        fresh_snap = Document(snap.text, str(edited))
+        if rng.random() < 0.3:
+            _edit(rng, doc)  # while the snapshot is analysed
+        got = ws.diagnostics(edited, snap)
+        doc.adopt(snap)
+        assert got == _fresh_diagnostics(tmp_path, docs, edited, fresh_snap)
+        other = models if edited == main else main
+        got = ws.diagnostics(other, docs[other].snapshot())
+        assert got == _fresh_diagnostics(
+            tmp_path, docs, other, Document(docs[other].text, str(other))
+        )
+
+
+def _fresh_diagnostics(
+    folder: Path, docs: dict[Path, Document], path: Path, doc: Document
+) -> list[Any]:
+    """The diagnostics of ``doc`` at ``path`` in a new workspace of ``folder`` where the
+    other documents are open with their texts now."""
+    ws = ProjectIndex([folder])
+    for p, d in docs.items():
+        ws.open(p, doc if p == path else Document(d.text, str(p)))
+    return ws.diagnostics(path, doc)
+
+
 @pytest.mark.parametrize("block", [1, 2, 3, 7])
 def test_token_starts_in_small_blocks(block: int, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(scanner.Starts, "BLOCK", block)

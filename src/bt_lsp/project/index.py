@@ -508,7 +508,7 @@ class ProjectIndex:
         # Another workspace package's catalogs are not this document's unless it depends
         # on that package.
         skip.update(self.unrelated_catalogs(path))
-        shared, includers = self._shared(frozenset(skip))
+        shared, includers = self._shared(frozenset(skip), (path, doc))
         included_by = [str(p) for p in includers.get(path, ()) if p not in in_closure]
         detected = self.btcpp_for(path, doc)
         ctx = shared.context(
@@ -520,7 +520,7 @@ class ProjectIndex:
             ros_models=ros_models,
             included_by=included_by,
             btcpp_version=detected.version,
-            foreign=self._foreign(path),
+            foreign=self._foreign(path, doc),
             btcpp_unclear=detected.conflict,
         )
         if self.cpp is not None:
@@ -529,24 +529,46 @@ class ProjectIndex:
             )
         return ctx
 
-    def _check_shared(self) -> None:
-        """Forget what :meth:`_shared` and :meth:`other_documents` made once a file
-        changed or an open document was edited."""
-        stamp = (self.generation, tuple(self._open), tuple(d.model for d in self._open.values()))
-        if self._shared_stamp is None or not _same(self._shared_stamp, stamp):
+    def _check_shared(self, own: Path | None = None, doc: Document | None = None) -> None:
+        """Forget what :meth:`_shared`, :meth:`_foreign` and :meth:`other_documents` made
+        once a file changed or an open document was edited.
+
+        ``own`` is the document they are asked for (``doc``: its text being analysed, a
+        snapshot of the open one).  What they made leaves its own declarations out of
+        what they give for it, so an edit of ``own`` alone keeps them for it, and its open
+        document's model is not made here: the analysis of a snapshot on the worker
+        thread made the open document's model as well (a second one, which the open
+        document then kept instead of the snapshot's, so that the next edit's model
+        shared no section with the last one analysed), and every edit combined the
+        workspace again for the one document in it."""
+        models = tuple(
+            (None if doc is None else doc.model) if p == own else d.model
+            for p, d in self._open.items()
+        )
+        stamp = (self.generation, tuple(self._open), models)
+        old = self._shared_stamp
+        if old is None or not _same(old, stamp, own):
             self._shared_by_skip.clear()
             self._foreign_by_packages.clear()
             self._documents_by_name = None
+            # Its slot holds the model its caches were made from, or None: unknown (a
+            # check for another document then finds it changed).
             self._shared_stamp = stamp
 
-    def _shared(self, skip: frozenset[Path]) -> tuple[SharedDecls, Mapping[Path, list[Path]]]:
+    def _shared(
+        self, skip: frozenset[Path], own: tuple[Path, Document] | None = None
+    ) -> tuple[SharedDecls, Mapping[Path, list[Path]]]:
         """The workspace's BT documents but ``skip``, combined once while none of them
-        changes, and who includes whom among them (the includers of each path, in order)."""
-        self._check_shared()
+        changes, and who includes whom among them (the includers of each path, in order).
+        ``own``: the document asked for and its text being analysed (see
+        :meth:`_check_shared`), which stands for the open document at its path."""
+        self._check_shared(*(own or (None, None)))
         hit = self._shared_by_skip.get(skip)
         if hit is not None:
             return hit
         docs = [(p, d) for p, d in self.bt_documents() if p not in skip]
+        if own is not None and own[0] in self._open:
+            docs = [(p, own[1] if p == own[0] else d) for p, d in docs]
         includers: dict[Path, list[Path]] = {}
         for p, d in docs:
             for target in dict.fromkeys(i.target for i in self.includes(p, d)):
@@ -636,7 +658,7 @@ class ProjectIndex:
                 out.update(normalize(p) for p in self.ros.catalogs(folder))
         return out
 
-    def _foreign(self, path: Path) -> frozenset[str]:
+    def _foreign(self, path: Path, doc: Document | None = None) -> frozenset[str]:
         """The workspace's BT files whose models do not count for the file at ``path``:
         those of packages its package neither is nor depends on (see :meth:`_unrelated`);
         made once per package while no file changes, so that a folder's check stays
@@ -644,7 +666,7 @@ class ProjectIndex:
         mine = frozenset(self.package_folders(path))
         if not mine:
             return frozenset()
-        self._check_shared()
+        self._check_shared(path, doc)  # (``path`` itself is never foreign to itself)
         hit = self._foreign_by_packages.get(mine)
         if hit is None:
             hit = frozenset(str(p) for p, _ in self.bt_documents() if self._unrelated(p, mine))
@@ -705,13 +727,14 @@ class ProjectIndex:
         out.sort(key=lambda d: (d.start, d.end, d.code))
         out = limited(out)
         if any(d.is_name_rule for d in out):  # where a name must change first, if not here
-            out = with_targets(doc, out, self.other_documents(path), ctx.models)
+            out = with_targets(doc, out, self.other_documents(path, doc), ctx.models)
         return out
 
-    def other_documents(self, path: Path) -> dict[str, Document]:
+    def other_documents(self, path: Path, doc: Document | None = None) -> dict[str, Document]:
         """The other BT documents of the workspace (open ones as edited), by path: what a
-        rename or a name fix of the document at ``path`` reaches and checks."""
-        self._check_shared()
+        rename or a name fix of the document at ``path`` (``doc``: its text in use, see
+        :meth:`_check_shared`) reaches and checks."""
+        self._check_shared(path, doc)  # (the document itself is left out)
         if self._documents_by_name is None:
             self._documents_by_name = {str(p): d for p, d in self.bt_documents()}
         out = dict(self._documents_by_name)  # copied whole (in C), then less one
@@ -732,11 +755,18 @@ def _stamp(path: Path) -> tuple[int, int]:
     return (st.st_mtime_ns, st.st_size)
 
 
-def _same(a: tuple[object, ...], b: tuple[object, ...]) -> bool:
-    """Whether two stamps of :meth:`ProjectIndex._shared` are the same: equal generations
-    and open paths, and the same model objects (compared by identity)."""
-    return (
-        a[0] == b[0] and a[1] == b[1] and all(x is y for x, y in zip(a[2], b[2], strict=True))  # type: ignore[call-overload]
+def _same(a: tuple[object, ...], b: tuple[object, ...], own: Path | None) -> bool:
+    """Whether two stamps of :meth:`ProjectIndex._check_shared` are the same: equal
+    generations and open paths, and the same model objects (compared by identity) but
+    that of the open document at ``own``."""
+    if a[0] != b[0] or a[1] != b[1]:
+        return False
+    paths = b[1]
+    assert isinstance(paths, tuple)
+    skip = paths.index(own) if own in paths else -1
+    return all(
+        x is y or k == skip
+        for k, (x, y) in enumerate(zip(a[2], b[2], strict=True))  # type: ignore[call-overload]
     )
 
 
