@@ -173,6 +173,34 @@ def test_workspace_diagnostics_of_snapshots_equal_fresh_ones(seed: int, tmp_path
         )
 
 
+def test_a_lookup_that_missed_counts_when_declared_after_other_changes() -> None:
+    """A tree's lookup that found nothing (the ``<SubTree>`` model of T3) still counts
+    once the entry is declared, after edits that re-checked other trees only (the check
+    keeps what the results it did not look at again missed)."""
+    text = (
+        '<root BTCPP_format="4" main_tree_to_execute="T0">\n'
+        '<BehaviorTree ID="T0"><Sequence><SubTree ID="T3" y="1"/><Wait/></Sequence>'
+        "</BehaviorTree>\n"
+        '<BehaviorTree ID="T1"><Sequence><SubTree ID="T4"/><Wait/></Sequence></BehaviorTree>\n'
+        '<BehaviorTree ID="T3"><AlwaysSuccess/></BehaviorTree>\n'
+        '<BehaviorTree ID="T4"><AlwaysSuccess/></BehaviorTree>\n'
+        '<TreeNodesModel><Action ID="Wait"/></TreeNodesModel>\n'
+        "</root>\n"
+    )
+    doc = Document(text)
+    assert analyze(doc) == []
+    tree4 = '<BehaviorTree ID="T4"><AlwaysSuccess/>'
+    for edit in ('<SubTree ID="T1"/>', "<Wait/>"):  # T4's calls change (T1 reads them)
+        at = doc.text.index(tree4) + len(tree4)
+        doc.edit(at, at, edit)
+        assert analyze(doc) == analyze(Document(doc.text))
+    at = doc.text.index('<Action ID="Wait"/>')
+    doc.edit(at, at, '<SubTree ID="T3"><input_port name="x"/></SubTree>')
+    found = analyze(doc)
+    assert found == analyze(Document(doc.text))
+    assert {"missing-required-port", "undeclared-port"} <= {d.code for d in found}
+
+
 def _fresh_diagnostics(
     folder: Path, docs: dict[Path, Document], path: Path, doc: Document
 ) -> list[Any]:

@@ -18,6 +18,7 @@ import pytest
 from bt_lsp.project import index as index_module
 from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules import shared_context
+from bt_lsp.rules.semantics import sections as section_checks
 from bt_lsp.syntax.document import Document
 
 # Tree T0 is called by no other tree; each other Ti is called by T(i-1).  The models
@@ -109,3 +110,26 @@ def test_edits_of_the_only_open_document_combine_the_workspace_once(
     again = Document(doc.text, str(path))
     fresh.open(path, again)
     assert _analysed(ws, path, doc) == list(fresh.diagnostics(path, again))
+
+
+def test_typing_in_a_tree_no_other_calls_checks_that_tree_alone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The ID of the tree typed in is new to the entries that the sections' results read
+    (no other tree calls T0): the other sections are not looked at."""
+    ws, path, doc = _workspace(tmp_path)
+    looked = itertools.count()
+    real = section_checks._unaffected
+
+    def counted(*args: object) -> bool:
+        next(looked)
+        return real(*args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(section_checks, "_unaffected", counted)
+    _type(doc, 'name="s0"')
+    got = _analysed(ws, path, doc)
+    assert next(looked) == 0
+    fresh = ProjectIndex([tmp_path])
+    again = Document(doc.text, str(path))
+    fresh.open(path, again)
+    assert got == list(fresh.diagnostics(path, again))

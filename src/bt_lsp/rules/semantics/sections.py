@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Final, TypeVar, cast
 
 from bt_lsp.rules.context import Context, ModelDecl, TreeDecl
 from bt_lsp.rules.diagnostics import Diagnostic, capped
-from bt_lsp.rules.facts import local_facts
+from bt_lsp.rules.facts import facts_of, local_facts
 from bt_lsp.rules.section_diff import common_ends
 from bt_lsp.rules.semantics.base import State, TagFindings
 from bt_lsp.syntax.elements import Element
@@ -138,7 +138,13 @@ class _History:
     looked up by its sections and found (so that the next check compares each entry once;
     most lookups find nothing, and a key absent from these counts as absent then), what
     the context was combined from besides the document itself, and its sections (all of
-    them valid then), with those that have diagnostics and those that name lines."""
+    them valid then), with those that have diagnostics and those that name lines.
+
+    Besides the entries looked up, ``sigs`` holds those of every ID the document declared
+    when every section was last looked at: the first edit of a section compares the
+    entries of what it declares with what they were, where an entry nobody had looked up
+    (the ID of a tree no other tree calls) counted as absent then, hence changed, and
+    made the check look at every section."""
 
     settings: tuple[object, ...] = ()
     sigs: tuple[dict[str | None, object], ...] = dataclasses.field(
@@ -267,6 +273,13 @@ def check_sections(st: State, check: Callable[[State, Sequence[Element]], None])
                 for d in entry.out
             )
     hist.settings = settings
+    if not same:  # the entries of what the document declares (see _History)
+        own = facts_of(st.doc, ctx.path)
+        ids = {t.id for t in own.trees}
+        ids.update(m.id for m in (*own.models, *own.subtree_models))
+        for key in ids:
+            for f in range(len(_FIELDS)):
+                current(f, key)
     for sigs, now in zip(hist.sigs, memo, strict=True):
         for looked, sig in now.items():
             if sig is None:
