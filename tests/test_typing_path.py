@@ -20,6 +20,7 @@ from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules import shared_context
 from bt_lsp.rules.semantics import sections as section_checks
 from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.table import ElementTable
 
 # Tree T0 is called by no other tree; each other Ti is called by T(i-1).  The models
 # section has long elements, which its table keeps once made.
@@ -133,3 +134,28 @@ def test_typing_in_a_tree_no_other_calls_checks_that_tree_alone(
     again = Document(doc.text, str(path))
     fresh.open(path, again)
     assert got == list(fresh.diagnostics(path, again))
+
+
+def test_an_edit_before_a_section_that_keeps_its_elements_makes_only_its_top(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The root's ``<TreeNodesModel>``, moved by an edit before it, is read without making
+    every element of its section."""
+    doc = Document(TEXT)
+    (models,) = doc.model.root_children_named(("TreeNodesModel",))
+    section = doc.model.sections[-1]
+    assert section.elements.kept and len(section.elements) > 30
+    _type(doc, 'name="s2"')
+    kept = itertools.count()
+    real = ElementTable._kept
+
+    def counted(self: ElementTable) -> object:
+        next(kept)
+        return real(self)
+
+    monkeypatch.setattr(ElementTable, "_kept", counted)
+    (moved,) = doc.model.root_children_named(("TreeNodesModel",))
+    assert next(kept) == 0
+    assert moved.token_start == models.token_start + 1
+    assert moved.attrs == models.attrs
+    assert list(moved.children) == list(models.children)

@@ -430,11 +430,13 @@ class Part:
 
 def section_top(sec: Section, origin: int, tok_origin: int, elem_base: int) -> Element:
     """A section's top element in document coordinates (kept on the section while it
-    stays where it is)."""
+    stays where it is).  Made alone: the elements of a section that keeps them would all
+    be made to read the first (at every edit before a large ``<TreeNodesModel>``, which
+    the edit moves)."""
     hit: tuple[int, int, int, Element] | None = sec.cache.get("top")
     if hit is not None and hit[0] == origin and hit[1] == tok_origin and hit[2] == elem_base:
         return hit[3]
-    el = sec.elements.placed(origin, tok_origin, elem_base)[0]
+    el = sec.elements.placed(origin, tok_origin, elem_base, keep=False)[0]
     sec.cache["top"] = (origin, tok_origin, elem_base, el)
     return el
 

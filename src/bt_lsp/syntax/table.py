@@ -464,10 +464,20 @@ class ElementTable(Sequence[Element]):
         ``columns.starts[rows[i]] + origin``."""
         return self._place.origin
 
-    def placed(self, origin: int, tok_origin: int, base: int) -> ElementTable:
-        """The same rows placed elsewhere."""
+    def placed(
+        self, origin: int, tok_origin: int, base: int, keep: bool | None = None
+    ) -> ElementTable:
+        """The same rows placed elsewhere (their elements kept once made as here, or as
+        ``keep`` says: ``False`` for a table read once, whose kept elements would all be
+        made to read one)."""
         return ElementTable(
-            self._place.cols, origin, tok_origin, base, self._lo, self._hi, self._keep
+            self._place.cols,
+            origin,
+            tok_origin,
+            base,
+            self._lo,
+            self._hi,
+            self._keep if keep is None else keep,
         )
 
     def __len__(self) -> int:
