@@ -64,54 +64,60 @@ class _Candidates(Generic[D]):
 
 
 class _WorkspaceTrees(Mapping[str, tuple[TreeDecl, ...]]):
-    """The shared documents' trees by ID, without those of the documents at ``hit``."""
+    """The shared documents' trees by ID, without those of the documents at ``hit``.  An
+    entry is made when first looked up: the document being checked is one of ``hit``, and
+    patching every tree ID it declares (thousands) at every edit cost more than the
+    lookups of the sections an edit checks again."""
 
-    __slots__ = ("_groups", "_hit", "_patch", "_shared", "_whole")
+    __slots__ = ("_groups", "_hit", "_patch", "_positions", "_shared", "_whole")
 
     def __init__(
         self,
         shared: dict[str, tuple[TreeDecl, ...]],
         positions: Mapping[str, tuple[int, ...]],
         groups: Sequence[tuple[TreeDecl, ...]],
-        hit: Collection[int],
+        hit: frozenset[int],
     ) -> None:
         self._shared = shared
+        self._positions = positions
         self._groups = groups
         self._hit = hit
         self._whole: dict[str, tuple[TreeDecl, ...]] | None = None
-        # The IDs the excluded documents declare: their entries without them (None: none).
+        # The entries looked up so far whose declarations the documents at ``hit`` share
+        # (None: they made them all).
         self._patch: dict[str, tuple[TreeDecl, ...] | None] = {}
-        for i in hit:
-            for t in groups[i]:
-                if t.id in self._patch:
-                    continue
-                kept = tuple(
-                    d for d, at in zip(shared[t.id], positions[t.id], strict=True) if at not in hit
-                )
-                self._patch[t.id] = kept or None
         if not hit:
             self._whole = shared
 
-    def __getitem__(self, key: str) -> tuple[TreeDecl, ...]:
-        if key in self._patch:
-            found = self._patch[key]
-            if found is None:
-                raise KeyError(key)
+    def _entry(self, key: str) -> tuple[TreeDecl, ...] | None:
+        """The entry of ``key``, ``None`` if there is none."""
+        found = self._shared.get(key)
+        if found is None or self._whole is self._shared:
             return found
-        return self._shared[key]
+        patch = self._patch
+        if key in patch:
+            return patch[key]
+        hit = self._hit
+        at = self._positions[key]
+        if not hit.isdisjoint(at):
+            found = tuple(d for d, i in zip(found, at, strict=True) if i not in hit) or None
+        patch[key] = found
+        return found
+
+    def __getitem__(self, key: str) -> tuple[TreeDecl, ...]:
+        found = self._entry(key)
+        if found is None:
+            raise KeyError(key)
+        return found
 
     def get(  # type: ignore[override]
         self, key: str, default: tuple[TreeDecl, ...] | None = None
     ) -> tuple[TreeDecl, ...] | None:
-        if key in self._patch:
-            found = self._patch[key]
-            return default if found is None else found
-        return self._shared.get(key, default)
+        found = self._entry(key) if isinstance(key, str) else None
+        return default if found is None else found
 
     def __contains__(self, key: object) -> bool:
-        if isinstance(key, str) and key in self._patch:
-            return self._patch[key] is not None
-        return key in self._shared
+        return isinstance(key, str) and self._entry(key) is not None
 
     def _all(self) -> dict[str, tuple[TreeDecl, ...]]:
         """The whole mapping, in the order ``combine`` makes it (made when iterated)."""
