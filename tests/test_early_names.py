@@ -90,6 +90,23 @@ def test_every_role_is_reported_as_the_full_analysis_reports_it() -> None:
     )
 
 
+def test_the_instance_names_checked_together_are_placed_each_on_its_node() -> None:
+    """The instance names are searched in one string, joined by line feeds: a name that
+    holds a line feed (a character reference) or ends the document's list is placed on
+    its own node, a bad name beside a good one on the same tag too."""
+    names = [f"node {i}" for i in range(300)]
+    names[0] = "first\x7f"
+    names[17] = "line&#10;feed"  # (the joining character, allowed)
+    names[18] = "after a&#10;line feed &#127;"
+    names[150] = "&#127;"
+    names[-1] = "last \x7f"
+    nodes = "".join(f'<Sequence name="{n}"><AlwaysSuccess name="ok"/></Sequence>' for n in names)
+    text = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{nodes}</BehaviorTree></root>'
+    found = early(text)
+    assert found == full_names(text)
+    assert [text[d.start : d.end] for d in found] == [names[k] for k in (0, 18, 150, 299)]
+
+
 def test_a_clean_document_has_none() -> None:
     text = '<root BTCPP_format="4"><BehaviorTree ID="Main"><AlwaysSuccess/></BehaviorTree></root>'
     assert early(text) == [] == full_names(text)

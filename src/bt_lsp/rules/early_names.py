@@ -21,8 +21,8 @@ Parsing reads nothing but the text: no DTD, no entities, no network.
 from __future__ import annotations
 
 import re
-from bisect import bisect_right
-from itertools import islice
+from bisect import bisect_left, bisect_right
+from itertools import accumulate, islice
 from typing import cast
 
 from lxml import etree
@@ -38,6 +38,7 @@ from bt_lsp.rules.names import (
     RESERVED_PORT_NAMES,
     NameKind,
     all_valid_port_uses,
+    instance_rule_breaks,
     may_hold_bad_instance_name,
 )
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element, Role, Zone, zone_in
@@ -46,7 +47,7 @@ from bt_lsp.syntax.tag_limits import MAX_ATTRS
 
 __all__ = ["early_name_diagnostics"]
 
-_MODEL, _PORT, _INSTANCE = NameKind.MODEL, NameKind.PORT, NameKind.INSTANCE
+_MODEL, _PORT = NameKind.MODEL, NameKind.PORT
 _NODE, _TREE, _ENTRY, _PORT_DECL = Zone.NODE, Zone.TREE, Zone.MODEL_ENTRY, Zone.PORT_DECL
 # A tag that names its node type by its ID attribute rather than by itself.
 _BY_ID = EXPLICIT_TAGS | {"SubTree"}
@@ -54,9 +55,23 @@ _BY_ID = EXPLICIT_TAGS | {"SubTree"}
 
 class _Reader:
     """An lxml parser target: follows each element's zone and notes those with a name
-    that breaks a rule (a superset of what the model reports: the model decides)."""
+    that breaks a rule (a superset of what the model reports: the model decides).
 
-    __slots__ = ("count", "good_keys", "good_models", "instances", "memo", "stack", "suspects")
+    It runs once per element of the document, so the usual element (a node of a known
+    type with known attributes) costs a few set lookups: the instance names are only
+    collected, and checked together at the end (:meth:`bad_instances`)."""
+
+    __slots__ = (
+        "count",
+        "good_keys",
+        "good_models",
+        "instances",
+        "memo",
+        "named",
+        "names",
+        "stack",
+        "suspects",
+    )
 
     def __init__(self, instances: bool) -> None:
         self.instances = instances  # whether instance names can break their rule here
@@ -68,6 +83,10 @@ class _Reader:
         self.good_models: set[str] = set(_BY_ID)
         self.good_keys: set[str] = set(RESERVED_PORT_NAMES)
         self.memo = NameMemo()  # what the name rules found, for this pass
+        # The instance names of the nodes (with ``instances``) and the elements holding
+        # them, index for index.
+        self.names: list[str] = []
+        self.named: list[int] = []
 
     def start(self, tag: str, attrib: dict[str, str]) -> None:
         index = self.count
@@ -80,15 +99,32 @@ class _Reader:
             parent, zone = -1, Zone.ROOT
         stack.append((index, zone))
         if zone is _NODE:
-            # Most nodes of a large document: a known type without attributes.
-            if not attrib and tag in self.good_models:
+            good_models = self.good_models
+            if not attrib:  # many nodes of a large document: a known type alone
+                if tag not in good_models:
+                    self._node_type(tag, index, parent)
                 return
-            suspect = self._node_suspect(tag, attrib)
-        elif zone in (_TREE, _ENTRY):
+            if tag not in good_models and self._node_type(tag, index, parent):
+                return
+            if not self.good_keys.issuperset(attrib) and self._node_keys(attrib, index, parent):
+                return  # (most tags have known attributes only: no set is made)
             value = attrib.get("ID")
-            role = Role.TREE_DEF if zone == _TREE else Role.MODEL_DEF
+            if value is not None and value not in good_models:
+                if violations(value, _MODEL, Role.NODE_ID, self.memo):
+                    self.suspects.append((index, zone, parent))
+                    return
+                good_models.add(value)
+            if self.instances:
+                value = attrib.get("name")
+                if value is not None:
+                    self.names.append(value)
+                    self.named.append(index)
+            return
+        if zone is _TREE or zone is _ENTRY:
+            value = attrib.get("ID")
+            role = Role.TREE_DEF if zone is _TREE else Role.MODEL_DEF
             suspect = value is not None and bool(violations(value, _MODEL, role, self.memo))
-        elif zone == _PORT_DECL:
+        elif zone is _PORT_DECL:
             value = attrib.get("name")
             suspect = value is not None and bool(
                 violations(value, _PORT, Role.PORT_DECL, self.memo)
@@ -98,29 +134,27 @@ class _Reader:
         if suspect:
             self.suspects.append((index, zone, parent))
 
-    def _node_suspect(self, tag: str, attrib: dict[str, str]) -> bool:
-        good_models, good_keys = self.good_models, self.good_keys
-        if tag not in good_models:
-            if violations(tag, _MODEL, Role.NODE_TYPE, self.memo):
+    def _node_type(self, tag: str, index: int, parent: int) -> bool:
+        """Whether node type ``tag`` (new to the pass) breaks a rule: the node is noted
+        as a suspect if so, the type as good if not."""
+        if violations(tag, _MODEL, Role.NODE_TYPE, self.memo):
+            self.suspects.append((index, _NODE, parent))
+            return True
+        self.good_models.add(tag)
+        return False
+
+    def _node_keys(self, attrib: dict[str, str], index: int, parent: int) -> bool:
+        """Whether an attribute name of a node, among those new to the pass, breaks the
+        port rule (the model keeps a tag's first MAX_ATTRS attributes; the rest are only
+        counted): as :meth:`_node_type`."""
+        keys = attrib.keys() if len(attrib) <= MAX_ATTRS else islice(attrib, MAX_ATTRS)
+        new_keys = set(keys) - self.good_keys
+        if new_keys:
+            if not all_valid_port_uses(new_keys):
+                self.suspects.append((index, _NODE, parent))
                 return True
-            good_models.add(tag)
-        # The model keeps a tag's first MAX_ATTRS attributes (the rest are only counted).
-        if not good_keys.issuperset(attrib):  # (most tags: known attributes, no new set)
-            keys = attrib.keys() if len(attrib) <= MAX_ATTRS else islice(attrib, MAX_ATTRS)
-            new_keys = set(keys) - good_keys
-            if new_keys:
-                if not all_valid_port_uses(new_keys):
-                    return True
-                good_keys |= new_keys
-        value = attrib.get("ID")
-        if value is not None and value not in good_models:
-            if violations(value, _MODEL, Role.NODE_ID, self.memo):
-                return True
-            good_models.add(value)
-        if not self.instances:
-            return False
-        value = attrib.get("name")
-        return value is not None and bool(violations(value, _INSTANCE, Role.INSTANCE, self.memo))
+            self.good_keys |= new_keys
+        return False
 
     def end(self, tag: str) -> None:
         self.stack.pop()
@@ -128,25 +162,41 @@ class _Reader:
     def close(self) -> None:
         return None
 
+    def bad_instances(self) -> list[int]:
+        """The nodes whose instance name breaks its rule, found in one search of all the
+        names, joined by line feeds (which the rule allows)."""
+        names = self.names
+        found = list(instance_rule_breaks("\n".join(names)))
+        if not found:
+            return []
+        ends = list(accumulate(len(n) + 1 for n in names))  # where each name's "\n" ends
+        named = self.named
+        return list(dict.fromkeys(named[bisect_right(ends, at)] for at in found))
+
 
 # In well-formed XML without a DOCTYPE, every '<' starts a tag, a comment, a CDATA section
 # or a processing instruction, except within the last three.
 _START_TAG = re.compile(r"<[^/!?]")
 _SKIPPED = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>", re.S)
+_MATCH_START = re.Match.start
 
 
 def _start_tags(text: str) -> list[int]:
-    """The offsets of the start tags of a well-formed ``text``, in document order."""
-    starts = [m.start() for m in _START_TAG.finditer(text)]
-    skipped = [m.span() for m in _SKIPPED.finditer(text)]
-    if skipped:
-        ends = [e for _, e in skipped]
-        starts = [
-            at
-            for at in starts
-            if (k := bisect_right(ends, at)) == len(skipped) or at < skipped[k][0]
-        ]
-    return starts
+    """The offsets of the start tags of a well-formed ``text``, in document order: those
+    of the pattern but the ones inside a comment, CDATA section or processing
+    instruction, cut out of the list in slices (a list of thousands, few cuts)."""
+    starts = list(map(_MATCH_START, _START_TAG.finditer(text)))
+    kept: list[int] = []
+    at = 0  # the first start not yet kept or dropped
+    for m in _SKIPPED.finditer(text):
+        begin, end = m.span()
+        inside = bisect_left(starts, begin, at)
+        kept += starts[at:inside]
+        at = bisect_left(starts, end, inside)
+    if not at:
+        return starts
+    kept += starts[at:]
+    return kept
 
 
 _PIECE = 1 << 16
@@ -192,6 +242,10 @@ def early_name_diagnostics(text: str) -> list[Diagnostic] | None:
     if len(parser.feed_error_log):  # e.g. an undeclared namespace prefix, which lxml drops
         return None
     suspects = reader.suspects
+    bad_instances = reader.bad_instances()
+    if bad_instances:
+        suspects.extend((index, _NODE, -1) for index in bad_instances)
+        suspects.sort()
     if len(suspects) >= MAX_DIAGNOSTICS:
         return None  # the complete set may leave some out (``limited``)
     if not suspects:

@@ -12,7 +12,7 @@ Offsets and columns are counted in code points within the name (0-based ``offset
 from __future__ import annotations
 
 import re
-from collections.abc import Collection, Mapping
+from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Final
@@ -671,6 +671,13 @@ def all_valid_port_uses(names: Collection[str]) -> bool:
     if _FORBIDDEN_RE.search("".join(names)) is not None:  # "\x00" among them
         return False
     return _EMPTY_OR_DIGIT_RE.search("\x00".join(names)) is None
+
+
+def instance_rule_breaks(text: str) -> Iterator[int]:
+    """The offsets of the characters of ``text`` that an instance name may not hold (the
+    instance rule of :func:`check_name`), in order: a pass may join many names in one
+    search (by a character the rule allows, such as a line feed)."""
+    return (m.start() for m in _INSTANCE_RE.finditer(text))
 
 
 def may_hold_bad_instance_name(text: str) -> bool:
