@@ -99,11 +99,11 @@ class _Reader:
             parent, zone = -1, Zone.ROOT
         stack.append((index, zone))
         if zone is _NODE:
-            good_models = self.good_models
             if not attrib:  # many nodes of a large document: a known type alone
-                if tag not in good_models:
+                if tag not in self.good_models:
                     self._node_type(tag, index, parent)
                 return
+            good_models = self.good_models
             if tag not in good_models and self._node_type(tag, index, parent):
                 return
             if not self.good_keys.issuperset(attrib) and self._node_keys(attrib, index, parent):
