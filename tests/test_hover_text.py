@@ -177,3 +177,26 @@ def test_markdown_hover_shows_special_characters_the_same_everywhere() -> None:
     plain = _hover(BAD_CHARS, "a*b", markdown=False)
     assert "path separators (/ \\ :), wildcards (* ? |)" in plain
     assert "'\\\\' (backslash)" in plain and "'*' (asterisk)" in plain
+
+
+def test_a_name_whose_backslash_inline_code_hides_is_shown_in_a_code_block() -> None:
+    """Neovim 0.7 hides a backslash before punctuation, a space or the closing backtick
+    even in inline code; a code block shows it in every client (the e2e test
+    test_hover_shows_markup_characters_as_written sees it in both Neovims)."""
+    for name in ("Main\\*Tree", "Main\\ Tree", "Main\\_Tree", "Main\\"):
+        text = (
+            f'<root BTCPP_format="4"><BehaviorTree ID="{name}"><AlwaysSuccess/>'
+            "</BehaviorTree></root>\n"
+        )
+        md = _hover(text, name)
+        assert md.splitlines()[:5] == [
+            "**Model name breaks the BehaviorTree.CPP naming rules:**",
+            "```text",
+            name,
+            "```",
+            "",
+        ], md
+        plain = _hover(text, name, markdown=False)
+        assert plain.startswith(f"Model name '{name}' breaks the BehaviorTree.CPP naming rules\n")
+    # A backslash before a letter shows in inline code everywhere.
+    assert _hover(BAD_CHARS, "a*b").startswith("**Model name `a*b\\c d` breaks")

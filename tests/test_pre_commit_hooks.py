@@ -1,7 +1,8 @@
 """The pre-commit hooks of ``.pre-commit-hooks.yaml``, run by the real ``pre-commit`` on a
 scratch repository, the way another project uses them: a bad tree ID blocks the commit, the
 fix hook renames it, and the XML that is not BehaviorTree.CPP's (``package.xml``) is never
-reported.
+reported.  The hooks get the committed files: a broken tree that the commit does not touch
+is not reported (nor fixed), while a SubTree that an untouched file defines still resolves.
 
 The hook repository is a fresh git repository holding this checkout's working tree (what
 ``pip install`` needs and the hooks file), so uncommitted changes are what is tested.
@@ -30,11 +31,19 @@ BAD = """\
   </BehaviorTree>
 </root>
 """
-# Defines the tree that BAD calls: the hooks check the repository as one workspace.
+# Defines the tree that BAD calls, committed before: each file is checked in its project.
 DOCK = """\
 <root BTCPP_format="4">
   <BehaviorTree ID="Dock">
     <AlwaysSuccess/>
+  </BehaviorTree>
+</root>
+"""
+# A broken tree committed before the hooks: a commit that does not touch it passes it by.
+OLD = """\
+<root BTCPP_format="4" main_tree_to_execute="Old Tree">
+  <BehaviorTree ID="Old Tree">
+    <SubTree ID="Gone"/>
   </BehaviorTree>
 </root>
 """
@@ -62,7 +71,12 @@ def test_hooks_file_defines_both_hooks() -> None:
     for hook in hooks.values():
         assert hook["language"] == "python"
         assert hook["files"] == r"\.xml$"
+        assert hook["types"] == ["xml"]
         assert hook["entry"].startswith("bt-lsp check")
+        # The changed files are passed, and left out as a walk over the folder would.
+        assert hook.get("pass_filenames", True) is True
+        assert "--force-exclude" in hook["entry"].split()
+        assert hook["require_serial"] is True
     assert "--fix" in hooks["bt-lsp-fix"]["entry"].split()
     assert "--fix" not in hooks["bt-lsp"]["entry"].split()
 
@@ -92,8 +106,14 @@ def test_a_bad_name_blocks_the_commit_and_the_fix_hook_repairs_it(tmp_path: Path
 
     project = tmp_path / "project"
     (project / "trees").mkdir(parents=True)
-    (project / "trees" / "main.xml").write_text(BAD, encoding="utf-8")
+    (project / "legacy").mkdir()
+    # Committed before the hooks are installed: files the next commits do not touch.
     (project / "trees" / "dock.xml").write_text(DOCK, encoding="utf-8")
+    (project / "legacy" / "old.xml").write_text(OLD, encoding="utf-8")
+    assert _git(project, "init", "-q", env=env).returncode == 0
+    for args in (["add", "-A"], ["commit", "-q", "-m", "before"]):
+        assert _git(project, *args, env=env).returncode == 0
+    (project / "trees" / "main.xml").write_text(BAD, encoding="utf-8")
     (project / "package.xml").write_text(PACKAGE, encoding="utf-8")
     config = project / ".pre-commit-config.yaml"
 
@@ -102,7 +122,6 @@ def test_a_bad_name_blocks_the_commit_and_the_fix_hook_repairs_it(tmp_path: Path
         config.write_text(yaml.safe_dump({"repos": [repo]}), encoding="utf-8")
 
     use("bt-lsp")
-    assert _git(project, "init", "-q", env=env).returncode == 0
     installed = subprocess.run(
         [sys.executable, "-m", "pre_commit", "install"],
         cwd=project,
@@ -122,7 +141,8 @@ def test_a_bad_name_blocks_the_commit_and_the_fix_hook_repairs_it(tmp_path: Path
     assert "model-name-forbidden-char" in out, out
     assert "package.xml" not in out, out
     assert "error unknown-subtree" not in out, out  # Dock is defined in dock.xml
-    assert _git(project, "rev-parse", "--verify", "-q", "HEAD", env=env).returncode != 0
+    assert "old.xml" not in out and "Old Tree" not in out, out  # not in the commit
+    assert _git(project, "rev-list", "--count", "HEAD", env=env).stdout.strip() == "1"
 
     # The fix hook: it renames the tree (and its use in main_tree_to_execute), which
     # pre-commit reports as a failure (files were modified); the fixed files then commit.
@@ -135,7 +155,17 @@ def test_a_bad_name_blocks_the_commit_and_the_fix_hook_repairs_it(tmp_path: Path
     assert 'ID="Main_Tree"' in text and 'main_tree_to_execute="Main_Tree"' in text, text
     assert "Main Tree" not in text
     assert (project / "package.xml").read_text(encoding="utf-8") == PACKAGE
+    assert (project / "legacy" / "old.xml").read_text(encoding="utf-8") == OLD
 
     assert _git(project, "add", "-A", env=env).returncode == 0
     committed = _git(project, "commit", "-m", "trees", env=env)
     assert committed.returncode == 0, committed.stdout + committed.stderr
+
+    # A commit of XML that is not BehaviorTree.CPP's only: the hook runs and passes.
+    use("bt-lsp")
+    (project / "package.xml").write_text(PACKAGE.replace("0.0.0", "0.0.1"), encoding="utf-8")
+    assert _git(project, "add", "-A", env=env).returncode == 0
+    only = _git(project, "commit", "-m", "version", env=env)
+    out = only.stdout + only.stderr
+    assert only.returncode == 0, out
+    assert "bt-lsp check" in out and "Passed" in out, out

@@ -381,6 +381,59 @@ def test_diagnostics_hover_and_quick_fix(tmp_path: Path, target: Target, text: s
     assert _warnings(run) == [], why
 
 
+# A tree ID with characters that Markdown reads as markup: a backslash before punctuation
+# (Neovim 0.7's Markdown syntax hides it, even in a code span) and an asterisk (emphasis).
+ODD = "Main\\*Tree"
+TREE_ODD = f"""\
+<root BTCPP_format="4" main_tree_to_execute="{ODD}">
+  <BehaviorTree ID="{ODD}">
+    <AlwaysSuccess/>
+  </BehaviorTree>
+</root>
+"""
+
+
+def test_hover_shows_markup_characters_as_written(tmp_path: Path, target: Target) -> None:
+    """The hover of a name with a backslash and an asterisk, as the float shows it (the
+    conceal of each Neovim's Markdown applied): the name, the rule's list of forbidden
+    characters and the list of the name's characters keep every character."""
+    nvim = _find_nvim(target)
+    ws = _workspace(tmp_path)
+    tree = ws / "trees" / "tree.xml"
+    tree.write_text(TREE_ODD, encoding="utf-8")
+    where = {
+        "BT_LSP_E2E_HOVER_CONTEXT": f'<BehaviorTree ID="{ODD}"',
+        "BT_LSP_E2E_HOVER_NEEDLE": ODD,
+    }
+    run = _run_nvim(tmp_path, nvim, tree, "hover", where)
+    why = run.explain()
+    hover = run.events["hover"]
+    window, seen = hover["window"], hover["seen"]
+    why += f"\n--- hover window\n{chr(10).join(window)}\n--- as shown\n{chr(10).join(seen)}"
+    assert len(seen) == len(window), why
+
+    assert ODD in hover["markdown"], why
+    assert any(ODD in line for line in window), why
+    assert any(ODD in line for line in seen), why  # the name, every character shown
+    rule = next(line for line in seen if "model-name-forbidden-char" in line)
+    assert "path separators (/ backslash :)" in rule, why
+    assert re.search(r"wildcards \(`?\*`? \? `?\|`?\)", rule), why
+    assert any(line.startswith("- column 5 ") and "U+005C (backslash)" in line for line in seen), (
+        why
+    )
+    # (Neovim 0.7 shows a code span's backticks, 0.11 hides them.)
+    assert any(
+        line.startswith("- column 6 ") and re.search(r"`?'\*'`? \(asterisk\)", line)
+        for line in seen
+    ), why
+    assert any(
+        line.startswith("Suggested replacement: ") and "Main_Tree" in line for line in seen
+    ), why
+
+    assert _server_complaints(run.lsp_log) == [], why
+    assert _warnings(run) == [], why
+
+
 def test_plain_xml_gets_no_client(tmp_path: Path, target: Target) -> None:
     nvim = _find_nvim(target)
     ws = _workspace(tmp_path)

@@ -53,11 +53,13 @@ from bt_lsp.cli.project import (
     BUILD_FOLDER,
     NOT_BT,
     config_errors,
+    forced_skip_reason,
     included_back,
     project_index,
     skip_reason,
     version_lines,
     workspace_lines,
+    workspaces,
 )
 from bt_lsp.cli.results import (
     FileResult,
@@ -114,6 +116,7 @@ class Options:
     output_format: OutputFormat = "concise"  # --output-format (text only)
     color: bool = False  # colour the text output (--color, NO_COLOR, FORCE_COLOR)
     statistics: bool = False  # --statistics: a count per code instead of the diagnostics
+    force_exclude: bool = False  # --force-exclude: a walk's exclusions for named files too
     started: float = field(default_factory=time.time)  # older temporaries are stale
 
 
@@ -357,10 +360,17 @@ def run(
             skipped[why] += 1
         return why is not None
 
+    given = paths
+    forced: set[str] = set()  # the named files that content alone may leave out
+    if options.force_exclude:
+        paths, forced = _force_exclude(paths, project, skipped)
     files, walk_errors = collect_files(paths, skip)
     named = {os.path.realpath(p) for p in paths if not os.path.isdir(p)}  # checked as given
-    not_bt = {p for p in not_bt if os.path.realpath(p) not in named}
-    not_bt -= included_back(project, files, not_bt)
+    not_bt = {p for p in not_bt if os.path.realpath(p) not in named} | forced
+    # A named file is checked if a file of its workspace includes it, as in a walk over
+    # the workspace; a walk's own files are the others it knows.
+    includers = [*files, *(str(p) for p, _ in project.bt_documents())] if forced else files
+    not_bt -= included_back(project, includers, not_bt)
     if not_bt:
         skipped[NOT_BT] += len(not_bt)
         files = [f for f in files if f not in not_bt]
@@ -394,17 +404,20 @@ def run(
     for e in walk_errors:
         say(err, f"bt-lsp: {e.message}\n")
     if not files and not configs:
+        # --force-exclude leaving out every file it was given (a pre-commit hook run on
+        # package.xml) is no mistake: nothing is said.
+        all_left_out = options.force_exclude and not any(os.path.isdir(p) for p in given)
         none = "no BehaviorTree.CPP XML files" if skipped else "no XML files"
-        if not options.quiet:
+        if options.verbose:
+            _skipped_lines(skipped, say, err)
+        if not options.quiet and not all_left_out:
             say(err, f"bt-lsp: {none} to check\n")
         if options.format != "text":  # still a document a reader can parse
             _report(out, options.format, [FileResult(e.path, error=e) for e in walk_errors])
         return 2 if walk_errors else 0
 
     if options.verbose:
-        for why, n in sorted(skipped.items()):
-            what = "folder" if why == BUILD_FOLDER else "file"
-            say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
+        _skipped_lines(skipped, say, err)
         for line in workspace_lines(paths):
             say(err, line + "\n")
         for line in version_lines(project, [f for f in files if f.endswith(".xml")]):
@@ -464,6 +477,34 @@ def run(
             text += f"; {plural(len(configs), 'configuration file')} could not be used"
         say(err, text + "\n")
     return exit_code(results)
+
+
+def _force_exclude(
+    paths: Sequence[str], project: ProjectIndex, skipped: Counter[str]
+) -> tuple[list[str], set[str]]:
+    """``--force-exclude``: the paths less the named files that a walk over their
+    workspace folder would leave out (counted in ``skipped``), and the named files kept
+    that are not BehaviorTree.CPP XML by their content (left out unless a file of the
+    workspace includes them)."""
+    root_of = {f: folder for folder, (_, named) in workspaces(paths).items() for f in named}
+    kept: list[str] = []
+    not_bt: set[str] = set()
+    for p in paths:
+        why = None if os.path.isdir(p) else forced_skip_reason(project, p, root_of[p])
+        if why is None or why == NOT_BT:
+            kept.append(p)
+            if why == NOT_BT:
+                not_bt.add(p)
+        else:
+            skipped[why] += 1
+    return kept, not_bt
+
+
+def _skipped_lines(skipped: Counter[str], say: Callable[[TextIO, str], None], err: TextIO) -> None:
+    """For ``--verbose``: how many folders and files were left out, and why."""
+    for why, n in sorted(skipped.items()):
+        what = "folder" if why == BUILD_FOLDER else "file"
+        say(err, f"bt-lsp: skipped {n} {what}{'s' if n != 1 else ''}: {why}\n")
 
 
 def _report(out: TextIO, format: Format, results: Sequence[FileResult]) -> None:

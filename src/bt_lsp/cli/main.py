@@ -165,6 +165,13 @@ def build_parser() -> argparse.ArgumentParser:
         "checked against",
     )
     check.add_argument(
+        "--force-exclude",
+        action="store_true",
+        help="leave out a file named on the command line as a walk over its workspace "
+        "would: in an exclude glob or a build, install, log, VCS or hidden folder, or not "
+        "BehaviorTree.CPP XML (for pre-commit hooks, which name the changed files)",
+    )
+    check.add_argument(
         "--follow-symlinks",
         action="store_true",
         help="with --fix, also rewrite files that a folder links to from outside it",
@@ -260,6 +267,7 @@ def _check(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         output_format=args.output_format or "concise",
         color=color,
         statistics=args.statistics,
+        force_exclude=args.force_exclude,
     )
     return check.run(args.paths, options)
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Final, Protocol
 
 from bt_lsp.project.config import MAX_DEPTH, ConfigError, Configs, Layer, excluded, find_config
+from bt_lsp.project.cpp_scan import CPP_SUFFIXES
 from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.project.settings import Settings
 from bt_lsp.project.sniff import is_bt_file
@@ -19,6 +20,7 @@ __all__ = [
     "NOT_BT",
     "WALK_SKIP_DIRS",
     "config_errors",
+    "forced_skip_reason",
     "included_back",
     "project_index",
     "skip_reason",
@@ -34,6 +36,8 @@ WALK_SKIP_DIRS: Final = frozenset({"build", "install", "log", ".git", "node_modu
 NOT_BT: Final = "not BehaviorTree.CPP XML"
 EXCLUDED: Final = "excluded"
 BUILD_FOLDER: Final = "build, install, log and VCS folders"
+IN_SKIPPED_FOLDER: Final = "in build, install, log, VCS or hidden folders"
+HIDDEN: Final = "hidden"
 
 
 class ProjectOptions(Protocol):
@@ -197,6 +201,30 @@ def skip_reason(workspace: ProjectIndex, path: str, is_dir: bool) -> str | None:
     return None if is_bt_file(p) else NOT_BT
 
 
+def forced_skip_reason(workspace: ProjectIndex, path: str, root: Path) -> str | None:
+    """``--force-exclude``: why a walk over ``root``, the workspace folder of ``path`` (a
+    file named on the command line), would leave the file out (``None``: it would check
+    it).  A folder on the way down from ``root`` that is hidden, a build or VCS folder or
+    an ``exclude`` glob leaves it out, and so do a hidden name, the file's own ``exclude``
+    glob and content that is not BehaviorTree.CPP XML (:func:`skip_reason`), so that
+    ``check --force-exclude FILE...`` (what a pre-commit hook runs with the changed files)
+    reports what ``check ROOT`` reports for them.  A C++ file is never sniffed."""
+    p = normalize(path)
+    parts = p.relative_to(root).parts if _under(p, root) else (p.name,)
+    folder = root
+    for name in parts[:-1]:
+        folder = folder / name
+        if name.startswith(".") or name in WALK_SKIP_DIRS:
+            return IN_SKIPPED_FOLDER
+        if skip_reason(workspace, str(folder), True) is not None:
+            return EXCLUDED
+    if p.name.startswith("."):
+        return HIDDEN
+    if p.suffix in CPP_SUFFIXES:
+        return EXCLUDED if excluded(p, workspace.settings_for(p).exclude) else None
+    return skip_reason(workspace, str(p), False)
+
+
 def included_back(workspace: ProjectIndex, files: Sequence[str], not_bt: Set[str]) -> set[str]:
     """The files of ``not_bt`` (skipped for their content) that one of the other
     ``files`` includes, directly or through others: BehaviorTree.CPP loads them as BT
@@ -206,7 +234,7 @@ def included_back(workspace: ProjectIndex, files: Sequence[str], not_bt: Set[str
     by_path = {normalize(f): f for f in not_bt}
     out: set[str] = set()
     for f in files:
-        if f in not_bt or not f.endswith(".xml"):
+        if not f.endswith(".xml") or normalize(f) in by_path:
             continue
         for p in workspace.include_closure(normalize(f)):
             hit = by_path.get(p)

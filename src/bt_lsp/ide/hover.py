@@ -9,7 +9,9 @@ same in every client that renders Markdown (:func:`markdown_safe`).  A backslash
 does not: Neovim 0.7 hides a backslash before punctuation or a space, even inside a code
 span, while Neovim 0.11 shows escapes as typed; and an unescaped ``*`` or ``_`` starts
 emphasis in Neovim 0.7's Markdown syntax.  So the Markdown-special characters go into
-code spans (which every client shows as typed), and a backslash is named.
+code spans (which every client shows as typed), and a backslash is named.  A name whose
+backslash Neovim 0.7 would hide in a code span is shown in a code block instead, which
+every client shows as typed (:meth:`_Writer.title_naming`).
 """
 
 from __future__ import annotations
@@ -57,6 +59,9 @@ def _visible(text: str) -> str:
 
 
 _INLINE_CODE_RE = re.compile(r"`+ ?([^`]*?) ?`+")
+# A backslash that Neovim 0.7's Markdown syntax hides even in a code span: before anything
+# but a letter or a digit (the closing backtick included).
+_HIDDEN_IN_CODE_RE = re.compile(r"\\(?![A-Za-z0-9])")
 # A word of plain text, and the characters that Markdown (CommonMark, Neovim 0.7's syntax)
 # may read as markup in it.
 _WORD_RE = re.compile(r"[^\s(),;]+")
@@ -144,6 +149,18 @@ class _Writer:
 
     def title(self, text: str) -> None:
         self.lines.append(f"**{text}**" if self.markdown else text)
+
+    def title_naming(self, before: str, name: str, after: str) -> None:
+        """The title ``before NAME after``, the name in inline code; or, when inline
+        code would not show the name as it is in every client (a backslash that Neovim
+        0.7 hides), ``before after:`` with the name below in a code block."""
+        shown = _visible(name)
+        if not self.markdown or _HIDDEN_IN_CODE_RE.search(shown) is None:
+            self.title(f"{before} {self.code(name)} {after}")
+            return
+        self.title(f"{before} {after}:")
+        # A line with a backslash never closes the fence (nor Neovim 0.7's ```+ match).
+        self.lines.extend(["```text", shown, "```"])
 
     def para(self, text: str) -> None:
         if self.lines:
@@ -291,7 +308,7 @@ def _bad_name(
 ) -> None:
     assert ref.kind is not None
     title = _KIND_TITLE[str(ref.kind)]
-    w.title(f"{title} {w.code(ref.text)} breaks the BehaviorTree.CPP naming rules")
+    w.title_naming(title, ref.text, "breaks the BehaviorTree.CPP naming rules")
     w.lines.append("")
     w.items([f"{w.code(v.code)}: {w.plain(RULES.get(v.code, v.rule))}" for v in violations])
     chars = [c for v in violations for c in v.chars]

@@ -82,8 +82,9 @@ KEYS: Final[tuple[Key, ...]] = (
         None,
         "list of globs",
         "`[]`",
-        "Files and folders left out of the workspace: not checked when a folder is walked, "
-        "and their trees and models count for no other file. A glob without `/` matches a "
+        "Files and folders left out of the workspace: not checked when a folder is walked "
+        "(nor when named with `check --force-exclude`), and their trees and models count "
+        "for no other file. A glob without `/` matches a "
         "name at any depth, one with `/` a path from the configuration file's folder (`**` "
         "spans folders). A file opened in the editor is still checked.",
     ),

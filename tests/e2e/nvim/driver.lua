@@ -6,6 +6,9 @@
 --   "quickfix"  (default) the file is the BehaviorTree fixture: diagnostics, hover on
 --               'Main Tree', the preferred quick fix through vim.lsp.buf.code_action(),
 --               the buffer after it, the diagnostics the server publishes again.
+--   "hover"     the file is a BehaviorTree file: the hover on BT_LSP_E2E_HOVER_NEEDLE in the
+--               first line containing BT_LSP_E2E_HOVER_CONTEXT, as the server sent it, as
+--               the float's buffer holds it and as the float shows it (conceal applied).
 --   "no-client" the file is plain XML: no client may start for it; then BT_LSP_E2E_OTHER
 --               (a BehaviorTree file) is opened to show that the plugin was working.
 
@@ -166,8 +169,9 @@ local function hover(bufnr, client, row, col)
     return false
   end)
   local shown = vim.api.nvim_buf_get_lines(vim.api.nvim_win_get_buf(float), 0, -1, false)
+  local seen = e2e.seen_lines(float)
   vim.api.nvim_win_close(float, true)
-  return markdown, shown
+  return markdown, shown, seen
 end
 
 local function quickfix_scenario()
@@ -180,8 +184,8 @@ local function quickfix_scenario()
   emit("diagnostics", { items = diags })
 
   local row, col = locate(bufnr, '<BehaviorTree ID="Main Tree"', "Main Tree")
-  local markdown, shown = hover(bufnr, client, row, col + 2)
-  emit("hover", { markdown = markdown or vim.NIL, window = shown })
+  local markdown, shown, seen = hover(bufnr, client, row, col + 2)
+  emit("hover", { markdown = markdown or vim.NIL, window = shown, seen = seen })
 
   -- The quick fix, as a user gets it: cursor on the name, code_action(), pick from the list.
   vim.api.nvim_win_set_cursor(0, { row + 1, col + 2 })
@@ -235,6 +239,19 @@ local function quickfix_scenario()
   emit("diagnostics_after", { items = settled_diagnostics(bufnr, 200, before) })
 end
 
+local function hover_scenario()
+  local bufnr = vim.api.nvim_get_current_buf()
+  emit("start", { nvim = version(), mode = require("bt_lsp").mode(), filetype = vim.bo.filetype })
+  local client = wait_attached(bufnr)
+  emit("attached", { client = client_info(client) })
+  emit("diagnostics", { items = settled_diagnostics(bufnr, 200) })
+  local context = os.getenv("BT_LSP_E2E_HOVER_CONTEXT")
+  local needle = os.getenv("BT_LSP_E2E_HOVER_NEEDLE")
+  local row, col = locate(bufnr, context, needle)
+  local markdown, shown, seen = hover(bufnr, client, row, col + 1)
+  emit("hover", { markdown = markdown or vim.NIL, window = shown, seen = seen })
+end
+
 local function no_client_scenario()
   local bufnr = vim.api.nvim_get_current_buf()
   emit("start", { nvim = version(), mode = require("bt_lsp").mode(), filetype = vim.bo.filetype })
@@ -283,7 +300,11 @@ local function no_client_scenario()
   end
 end
 
-local scenarios = { quickfix = quickfix_scenario, ["no-client"] = no_client_scenario }
+local scenarios = {
+  quickfix = quickfix_scenario,
+  hover = hover_scenario,
+  ["no-client"] = no_client_scenario,
+}
 
 local function main()
   local name = os.getenv("BT_LSP_E2E_SCENARIO") or "quickfix"
