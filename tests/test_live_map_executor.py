@@ -7,7 +7,9 @@ then onto an edited ``main.xml``, through the API and through ``bt-lsp monitor -
 
 from __future__ import annotations
 
+import io
 import shutil
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -130,6 +132,26 @@ def test_monitor_map_prints_each_nodes_file_and_line(
     at = line_of(edited, 'name="fine"')
     assert "the text differs from the running tree (1):" in out
     assert f'main.xml:{at}: #22 AlwaysSuccess "ok" (ok) is AlwaysSuccess "fine" in the text' in out
+
+
+def test_monitor_map_while_watching_sees_an_edit_on_disk(folder: Path, port: int) -> None:
+    from bt_lsp.cli import live
+
+    main_text = (folder / "main.xml").read_text()
+    edited = main_text.replace('name="ok"', 'name="fine"')
+    timer = threading.Timer(0.5, lambda: (folder / "main.xml").write_text(edited))
+    timer.start()
+    out = io.StringIO()
+    try:
+        code = live.monitor(
+            f"127.0.0.1:{port}", rate=20, plain=True, duration=3.0, map_path=str(folder), out=out
+        )
+    finally:
+        timer.join()
+    assert code == 0
+    frames = [f for f in out.getvalue().split("\n\n") if f.strip()]
+    assert "differs" not in frames[0] and "main.xml:" in frames[0]
+    assert 'is AlwaysSuccess "fine" in the text' in frames[-1]
 
 
 def test_monitor_map_of_a_missing_path_is_a_usage_error(
