@@ -2,8 +2,10 @@
 
 ``replay`` steps through a FileLogger2 log: each transition's time, node and statuses.
 ``monitor`` connects to a running executor's Groot2Publisher (it never listens) and draws
-the tree with live statuses; ``--once`` prints one snapshot.  ``monitor`` needs pyzmq
-(``pip install 'bt-lsp[live]'``); it uses rich for the live view when installed.
+the tree with live statuses; ``--once`` prints one snapshot, ``--map PATH`` the
+``file:line`` each node comes from and where the text differs (``cli.live_map``).
+``monitor`` needs pyzmq (``pip install 'bt-lsp[live]'``); it uses rich for the live view
+when installed.
 
 Exit status: 0; 1 when ``monitor`` cannot reach the executor or gets a malformed answer;
 2 for a usage error or a log that cannot be read.
@@ -14,11 +16,13 @@ from __future__ import annotations
 import argparse
 import datetime
 import json
+import os
 import sys
 import time
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, TextIO
 
+from bt_lsp.cli.live_map import SourceMap
 from bt_lsp.live.btlog import BtLog
 from bt_lsp.live.protocol import LiveError, NodeState, NodeStatus, parse_address
 from bt_lsp.live.tree import LiveNode, LiveTree
@@ -103,6 +107,15 @@ def add_parsers(sub: Any) -> None:
     )
     monitor.add_argument(
         "--duration", type=_seconds, metavar="SECONDS", help="stop after this long"
+    )
+    monitor.add_argument(
+        "--map",
+        metavar="FILE_OR_DIR",
+        help=(
+            "show where each node comes from (file:line) in the tree file the executor "
+            "loaded, or in the file of a folder that declares the running tree, and what "
+            "the text changed since"
+        ),
     )
 
 
@@ -222,10 +235,16 @@ def _snapshot(
     tree: LiveTree,
     states: Mapping[int, NodeState],
     blackboards: Mapping[str, Any] | None,
+    sources: SourceMap | None = None,
 ) -> list[str]:
     uuid = client.uuid.hex() if client.uuid else "?"
     lines = [f"{tree.tree_id} at {address}  (tree {uuid}, executor run {client.generation})"]
-    lines += draw(tree, states)
+    if sources is None:
+        lines += draw(tree, states)
+    else:
+        located = sources.locate(tree)
+        lines += draw(tree, states, located.where)
+        lines += sources.lines(located)
     for name, entries in (blackboards or {}).items():
         lines.append(f"blackboard {name}:")
         if isinstance(entries, dict) and entries:
@@ -244,6 +263,7 @@ def monitor(
     blackboard: bool = False,
     timeout: float = 1.0,
     duration: float | None = None,
+    map_path: str | None = None,
     out: TextIO | None = None,
     err: TextIO | None = None,
 ) -> int:
@@ -254,6 +274,12 @@ def monitor(
     except ValueError as e:
         err.write(f"bt-lsp: monitor: {e}\n")
         return 2
+    sources: SourceMap | None = None
+    if map_path is not None:
+        if not os.path.exists(map_path):
+            err.write(f"bt-lsp: monitor: --map {map_path}: no such file or folder\n")
+            return 2
+        sources = SourceMap(map_path)
     try:
         from bt_lsp.live.client import Groot2Client
     except ImportError:
@@ -269,9 +295,10 @@ def monitor(
             except LiveError as e:
                 err.write(f"bt-lsp: monitor: {e}\n")
                 return 1
-            out.write("\n".join(_snapshot(shown, client, tree, states, boards)) + "\n")
+            lines = _snapshot(shown, client, tree, states, boards, sources)
+            out.write("\n".join(lines) + "\n")
             return 0
-        return _watch(shown, client, rate, plain, blackboard, duration, out, err)
+        return _watch(shown, client, rate, plain, blackboard, duration, sources, out, err)
 
 
 def _watch(
@@ -281,6 +308,7 @@ def _watch(
     plain: bool,
     blackboard: bool,
     duration: float | None,
+    sources: SourceMap | None,
     out: TextIO,
     err: TextIO,
 ) -> int:
@@ -309,7 +337,7 @@ def _watch(
             boards = client.blackboards(tree.blackboards) if blackboard else None
         except LiveError as e:
             return [f"{shown}: {e}; retrying"]
-        return _snapshot(shown, client, tree, states, boards)
+        return _snapshot(shown, client, tree, states, boards, sources)
 
     def run(show: Callable[[list[str]], None]) -> int:
         period = 1.0 / rate

@@ -321,6 +321,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 blackboard=args.blackboard,
                 timeout=args.timeout,
                 duration=args.duration,
+                map_path=args.map,
             )
         parser.print_help(sys.stderr)
         return 2

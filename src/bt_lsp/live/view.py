@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from bt_lsp.live.protocol import NodeState
 from bt_lsp.live.tree import LiveNode, LiveTree
@@ -13,8 +13,13 @@ def state_text(state: NodeState | None) -> str:
     return "?" if state is None else str(state)
 
 
-def draw(tree: LiveTree, states: Mapping[int, NodeState] | None = None) -> list[str]:
-    """The tree drawn with box characters; statuses aligned in a column when given."""
+def draw(
+    tree: LiveTree,
+    states: Mapping[int, NodeState] | None = None,
+    where: Mapping[int, str] | None = None,
+) -> list[str]:
+    """The tree drawn with box characters; where each node comes from (``where``, by
+    uid: ``file:line``) and its status aligned in columns when given."""
     rows: list[tuple[str, LiveNode]] = []
 
     def walk(node: LiveNode, prefix: str, last: bool, top: bool) -> None:
@@ -26,7 +31,13 @@ def draw(tree: LiveTree, states: Mapping[int, NodeState] | None = None) -> list[
 
     # Iterative depth is bounded by the tree parser (MAX_DEPTH), so recursion is safe here.
     walk(tree.root, "", True, True)
-    if states is None:
-        return [text for text, _ in rows]
-    width = max(len(text) for text, _ in rows) + 2
-    return [f"{text:<{width}}{state_text(states.get(node.uid))}" for text, node in rows]
+    columns: list[Callable[[int], str]] = []
+    if where is not None:
+        columns.append(lambda uid: where.get(uid, "?"))
+    if states is not None:
+        columns.append(lambda uid: state_text(states.get(uid)))
+    texts = [text for text, _ in rows]
+    for column in columns:
+        width = max(map(len, texts)) + 2
+        texts = [f"{t:<{width}}{column(n.uid)}" for t, (_, n) in zip(texts, rows, strict=True)]
+    return texts

@@ -407,6 +407,7 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 def create_server() -> BtServer:
     from bt_lsp.server import actions, completion, documents, hover, navigation
+    from bt_lsp.server import live as live_command
     from bt_lsp.server import render as render_command
 
     server = BtServer()
@@ -516,6 +517,7 @@ def create_server() -> BtServer:
     navigation.register(server)
     completion.register(server)
     render_command.register(server)
+    live_command.register(server)
     return server
 
 

@@ -68,7 +68,8 @@ def _position(raw: object) -> tuple[int, int] | None:
     return line, character
 
 
-def _range(doc: Document, start: int, end: int, enc: Encoding) -> dict[str, Any]:
+def range_json(doc: Document, start: int, end: int, enc: Encoding) -> dict[str, Any]:
+    """The LSP range of ``doc[start:end]`` as JSON (offsets past the text clamped)."""
     n = len(doc.text)
     r = to_range(doc.lines, min(start, n), min(end, n), enc)
     return {
@@ -77,7 +78,7 @@ def _range(doc: Document, start: int, end: int, enc: Encoding) -> dict[str, Any]
     }
 
 
-class _Places:
+class Places:
     """Documents by the picture's ``source`` key (``None`` is the rendered one)."""
 
     def __init__(self, ls: BtServer, uri: str, doc: Document) -> None:
@@ -105,7 +106,7 @@ class _Places:
 
 def _nodes(
     picture: Picture,
-    places: _Places,
+    places: Places,
     targets: Mapping[str, tuple[str | None, Element]],
     enc: Encoding,
 ) -> list[dict[str, Any]]:
@@ -120,7 +121,7 @@ def _nodes(
         }
         if place is not None:
             uri, doc = place
-            item["range"] = _range(doc, node.start, node.end, enc)
+            item["range"] = range_json(doc, node.start, node.end, enc)
             if node.source is not None:
                 item["uri"] = uri
         if node.severity is not None:
@@ -133,7 +134,7 @@ def _nodes(
                 el = target[1]
                 item["target"] = {
                     "uri": tplace[0],
-                    "range": _range(tplace[1], el.name_start, el.name_end, enc),
+                    "range": range_json(tplace[1], el.name_start, el.name_end, enc),
                 }
         out.append(item)
     return out
@@ -198,7 +199,7 @@ def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
             found = resolve(node.subtree)
             if found is not None:
                 targets[node.subtree] = (found.source, found.element)
-    places = _Places(ls, uri, od.doc)
+    places = Places(ls, uri, od.doc)
     return {
         "tree": picture.tree_id,
         "format": fmt,
