@@ -1,13 +1,17 @@
 """A BehaviorTree.CPP executor for the live tests: a small tree ticking with a
 Groot2Publisher on 127.0.0.1:PORT (and PORT + 1), for at most SECONDS.
 
-Run as ``python executor.py PORT SECONDS [NODES]``.  It prints ``ready`` once the
-publisher is up, then ``result STATUS`` each time the tree finishes (and starts it again).
-With NODES, the tree is a Sequence of that many AlwaysSuccess nodes (for the CPU figure).
+Run as ``python executor.py PORT SECONDS [NODES | FILE.xml]``.  It prints ``ready`` once
+the publisher is up, then ``result STATUS`` each time the tree finishes (and starts it
+again).  With NODES, the tree is a Sequence of that many AlwaysSuccess nodes (for the CPU
+figure); with FILE.xml, the main tree of that file (``main_tree_to_execute``), its
+``<include>`` paths relative to the file.
 """
 
 from __future__ import annotations
 
+import os
+import re
 import sys
 import time
 
@@ -40,10 +44,22 @@ def wide(nodes: int) -> str:
 
 def main() -> None:
     port, seconds = int(sys.argv[1]), float(sys.argv[2])
-    nodes = int(sys.argv[3]) if len(sys.argv) > 3 else 0
+    extra = sys.argv[3] if len(sys.argv) > 3 else ""
+    nodes = int(extra) if extra.isdigit() else 0
+    text = wide(nodes) if nodes else TREE
+    if extra.endswith(".xml"):
+        # The binding's register_behavior_tree_from_file does not take a str: the text is
+        # registered from the file's folder, where BehaviorTree.CPP resolves its includes
+        # (the folder its factory was made in).
+        path = os.path.abspath(extra)
+        os.chdir(os.path.dirname(path))
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    found = re.search(r'main_tree_to_execute="([^"]+)"', text)
     factory = bt.BehaviorTreeFactory()
-    factory.register_behavior_tree_from_text(wide(nodes) if nodes else TREE)
-    tree = factory.create_tree("Main")
+    factory.register_behavior_tree_from_text(text)
+    main_tree = found.group(1) if found else "Main"
+    tree = factory.create_tree(main_tree)
     tree.root_blackboard().set_int("counter", 0)
     publisher = bt.Groot2Publisher(tree, port)
     print("ready", flush=True)
