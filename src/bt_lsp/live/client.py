@@ -307,6 +307,16 @@ class Groot2Client:
             self._sub.setsockopt(zmq.SUBSCRIBE, b"")
             self._sub.connect(self._url(self.port + 1))
 
+    def poll_breakpoint(self, timeout: float) -> int | None:
+        """The uid of a breakpoint notification received within ``timeout`` seconds, or
+        None.  A malformed notification is consumed and raised as ProtocolError (the
+        caller reports it).  No keepalive: the caller sends a request often enough."""
+        self.subscribe()
+        assert self._sub is not None
+        if not self._sub.poll(max(0, int(timeout * 1000)), zmq.POLLIN):
+            return None
+        return decode_notification(self._sub.recv_multipart())
+
     def wait_breakpoint(self, timeout: float, *, keepalive: float = 1.0) -> int | None:
         """The uid of the next breakpoint reached, or None after ``timeout`` seconds.
 
