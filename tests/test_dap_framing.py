@@ -47,7 +47,10 @@ class Trickle(io.RawIOBase):
 
 
 def test_frames_round_trip_whatever_the_reads() -> None:
-    messages = [{"seq": 1, "type": "request", "command": "initialize"}, {"é": "ü" * 100}]
+    messages: list[dict[str, Any]] = [
+        {"seq": 1, "type": "request", "command": "initialize"},
+        {"é": "ü" * 100},
+    ]
     data = b"".join(encode(m) for m in messages)
     assert [json.loads(b) for b in frames(data)] == messages  # type: ignore[arg-type]
     reader = FrameReader(Trickle(data).read)
