@@ -218,7 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="the folder whose files count as the workspace (default: the file's folder)",
     )
     live.add_parsers(sub)
-    sub.add_parser(
+    debug = sub.add_parser(
         "debug-adapter",
         help="a Debug Adapter (DAP, on stdio) for a running tree (Groot2 protocol)",
         description=(
@@ -229,6 +229,7 @@ def build_parser() -> argparse.ArgumentParser:
             "btLsp/succeedNode and btLsp/failNode. Needs pyzmq (pip install 'bt-lsp[live]')."
         ),
     )
+    debug.add_argument("--stdio", action="store_true", help="talk over stdin/stdout (the only way)")
     return parser
 
 
