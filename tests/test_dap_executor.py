@@ -4,6 +4,7 @@ tree file; every wait is bounded."""
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -216,16 +217,20 @@ def test_breakpoint_set_before_the_executor_starts(
         ex.kill()
 
 
+@pytest.mark.parametrize("how", ["stdin closed", "SIGTERM"])
 def test_ending_the_adapter_while_stopped_releases_the_tree(
-    dap: DapClient, executor: Executor, tree_file: Path, port: int
+    dap: DapClient, executor: Executor, tree_file: Path, port: int, how: str
 ) -> None:
-    """The editor went away without a disconnect (stdin closed): no hook is left."""
+    """The editor went away without a disconnect, or stopped the adapter: no hook is left."""
     dap.start(port)
     (ok,) = set_breakpoints(dap, tree_file, LINE["ok"])
     verified(dap, ok)
     dap.event("stopped")
     executor.drain()
     assert executor.line(0.3) is None
+    if how == "SIGTERM":
+        dap.proc.send_signal(signal.SIGTERM)
+        dap.proc.wait(10)
     dap.close()
     assert dap.proc.returncode == 0
     assert hooks(port) == []

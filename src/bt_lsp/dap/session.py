@@ -194,6 +194,7 @@ class Session:
         self._next_ping = 0.0
         self._tree: LiveTree | None = None
         self._parents: dict[int, int] = {}
+        self._running: frozenset[str] = frozenset()  # the IDs of the trees that run
         self._board_of: dict[int, str] = {}
         self._inserted: set[int] = set()
         self._present: set[int] = set()
@@ -358,6 +359,9 @@ class Session:
 
     def _new_tree(self, tree: LiveTree) -> None:
         self._tree = tree
+        self._running = frozenset(
+            {tree.tree_id} | {n.subtree for n in tree.nodes.values() if n.subtree is not None}
+        )
         self._inserted = set()
         self._present = set()
         self._dump = None
@@ -488,10 +492,7 @@ class Session:
             )
         if not bp.uids:
             tree_id = source.map.tree_of(bp.node.element)
-            running = {self._tree.tree_id} | {
-                n.subtree for n in self._tree.nodes.values() if n.subtree is not None
-            }
-            if tree_id not in running:
+            if tree_id not in self._running:
                 return False, (
                     f"tree {tree_id} is not part of the running tree ({self._tree.tree_id})"
                 )
@@ -774,7 +775,13 @@ class Session:
         self._link = None
         try:
             if self._generation is not None:
-                link.remove_all_hooks()
+                try:
+                    link.remove_all_hooks()
+                except LiveError as e:
+                    if isinstance(e, ProtocolError):
+                        raise
+                    # Once more: a request cut short (by a signal) left the socket reset.
+                    link.remove_all_hooks()
                 left = link.hooks()
                 if left:
                     self.out.output(
