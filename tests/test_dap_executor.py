@@ -254,3 +254,86 @@ def test_garbage_on_stdin_is_reported_and_the_session_goes_on(
     assert not reply["success"] and "already attached" in reply["message"]
     dap.request("disconnect")
     assert hooks(port) == []
+
+
+class HostileExecutor:
+    """A Groot2 server on 127.0.0.1 (requests only: no publisher) answering each request
+    type with its scripted answers first, then its usual one."""
+
+    def __init__(self, port: int, script: dict[str, list[bytes]], usual: dict[str, bytes]):
+        import threading
+
+        import zmq
+
+        self.script = script
+        self.usual = usual
+        self.ctx = zmq.Context()
+        self.sock = self.ctx.socket(zmq.REP)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.bind(f"tcp://127.0.0.1:{port}")
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        import zmq
+
+        uuid = b"u" * 16
+        while not self.stop.is_set():
+            if not self.sock.poll(100):
+                continue
+            head, *_ = self.sock.recv_multipart()
+            kind = chr(head[1]) if len(head) > 1 else "?"
+            queue = self.script.get(kind, [])
+            body = queue.pop(0) if queue else self.usual.get(kind)
+            try:
+                if body is None:
+                    self.sock.send_multipart([b"error", b"not here"])
+                else:
+                    self.sock.send_multipart([head + uuid, body])
+            except zmq.ZMQError:
+                return
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join(5)
+        self.sock.close(0)
+        self.ctx.term()
+
+
+def test_malformed_answers_are_reported_and_the_adapter_goes_on(
+    dap: DapClient, tree_file: Path, port: int
+) -> None:
+    tree = b'<root><BehaviorTree ID="Main" _fullpath=""><Sequence name="seq" _uid="1"/>'
+    hostile = HostileExecutor(
+        port,
+        script={"S": [b"\x01\x00"], "T": [b"<root><BehaviorTree"]},
+        usual={
+            "S": b"\x01\x00\x02",
+            "T": tree + b"</BehaviorTree></root>",
+            "A": b"",
+            "D": b"[]",
+        },
+    )
+    try:
+        dap.start(port)
+        (seq,) = set_breakpoints(dap, tree_file, LINE["seq"])
+        assert not seq["verified"]
+        dap.wait(
+            lambda m: (
+                m.get("event") == "breakpoint"
+                and "publisher" in m["body"]["breakpoint"].get("message", "")
+            ),
+            timeout=15.0,
+        )
+        text = dap.output()
+        assert "malformed answer from the executor: a status buffer" in text
+        assert "malformed answer from the executor: the tree is not XML" in text
+        assert "no connection to the executor's publisher" in text
+        assert dap.request("threads")["body"]["threads"] == [{"id": 1, "name": "tree Main"}]
+        assert dap.request("disconnect")["success"]
+        dap.proc.wait(10)
+        assert dap.proc.returncode == 0
+        assert "Traceback" not in dap.errors()
+    finally:
+        hostile.close()
