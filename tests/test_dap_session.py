@@ -44,6 +44,7 @@ class FakeLink:
         self.unlocks: list[tuple[int, Resume, bool]] = []
         self.boards: dict[str, Any] = {"Main": {"counter": 3, "pose": {"x": 1}}, "sub1": None}
         self.fail_next: dict[str, Exception] = {}
+        self.broken_tree = False
         self.closed = False
         self.requests: list[str] = []
 
@@ -62,6 +63,8 @@ class FakeLink:
 
     def read_tree(self) -> LiveTree:
         self._call("read_tree")
+        if self.broken_tree:
+            raise ProtocolError("two nodes have _uid 3")
         return self.tree
 
     def status(self) -> dict[int, NodeState]:
@@ -360,6 +363,23 @@ def test_malformed_answers_are_reported_and_the_session_goes_on(h: Harness) -> N
     reply = h.request("variables", variablesReference=scope["variablesReference"])
     assert not reply["success"] and "truncated" in reply["message"]
     assert h.ok("variables", variablesReference=scope["variablesReference"])["variables"]
+
+
+def test_a_tree_that_cannot_be_read_is_said_once_and_tried_again(h: Harness) -> None:
+    h.attached()
+    (bp,) = h.breakpoints(WORK)
+    assert bp["verified"]
+    h.link.restart()
+    h.link.broken_tree = True
+    h.tick(6, step=0.2)
+    assert h.output().count("two nodes have _uid 3") == 1
+    assert 2 <= h.link.requests.count("read_tree") - 1 <= 4  # every 0.5 s, not every poll
+    last = h.events("breakpoint")[-1]["breakpoint"]
+    assert not last["verified"] and "waiting" in last["message"]
+    h.link.broken_tree = False
+    h.tick(2)
+    assert h.events("breakpoint")[-1]["breakpoint"]["verified"]
+    assert set(h.link.installed) == {UID["work"]}
 
 
 def test_a_lost_executor_and_a_restarted_one(h: Harness) -> None:

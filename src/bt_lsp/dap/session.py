@@ -189,6 +189,7 @@ class Session:
         self._blind = False  # connected, but not to the publisher: no hooks go in
         self._connected = False
         self._said_waiting = False
+        self._last_trouble: str | None = None
         self._generation: int | None = None
         self._next_probe = 0.0
         self._next_ping = 0.0
@@ -252,9 +253,13 @@ class Session:
         self.out.output(f"bt-lsp: skipped a message: {text}", "stderr")
 
     def _trouble(self, e: LiveError) -> None:
-        """An executor error seen while answering or polling."""
+        """An executor error seen while answering or polling (a malformed answer is said
+        once while it repeats)."""
         if isinstance(e, ProtocolError):
-            self.out.output(f"bt-lsp: malformed answer from the executor: {e}", "stderr")
+            text = f"bt-lsp: malformed answer from the executor: {e}"
+            if text != self._last_trouble:
+                self._last_trouble = text
+                self.out.output(text, "stderr")
         elif not isinstance(e, ExecutorError):
             self._lost(e)
 
@@ -284,7 +289,7 @@ class Session:
                 link.status()
                 self._next_ping = self._clock() + KEEPALIVE
             if link.generation != self._generation:
-                self._connected_now()
+                self._reconnect(link)
             elif self._blind and self._await_publisher(0):
                 self._sync()
         except LiveError as e:
@@ -302,12 +307,19 @@ class Session:
                 self._said_waiting = True
                 self.out.output(f"bt-lsp: waiting for the executor at {self._address} ({e})")
             return
+        self._reconnect(link)
+
+    def _reconnect(self, link: Link) -> None:
+        """(Re)attach now that the executor answers; on failure, try again later."""
         try:
             self._connected_now()
         except LiveError as e:
-            self._connected = False
-            self._next_probe = self._clock() + PROBE_EVERY
+            if isinstance(e, ProtocolError):
+                self._connected = False  # its tree cannot be read: not attached
             self._trouble(e)
+            if not self._connected:
+                self._next_probe = self._clock() + PROBE_EVERY
+                self._announce()
 
     def _connected_now(self) -> None:
         """The executor answers: read its tree if this is a new run, and set the hooks."""
