@@ -120,6 +120,25 @@ def test_breakpoint_stops_the_tree_and_force_failure_changes_the_result(
     assert executor.wait_for("result", 5.0) == "result SUCCESS"
 
 
+def test_publisher_connection_is_known(port: int) -> None:
+    with Groot2Client("127.0.0.1", port, timeout=1.0) as c:
+        time.sleep(0.3)
+        assert not c.publisher_connected()  # nothing listens yet
+        ex = Executor(port)
+        try:
+            end = time.monotonic() + 5
+            while not c.publisher_connected():
+                assert time.monotonic() < end
+                time.sleep(0.02)
+            ex.kill()
+            end = time.monotonic() + 5
+            while c.publisher_connected():
+                assert time.monotonic() < end
+                time.sleep(0.02)
+        finally:
+            ex.kill()
+
+
 def test_continue_and_replace_hooks(client: Groot2Client, executor: Executor) -> None:
     tree = client.read_tree()
     ok = tree.find("ok")[0].uid

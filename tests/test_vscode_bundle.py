@@ -122,6 +122,30 @@ def test_bootstrap_unpacks_once_for_this_python(tmp_path: Path) -> None:
     assert sorted(p.name for p in storage.iterdir()) == [folder.name]
 
 
+def test_bootstrap_runs_the_server_or_the_debug_adapter(tmp_path: Path) -> None:
+    """``serve FOLDER ARGS`` and ``debug-adapter FOLDER ARGS`` run that bt-lsp command from
+    FOLDER (here a stand-in bt_lsp that prints its argv)."""
+    cli = tmp_path / "site" / "bt_lsp" / "cli"
+    cli.mkdir(parents=True)
+    (cli.parent / "__init__.py").write_text('__version__ = "9.9"\n', encoding="utf-8")
+    (cli / "__init__.py").write_text("", encoding="utf-8")
+    (cli / "main.py").write_text(
+        "import sys\n\ndef main(argv):\n    sys.stdout.write(repr(argv))\n    return 0\n",
+        encoding="utf-8",
+    )
+    for verb in ("serve", "debug-adapter"):
+        run = subprocess.run(
+            [sys.executable, "-I", str(BOOTSTRAP), verb, str(cli.parent.parent), "--stdio"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
+        assert run.returncode == 0, run.stderr
+        assert run.stdout == repr([verb, "--stdio"])
+        assert "bt-lsp 9.9 (bundled" in run.stderr
+
+
 def test_bootstrap_refuses_a_python_it_has_no_wheels_for(tmp_path: Path) -> None:
     other = sorted(PYTHONS - {THIS_PYTHON})
     ext = _fake_extension(tmp_path, {"demo/__init__.py": ""}, other)

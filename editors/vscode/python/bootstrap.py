@@ -12,6 +12,8 @@ which version). The extension runs this file with the Python it found, always wi
         Exit 3 with {"ok": false, "reason": ...} when this Python cannot run the bundle.
     python -I bootstrap.py serve FOLDER [ARGS...]
         Runs ``bt-lsp serve ARGS`` from FOLDER (the path the install step printed).
+    python -I bootstrap.py debug-adapter FOLDER [ARGS...]
+        Runs ``bt-lsp debug-adapter ARGS`` from FOLDER (the editor's debugger).
 
 A wheel is a zip whose top level is what goes on sys.path, so unpacking it is an install
 that needs neither pip nor venv (Debian's python3 has neither by default). The binary
@@ -146,7 +148,7 @@ def install(storage):
     return 0
 
 
-def serve(folder, args):
+def serve(folder, args, command="serve"):
     sys.path.insert(0, folder)
     import bt_lsp
     from bt_lsp.cli.main import main
@@ -156,15 +158,18 @@ def serve(folder, args):
         % (bt_lsp.__version__, os.path.dirname(bt_lsp.__file__), _python_text(), sys.executable)
     )
     sys.stderr.flush()
-    return main(["serve"] + list(args))
+    return main([command] + list(args))
 
 
 def entry(argv):
     if len(argv) >= 2 and argv[0] == "install":
         return install(argv[1])
-    if len(argv) >= 2 and argv[0] == "serve":
-        return serve(argv[1], argv[2:])
-    sys.stderr.write("usage: bootstrap.py install STORAGE | serve FOLDER [ARGS...]\n")
+    if len(argv) >= 2 and argv[0] in ("serve", "debug-adapter"):
+        return serve(argv[1], argv[2:], argv[0])
+    sys.stderr.write(
+        "usage: bootstrap.py install STORAGE | serve FOLDER [ARGS...]"
+        " | debug-adapter FOLDER [ARGS...]\n"
+    )
     return 2
 
 

@@ -12,6 +12,7 @@ import {
   State,
 } from 'vscode-languageclient/node';
 import { Bundle, findBundle } from './bundled';
+import { registerDebugAdapter } from './debugAdapter';
 import { resolveServerCommand } from './serverCommand';
 import { ServerStatus } from './status';
 import { registerTreeView } from './treeView';
@@ -83,6 +84,7 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
     }),
   );
   registerTreeView(context, () => client, log);
+  registerDebugAdapter(context, log, () => bundle);
   return enqueue(startClient);
 }
 

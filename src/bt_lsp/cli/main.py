@@ -225,6 +225,18 @@ def build_parser() -> argparse.ArgumentParser:
         help="the folder whose files count as the workspace (default: the file's folder)",
     )
     live.add_parsers(sub)
+    debug = sub.add_parser(
+        "debug-adapter",
+        help="a Debug Adapter (DAP, on stdio) for a running tree (Groot2 protocol)",
+        description=(
+            "Speak the Debug Adapter Protocol on stdin and stdout, for an editor's debugger: "
+            "an 'attach' request with the host and port of an executor's Groot2Publisher "
+            "(default 127.0.0.1:1667; it connects, never listens), breakpoints on the lines "
+            "of tree files, the blackboards as variables, continue, and the custom requests "
+            "btLsp/succeedNode and btLsp/failNode. Needs pyzmq (pip install 'bt-lsp[live]')."
+        ),
+    )
+    debug.add_argument("--stdio", action="store_true", help="talk over stdin/stdout (the only way)")
     return parser
 
 
@@ -310,6 +322,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
         if args.command == "render":
             return _render(args)
+        if args.command == "debug-adapter":
+            from bt_lsp.dap.adapter import main as debug_adapter
+
+            return debug_adapter()
         if args.command == "replay":
             return live.replay(args.file, format=args.format, node=args.node)
         if args.command == "monitor":

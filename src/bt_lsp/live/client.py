@@ -106,6 +106,8 @@ class Groot2Client:
         self._req: zmq.Socket[bytes] | None = None
         self._monitor: zmq.Socket[bytes] | None = None
         self._sub: zmq.Socket[bytes] | None = None
+        self._sub_monitor: zmq.Socket[bytes] | None = None
+        self._sub_up = False
         self._open_req()
 
     # ------------------------------------------------------------------ sockets
@@ -158,8 +160,12 @@ class Groot2Client:
         """Close the sockets (hooks stay in the executor: remove them first if needed)."""
         self._close_req()
         if self._sub is not None:
+            self._sub.disable_monitor()
             self._sub.close(0)
             self._sub = None
+        if self._sub_monitor is not None:
+            self._sub_monitor.close(0)
+            self._sub_monitor = None
         self._context.term()
 
     def __enter__(self) -> Groot2Client:
@@ -305,7 +311,36 @@ class Groot2Client:
             self._sub = self._socket(zmq.SUB)
             self._sub.setsockopt(zmq.RCVHWM, 1000)
             self._sub.setsockopt(zmq.SUBSCRIBE, b"")
+            self._sub_monitor = self._sub.get_monitor_socket(
+                zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_DISCONNECTED
+            )
             self._sub.connect(self._url(self.port + 1))
+
+    def publisher_connected(self) -> bool:
+        """Whether the subscriber is connected to the publisher (PORT + 1) now: its
+        handshake done, so the subscription follows on the same connection.  A
+        breakpoint hit while it is not is stopped unseen."""
+        self.subscribe()
+        monitor = self._sub_monitor
+        while monitor is not None:
+            try:
+                frames = monitor.recv_multipart(zmq.NOBLOCK)
+            except zmq.ZMQError:
+                break
+            if frames and len(frames[0]) >= 2:
+                event = int.from_bytes(frames[0][:2], "little")
+                self._sub_up = event == zmq.EVENT_HANDSHAKE_SUCCEEDED
+        return self._sub_up
+
+    def poll_breakpoint(self, timeout: float) -> int | None:
+        """The uid of a breakpoint notification received within ``timeout`` seconds, or
+        None.  A malformed notification is consumed and raised as ProtocolError (the
+        caller reports it).  No keepalive: the caller sends a request often enough."""
+        self.subscribe()
+        assert self._sub is not None
+        if not self._sub.poll(max(0, int(timeout * 1000)), zmq.POLLIN):
+            return None
+        return decode_notification(self._sub.recv_multipart())
 
     def wait_breakpoint(self, timeout: float, *, keepalive: float = 1.0) -> int | None:
         """The uid of the next breakpoint reached, or None after ``timeout`` seconds.
