@@ -18,6 +18,7 @@ from bt_lsp.render.layout import (
     PAD_Y,
     Box,
     Layout,
+    bus_y,
     layout,
 )
 from bt_lsp.render.picture import Node, Picture
@@ -228,10 +229,12 @@ def _node(node: Node, b: Box, lines: list[str]) -> str:
 
 
 def _edge(pb: Box, cb: Box, inlined: bool) -> str:
+    """Down from the parent, along the gap above the child's row, down into the child: every
+    segment stays in the parent's band and out of the rows' boxes (see layout)."""
     cls = "edge inlined" if inlined else "edge"
     return (
-        f'<path class="{cls}" d="M{pb.x + pb.w / 2:.1f} {pb.y + pb.h:.1f}'
-        f'V{(pb.y + pb.h + cb.y) / 2:.1f}H{cb.x + cb.w / 2:.1f}V{cb.y:.1f}"/>'
+        f'<path class="{cls}" d="M{pb.cx:.1f} {pb.bottom:.1f}'
+        f'V{bus_y(cb):.1f}H{cb.cx:.1f}V{cb.y:.1f}"/>'
     )
 
 
