@@ -343,6 +343,21 @@ def test_svg_is_standalone_and_themed() -> None:
     assert "Sequence" in texts and '"root seq"' in texts
 
 
+def test_svg_opens_fitted() -> None:
+    """The viewBox holds every box, and the root (a file opened on its own, not a picture
+    inlined in a page) is capped at the window's size, so a viewer scales it to fit."""
+    _, pic = _picture(ports=True)
+    laid = layout(pic)
+    svg = etree.fromstring(to_svg(pic, laid).encode())
+    x, y, w, h = map(float, _attr(svg, "viewBox").split())
+    assert (x, y) == (0, 0)
+    assert (w, h) == (float(_attr(svg, "width")), float(_attr(svg, "height")))
+    assert all(b.x + b.w <= w and b.bottom <= h for b in laid.boxes)
+    style = _found(svg, f"{SVG_NS}style").text or ""
+    assert ".bt-tree:root{max-width:100vw;max-height:100vh}" in style
+    assert svg.get("preserveAspectRatio") in (None, "xMidYMid meet")  # scaled, not cropped
+
+
 def test_svg_marks_keys_and_badges() -> None:
     _, pic = _picture(ports=True)
     svg = etree.fromstring(to_svg(pic).encode())
