@@ -14,6 +14,7 @@ from lxml import etree
 
 from bt_lsp.render import (
     build_picture,
+    changed_node,
     find_tree,
     layout,
     main_tree,
@@ -207,6 +208,38 @@ def test_tree_at_and_main_tree() -> None:
     assert t is not None and t.value("ID") == "Walk"
     t = tree_at(doc.model, SAMPLE.index("<TreeNodesModel>"))
     assert t is not None and t.value("ID") == "Main"  # outside every tree: the main one
+
+
+def test_changed_node_is_what_an_edit_made_or_changed() -> None:
+    text = SAMPLE.replace("<CheckBattery/>", '<CheckBattery/>\n      <Sleep msec="5"/>')
+    doc, pic = _picture(text, expand_subtrees=True)
+    walk = next(n for n in pic.nodes if n.type == "Walk")  # the call, expanded below
+
+    def changed(start: int, end: int) -> str | None:
+        node = changed_node(pic, start, end)
+        return node.type if node is not None else None
+
+    sleep = text.index("<Sleep")
+    assert changed(sleep, sleep + len('<Sleep msec="5"/>')) == "Sleep"  # typed whole
+    assert changed(sleep - 7, sleep + len('<Sleep msec="5"/>') + 1) == "Sleep"  # with blanks
+    fallback = text.index("<Fallback>")
+    end = text.index("</Fallback>") + len("</Fallback>")
+    assert changed(fallback, end) == "Fallback"  # a pasted subtree: its top node
+    assert changed(end - 3, end) == "Fallback"  # its end tag edited
+    door = text.index('door="{door}"') + 7
+    assert changed(door, door + 1) == "IsDoorOpen"  # an attribute edited
+    assert changed(door + 1, door) == "IsDoorOpen"  # the span either way round
+    assert changed(sleep, sleep) == "Sleep"  # an empty span: a deletion inside it
+    after = text.index("/>", sleep) + 2
+    assert changed(after, after) == "Sleep"  # just after its end: the last character typed
+    assert changed(after + 1, after + 2) == "Sequence"  # between children: their parent
+    # An edit in the called tree changes its copy drawn under the SubTree call.
+    move = text.index('<Action ID="Move"') + 3
+    node = changed_node(pic, move, move)
+    assert node is not None and node.type == "Move" and node.source is None
+    assert walk.expanded and node.depth > walk.depth
+    assert changed(text.index("<TreeNodesModel>"), text.index("<TreeNodesModel>") + 3) is None
+    assert doc.text == text
 
 
 # -- layout geometry -------------------------------------------------------------------------
