@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from itertools import pairwise
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
@@ -13,6 +14,7 @@ from lxml import etree
 
 from bt_lsp.render import (
     build_picture,
+    changed_node,
     find_tree,
     layout,
     main_tree,
@@ -23,12 +25,13 @@ from bt_lsp.render import (
     tree_at,
     workspace_resolver,
 )
-from bt_lsp.render.layout import SIBLING_GAP
+from bt_lsp.render.layout import MARGIN, SIBLING_GAP
 from bt_lsp.render.picture import MAX_NODES
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
+from tests.layout_check import extents, problems
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 
@@ -207,6 +210,38 @@ def test_tree_at_and_main_tree() -> None:
     assert t is not None and t.value("ID") == "Main"  # outside every tree: the main one
 
 
+def test_changed_node_is_what_an_edit_made_or_changed() -> None:
+    text = SAMPLE.replace("<CheckBattery/>", '<CheckBattery/>\n      <Sleep msec="5"/>')
+    doc, pic = _picture(text, expand_subtrees=True)
+    walk = next(n for n in pic.nodes if n.type == "Walk")  # the call, expanded below
+
+    def changed(start: int, end: int) -> str | None:
+        node = changed_node(pic, start, end)
+        return node.type if node is not None else None
+
+    sleep = text.index("<Sleep")
+    assert changed(sleep, sleep + len('<Sleep msec="5"/>')) == "Sleep"  # typed whole
+    assert changed(sleep - 7, sleep + len('<Sleep msec="5"/>') + 1) == "Sleep"  # with blanks
+    fallback = text.index("<Fallback>")
+    end = text.index("</Fallback>") + len("</Fallback>")
+    assert changed(fallback, end) == "Fallback"  # a pasted subtree: its top node
+    assert changed(end - 3, end) == "Fallback"  # its end tag edited
+    door = text.index('door="{door}"') + 7
+    assert changed(door, door + 1) == "IsDoorOpen"  # an attribute edited
+    assert changed(door + 1, door) == "IsDoorOpen"  # the span either way round
+    assert changed(sleep, sleep) == "Sleep"  # an empty span: a deletion inside it
+    after = text.index("/>", sleep) + 2
+    assert changed(after, after) == "Sleep"  # just after its end: the last character typed
+    assert changed(after + 1, after + 2) == "Sequence"  # between children: their parent
+    # An edit in the called tree changes its copy drawn under the SubTree call.
+    move = text.index('<Action ID="Move"') + 3
+    node = changed_node(pic, move, move)
+    assert node is not None and node.type == "Move" and node.source is None
+    assert walk.expanded and node.depth > walk.depth
+    assert changed(text.index("<TreeNodesModel>"), text.index("<TreeNodesModel>") + 3) is None
+    assert doc.text == text
+
+
 # -- layout geometry -------------------------------------------------------------------------
 
 TYPES = [
@@ -224,14 +259,16 @@ TYPES = [
 
 @st.composite
 def random_trees(draw: st.DrawFn) -> str:
-    """A random tree (any shape, node widths varying) as BT XML."""
+    """A random tree (any shape; box widths and heights varying with the node type, the
+    instance name and the number of attributes) as BT XML."""
     n = draw(st.integers(1, 60))
     parents = [draw(st.integers(0, i)) for i in range(n)]  # node i+1's parent is <= i
     kids: list[list[int]] = [[] for _ in range(n + 1)]
     for i, p in enumerate(parents, 1):
         kids[p].append(i)
     names = draw(st.lists(st.sampled_from(TYPES), min_size=n + 1, max_size=n + 1))
-    inst = draw(st.lists(st.text("ab <&\"'é😀", max_size=12), min_size=n + 1, max_size=n + 1))
+    inst = draw(st.lists(st.text("ab <&\"'é😀", max_size=48), min_size=n + 1, max_size=n + 1))
+    extra = draw(st.lists(st.integers(0, 3), min_size=n + 1, max_size=n + 1))
     out: list[str] = []
     stack: list[tuple[int, bool]] = [(0, False)]
     while stack:
@@ -241,6 +278,7 @@ def random_trees(draw: st.DrawFn) -> str:
             out.append(f"</{tag}>")
             continue
         attr = f" name={quoteattr(inst[i])}" if inst[i] else ""
+        attr += "".join(f' p{j}="{{key_{j}}}"' for j in range(extra[i]))
         if not kids[i]:
             out.append(f"<{tag}{attr}/>")
             continue
@@ -250,61 +288,46 @@ def random_trees(draw: st.DrawFn) -> str:
     return f'<root BTCPP_format="4"><BehaviorTree ID="T">{"".join(out)}</BehaviorTree></root>'
 
 
-def _overlap(a, b) -> bool:  # type: ignore[no-untyped-def]
-    return a.x < b.x + b.w and b.x < a.x + a.w and a.y < b.y + b.h and b.y < a.y + a.h
-
-
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(random_trees(), st.booleans())
 def test_layout_is_tidy(text: str, ports: bool) -> None:
+    """No overlap, sibling subtrees side by side in XML order, parents above and centred
+    over their children, no connector through a box (tests/layout_check.py)."""
     _, pic = _picture(text, ports=ports)
-    laid = layout(pic)
-    boxes = laid.boxes
-    assert len(boxes) == len(pic.nodes)
-    for i, a in enumerate(boxes):  # no two boxes intersect
-        for b in boxes[i + 1 :]:
-            assert not _overlap(a, b)
-    for node in pic.nodes:
-        box = boxes[node.index]
-        assert box.x >= 0 and box.y >= 0
-        assert box.x + box.w <= laid.width + 1e-6 and box.bottom <= laid.height + 1e-6
-        if node.children:
-            first, last = boxes[node.children[0]], boxes[node.children[-1]]
-            assert box.cx == pytest.approx((first.cx + last.cx) / 2)  # centred above
-            xs = [boxes[c].cx for c in node.children]
-            assert xs == sorted(xs) and len(set(xs)) == len(xs)  # in XML order
-            assert all(boxes[c].y > box.bottom for c in node.children)  # below
-
-
-def _extents(pic, boxes, root: int) -> dict[float, tuple[float, float]]:  # type: ignore[no-untyped-def]
-    """Row top -> (leftmost, rightmost) x of the boxes of ``root``'s subtree."""
-    out: dict[float, tuple[float, float]] = {}
-    stack = [root]
-    while stack:
-        i = stack.pop()
-        b = boxes[i]
-        lo, hi = out.get(b.y, (b.x, b.x + b.w))
-        out[b.y] = (min(lo, b.x), max(hi, b.x + b.w))
-        stack.extend(pic.nodes[i].children)
-    return out
+    assert problems(pic) == []
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(random_trees())
-def test_layout_is_compact(text: str) -> None:
-    """Each subtree sits as close to its left siblings' subtrees as the gap allows: at some
-    row exactly the gap apart, nowhere closer."""
-    _, pic = _picture(text)
-    boxes = layout(pic).boxes
+@given(random_trees(), st.booleans())
+def test_layout_is_compact(text: str, ports: bool) -> None:
+    """Each subtree sits exactly the gap to the right of its left sibling's subtree, and a
+    node with children is no wider than the subtree below it needs."""
+    _, pic = _picture(text, ports=ports)
+    laid = layout(pic)
+    ext = extents(pic, laid.boxes)
     for node in pic.nodes:
-        for k in range(1, len(node.children)):
-            here = _extents(pic, boxes, node.children[k])
-            before: dict[float, float] = {}
-            for c in node.children[:k]:
-                for y, (_, hi) in _extents(pic, boxes, c).items():
-                    before[y] = max(before.get(y, hi), hi)
-            gaps = [here[y][0] - before[y] for y in here if y in before]
-            assert min(gaps) == pytest.approx(SIBLING_GAP)
+        kids = node.children
+        for a, b in pairwise(kids):
+            assert ext[b][0] - ext[a][1] == pytest.approx(SIBLING_GAP)
+    assert laid.width == pytest.approx(ext[0][1] - ext[0][0] + 2 * MARGIN)
+
+
+def test_layout_keeps_a_deep_subtree_out_of_its_neighbours_column() -> None:
+    """A leaf beside a deep, wide subtree stays to its right at every row: the contour
+    packing this replaced tucked the leaf's neighbour's children under it."""
+    text = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
+        "<Inverter><Sequence><AVeryLongCustomActionNameThatIsWide/>"
+        "<AVeryLongCustomActionNameThatIsWide/></Sequence></Inverter>"
+        '<AlwaysSuccess p0="{a}" p1="{b}" p2="{c}"/>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    _, pic = _picture(text, ports=True)
+    boxes = layout(pic).boxes
+    leaf = next(n.index for n in pic.nodes if n.type == "AlwaysSuccess")
+    wide = [n.index for n in pic.nodes if n.type == "AVeryLongCustomActionNameThatIsWide"]
+    assert all(boxes[leaf].x >= boxes[w].x + boxes[w].w + SIBLING_GAP for w in wide)
+    assert problems(pic) == []
 
 
 def test_deep_tree_has_no_recursion_limit() -> None:
@@ -351,6 +374,21 @@ def test_svg_is_standalone_and_themed() -> None:
     assert "href" not in out and "url(" not in out and "<image" not in out and "<script" not in out
     texts = [_text(t) for t in svg.iter(f"{SVG_NS}text")]
     assert "Sequence" in texts and '"root seq"' in texts
+
+
+def test_svg_opens_fitted() -> None:
+    """The viewBox holds every box, and the root (a file opened on its own, not a picture
+    inlined in a page) is capped at the window's size, so a viewer scales it to fit."""
+    _, pic = _picture(ports=True)
+    laid = layout(pic)
+    svg = etree.fromstring(to_svg(pic, laid).encode())
+    x, y, w, h = map(float, _attr(svg, "viewBox").split())
+    assert (x, y) == (0, 0)
+    assert (w, h) == (float(_attr(svg, "width")), float(_attr(svg, "height")))
+    assert all(b.x + b.w <= w and b.bottom <= h for b in laid.boxes)
+    style = _found(svg, f"{SVG_NS}style").text or ""
+    assert ".bt-tree:root{max-width:100vw;max-height:100vh}" in style
+    assert svg.get("preserveAspectRatio") in (None, "xMidYMid meet")  # scaled, not cropped
 
 
 def test_svg_marks_keys_and_badges() -> None:

@@ -1,6 +1,7 @@
 """ "bt-lsp: Show Tree" in a real VS Code (code-server driven by headless Chromium): the picture
-appears beside the XML, follows an edit, a click on a node selects its element, the cursor
-highlights its node, an update keeps the zoom, and a SubTree opens its tree.
+appears beside the XML, fitted, follows an edit, a click on a node selects its element, the
+cursor highlights its node, an update keeps the zoom, a node typed out of view is scrolled into
+view, and a SubTree opens its tree.
 
 Needs what tests/e2e/test_vscode.py needs (`editors/vscode/e2e/setup.sh`). Its screenshot goes
 to `.e2e-artifacts/vscode/tree.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
@@ -95,6 +96,8 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     insert_col = len(LINES[charge_line - 1]) + 1  # after <Charge .../>
     fallback_line = 5
     fallback_col = LINES[fallback_line - 1].index("<Fallback") + 1
+    inverter_line = 9
+    assert LINES[inverter_line - 1].endswith("</Inverter>")
     config = {
         "url": code_server.url,
         "file": "mission.xml",
@@ -104,6 +107,9 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
         "clickType": "Fallback",
         "cursorAt": [charge_line, LINES[charge_line - 1].index("Charge") + 3],
         "cursorType": "Charge",
+        "addAt": [inverter_line, len(LINES[inverter_line - 1]) + 1],  # after </Inverter>
+        "add": '<Sleep msec="1"/>',
+        "addType": "Sleep",
         "expandedType": "Align",
         "subtreeType": "Dock",
         "subtreeTree": "Dock",
@@ -155,6 +161,7 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     assert first["kinds"][2:6] == ["action", "control", "condition", "subtree"], context
     assert first["badges"] == ["Inverter"], context
     assert first["stroke"] not in (None, "", "none"), context  # the SVG's styles ran under the CSP
+    assert first["fits"] and first["inView"] == first["types"], context  # opened fitted
     assert result["titleButton"], context  # the editor-title button on an XML file
 
     # It follows an edit (after the debounce), in XML order.
@@ -183,6 +190,12 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     assert result["zoomed"] != result["zoomBefore"], context
     assert result["afterSecondEdit"]["transform"] == result["transformBeforeSecondEdit"], context
 
+    # Zoomed far in, a node typed where the view did not reach was scrolled into view: the view
+    # moved, at the same zoom.
+    (ax, ay, ak), (bx, by, bk) = (transform(result[k]["transform"]) for k in ("added", "beforeAdd"))
+    assert result["added"]["types"][-1] == "Sleep" and "Sleep" in result["added"]["inView"], context
+    assert ak == bk and (ax, ay) != (bx, by), context
+
     # "expand SubTrees" inlines the called tree below its SubTree node; "ports" shows ports.
     assert result["expanded"]["types"][6:10] == ["Dock", "Sequence", "Align", "Stop"], context
     assert result["withPorts"]["keys"] == ["{battery}"], context
@@ -192,12 +205,12 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
     assert result["subtree"]["types"] == ["Dock", "Sequence", "Align", "Stop"], context
     assert "Ln 12," in result["subtreeSelection"], context
 
-    # A tree of 1,000 nodes: the view follows the newly active editor and draws every node,
-    # fits it with the keyboard, and a click on one of them still selects its element.
+    # A tree of 1,000 nodes: the view follows the newly active editor, draws every node, opens
+    # with all of it in view ('0' fits it the same way), and a click on one still selects it.
     big = result["big"]
     assert big["nodes"] == BIG_NODES + 1, context
-    assert big["initialTransform"].endswith("scale(0.5)"), context  # readable, not fitted
-    assert big["fittedTransform"] != big["initialTransform"], context
+    assert big["fits"], context
+    assert big["fittedTransform"] == big["initialTransform"], context
     assert big["zoomedTransform"] != big["fittedTransform"], context
     assert "selected" in big["selection"], context
 

@@ -140,10 +140,61 @@ async def test_follows_an_edit(client: BtClient) -> None:
     ]
 
 
+def _lsp_range(client: BtClient, text: str, start: int, end: int) -> dict[str, Any]:
+    r = client.range(text, start, end)
+    return {
+        "start": {"line": r.start.line, "character": r.start.character},
+        "end": {"line": r.end.line, "character": r.end.character},
+    }
+
+
+async def test_names_the_node_an_edit_changed(client: BtClient) -> None:
+    """``edited`` (what the client's edits replaced) gives ``changed``, the node to keep in
+    view: a node typed in, a character of a line with a non-ASCII one before it."""
+    uri = client.open(DOC)
+    await client.diags(uri, 1)
+    added = "<AlwaysSuccess/>"
+    new = DOC.replace('<Say msg="{greeting}"/>', '<Say msg="{greeting}"/>' + added)
+    client.replace(uri, 2, new)
+    at = new.index(added)
+    plain = await _render(client, {"uri": uri, "position": _pos(client, 0, new)})
+    assert plain["changed"] is None
+    result = await _render(
+        client,
+        {
+            "uri": uri,
+            "position": _pos(client, 0, new),
+            "edited": _lsp_range(client, new, at, at + len(added)),
+        },
+    )
+    by_id = {n["id"]: n["type"] for n in result["nodes"]}
+    assert by_id[result["changed"]] == "AlwaysSuccess"
+    # The last character of a node after an emoji (2 UTF-16 units, 4 bytes) of its line:
+    # read one code point too far, the edit would be the next node's.
+    emoji = new.replace('msg="{greeting}"', 'msg="😋"')
+    client.replace(uri, 3, emoji)
+    gt = emoji.index("<AlwaysSuccess/>") - 1
+    edited = _lsp_range(client, emoji, gt, gt + 1)
+    result = await _render(client, {"uri": uri, "tree": "Main", "edited": edited})
+    assert by_id[result["changed"]] == "Say"
+    edited = _lsp_range(client, emoji, gt + 1, gt + 2)
+    result = await _render(client, {"uri": uri, "tree": "Main", "edited": edited})
+    assert by_id[result["changed"]] == "AlwaysSuccess"
+    outside = emoji.index("<TreeNodesModel>")
+    edited = _lsp_range(client, emoji, outside, outside)
+    result = await _render(client, {"uri": uri, "tree": "Main", "edited": edited})
+    assert result["changed"] is None
+
+
 async def test_no_tree_and_bad_arguments(client: BtClient) -> None:
     uri = client.open('<root BTCPP_format="4"><TreeNodesModel/></root>')
     assert await _render(client, {"uri": uri, "position": {"line": 0, "character": 0}}) is None
-    for bad in ({"position": {"line": 0, "character": 0}}, {"uri": uri, "format": "png"}):
+    for bad in (
+        {"position": {"line": 0, "character": 0}},
+        {"uri": uri, "format": "png"},
+        {"uri": uri, "edited": {"start": {"line": 0, "character": 0}}},
+        {"uri": uri, "edited": [0, 1]},
+    ):
         with pytest.raises(JsonRpcException):
             await _render(client, bad)
     with pytest.raises(JsonRpcException, match="not an open document"):

@@ -8,13 +8,15 @@
 //                  "subtreeType": "Dock", "subtreeTree": "Dock", "shotDir": "/tmp/shots"}'
 //
 // Steps: open the file, wait for the server (its first squiggle), run "bt-lsp: Show Tree" from the
-// Command Palette, read the picture's nodes in the webview; type `insert` at line:column insertAt
-// and wait for the picture to show a node of type expectType; click the node of type clickType
-// and read the editor's selection from the status bar; zoom with the keyboard; move the cursor to
-// cursorAt and read which node the webview highlights; check that an update keeps the zoom;
-// tick "expand SubTrees" (a node of type expandedType appears) and "ports" (blackboard keys
-// appear); double-click the SubTree node of type subtreeType and wait for the picture of
-// subtreeTree; with `big`, open its file and check that its tree is drawn in full.
+// Command Palette, read the picture's nodes in the webview (and whether it opened fitted); type
+// `insert` at line:column insertAt and wait for the picture to show a node of type expectType;
+// click the node of type clickType and read the editor's selection from the status bar; zoom with
+// the keyboard; move the cursor to cursorAt and read which node the webview highlights; check
+// that an update keeps the zoom; zoom far in and type `add` at addAt, then read whether the new
+// node of type addType is in view; tick "expand SubTrees" (a node of type expandedType appears)
+// and "ports" (blackboard keys appear); double-click the SubTree node of type subtreeType and wait
+// for the picture of subtreeTree; with `big`, open its file and check that its tree is drawn in
+// full and opened fitted.
 // Screenshots: tree.png (after the click), tree-failure.png on failure, in shotDir.
 // Exit status: 0 when every step ran (the caller judges the result), 1 when one failed.
 
@@ -57,7 +59,18 @@ async function picture(frame) {
       stroke: nodes.length ? getComputedStyle(nodes[1].querySelector('.shape')).stroke : null,
       status: document.getElementById('status').textContent,
       keys: [...document.querySelectorAll('#canvas tspan.key')].map((t) => t.textContent),
+      // The node types wholly in view, and whether all of the picture is.
+      inView: nodes.filter((g) => inside(g)).map((g) => g.dataset.type),
+      fits: inside(document.querySelector('#canvas svg')),
     };
+    function inside(el) {
+      if (!el) {
+        return false;
+      }
+      const r = el.getBoundingClientRect();
+      const v = document.getElementById('view').getBoundingClientRect();
+      return r.left >= v.left - 1 && r.right <= v.right + 1 && r.top >= v.top - 1 && r.bottom <= v.bottom + 1;
+    }
   });
 }
 
@@ -166,6 +179,25 @@ async function main(page) {
     return p.renders > renders ? p : null;
   }, STEP_TIMEOUT) || (await picture(frame));
 
+  mark('a node added out of view');
+  // Fitted, then zoomed far in at the middle: the end of the tree's top rows is out of view.
+  await frame.focus('#view');
+  await page.keyboard.press('0');
+  for (let i = 0; i < 8; i++) {
+    await page.keyboard.press('+');
+  }
+  const zoomedIn = await picture(frame);
+  result.beforeAdd = { transform: zoomedIn.transform, inView: zoomedIn.inView };
+  await page.click('.editor-instance .monaco-editor .view-lines');
+  await gotoPosition(page, config.addAt[0], config.addAt[1]);
+  await page.keyboard.type(config.add);
+  result.added = await until(async () => {
+    const p = await picture(frame);
+    return p.inView.includes(config.addType) ? p : null;
+  }, STEP_TIMEOUT) || (await picture(frame));
+  await frame.focus('#view');
+  await page.keyboard.press('0'); // all of it in view again for the next steps
+
   mark('expand and ports');
   await frame.click('#expand');
   result.expanded = await until(async () => {
@@ -197,8 +229,10 @@ async function main(page) {
     }, SERVER_TIMEOUT, 100);
     result.big = { nodes: big ? big.types.length : (await picture(frame)).types.length, shownMs: Date.now() - t0 };
     await frame.focus('#view');
-    // Drawn at a readable zoom (too large to fit); '0' fits all of it, '+' zooms in again.
-    result.big.initialTransform = (await picture(frame)).transform;
+    // Opened fitted, all of it in view; '0' fits it again, '+' zooms in.
+    const opened = await picture(frame);
+    result.big.initialTransform = opened.transform;
+    result.big.fits = opened.fits;
     const z0 = Date.now();
     await page.keyboard.press('0');
     result.big.fittedTransform = (await picture(frame)).transform;
@@ -206,6 +240,15 @@ async function main(page) {
     await page.keyboard.press('+');
     result.big.zoomedTransform = (await picture(frame)).transform;
     await page.keyboard.press('0');
+    // Zoomed in to where a node is large enough to click.
+    for (let i = 0; i < 40; i++) {
+      const t = (await picture(frame)).transform;
+      const k = parseFloat((/scale\(([\d.e-]+)\)/.exec(t) || [])[1] || '1');
+      if (k >= 0.3) {
+        break;
+      }
+      await page.keyboard.press('+');
+    }
     // The last node in view (drawn in pre-order: the deepest visible one on the right).
     const target = await frame.$$eval('#canvas g.node', (gs) => {
       const view = document.getElementById('view').getBoundingClientRect();

@@ -1,7 +1,8 @@
 // The webview of "bt-lsp: Show Tree": shows the SVG the server drew, pans and zooms it (mouse and
-// keyboard), keeps the zoom and scroll across updates of the same tree, highlights the node the
-// extension names, and reports clicks. No eval, no remote content: the CSP allows this script and
-// styles carrying the page's nonce only.
+// keyboard), opens each tree fitted to the view, keeps the zoom and scroll across updates of the
+// same tree (or the fit, until the user zooms or pans) and scrolls the node an edit made or
+// changed into view, highlights the node the extension names, and reports clicks. No eval, no
+// remote content: the CSP allows this script and styles carrying the page's nonce only.
 (function () {
   'use strict';
   const vscode = acquireVsCodeApi();
@@ -10,10 +11,12 @@
   const title = document.getElementById('title');
   const status = document.getElementById('status');
   const nonce = canvas.dataset.nonce;
-  const MIN_ZOOM = 0.05;
+  const MIN_ZOOM = 0.05; // unless fitting the whole tree takes less
   const MAX_ZOOM = 8;
+  const MARGIN = 16;
 
-  let state = Object.assign({ x: 16, y: 16, k: 1, tree: null }, vscode.getState() || {});
+  // fitted: the view shows the whole tree and follows its size until the user zooms or pans.
+  let state = Object.assign({ x: 16, y: 16, k: 1, tree: null, fitted: false }, vscode.getState() || {});
   let selected = null;
   let size = { w: 0, h: 0 };
   let drag = null;
@@ -23,37 +26,34 @@
     vscode.setState(state);
   }
 
-  function fit() {
-    const w = view.clientWidth;
-    const h = view.clientHeight;
-    if (!size.w || !w) {
-      return;
+  /** The zoom at which the whole tree fits the view (at most 1: a small tree is not blown up). */
+  function fitScale() {
+    const w = view.clientWidth - 2 * MARGIN;
+    const h = view.clientHeight - 2 * MARGIN;
+    if (!size.w || !size.h || w <= 0 || h <= 0) {
+      return null;
     }
-    state.k = Math.max(MIN_ZOOM, Math.min(1, (w - 32) / size.w, Math.max((h - 32) / size.h, 0.35)));
-    state.x = Math.max(16, (w - size.w * state.k) / 2);
-    state.y = 16;
-    apply();
+    return Math.min(1, w / size.w, h / size.h);
   }
 
-  /** A new tree: all of it when it fits at a readable size, else its top, root centred. */
-  function initial() {
-    const w = view.clientWidth;
-    if (!size.w || !w) {
+  /** The whole tree in view, centred (so that zooming in at the middle stays on the tree). */
+  function fit() {
+    const k = fitScale();
+    if (k === null) {
       return;
     }
-    const k = Math.min(1, (w - 32) / size.w, Math.max((view.clientHeight - 32) / size.h, 0.5));
-    if (k >= 0.5) {
-      fit();
-      return;
-    }
-    state.k = 0.5;
-    state.x = w / 2 - (size.w / 2) * state.k;
-    state.y = 16;
+    state.k = k;
+    state.x = (view.clientWidth - size.w * k) / 2;
+    state.y = (view.clientHeight - size.h * k) / 2;
+    state.fitted = true;
     apply();
   }
 
   function zoomAt(factor, mx, my) {
-    const k = Math.min(MAX_ZOOM, Math.max(MIN_ZOOM, state.k * factor));
+    const fitted = fitScale();
+    const min = fitted === null ? MIN_ZOOM : Math.min(MIN_ZOOM, fitted);
+    const k = Math.min(MAX_ZOOM, Math.max(min, state.k * factor));
+    state.fitted = false;
     state.x = mx - ((mx - state.x) * k) / state.k;
     state.y = my - ((my - state.y) * k) / state.k;
     state.k = k;
@@ -75,8 +75,35 @@
       if (box.right < outer.left || box.left > outer.right || box.bottom < outer.top || box.top > outer.bottom) {
         state.x += outer.left + outer.width / 2 - (box.left + box.width / 2);
         state.y += outer.top + outer.height / 3 - (box.top + box.height / 2);
+        state.fitted = false;
         apply();
       }
+    }
+  }
+
+  /** The shift along one axis that brings [lo, hi] inside [min, max] (its start, if too long). */
+  function shiftInto(lo, hi, min, max) {
+    if (lo < min || hi - lo > max - min) {
+      return min - lo;
+    }
+    return hi > max ? max - hi : 0;
+  }
+
+  /** Pans, as little as it takes, until node ``id`` is wholly in view (keeping the zoom). */
+  function keepInView(id) {
+    const node = id ? document.getElementById(id) : null;
+    if (!node) {
+      return;
+    }
+    const box = node.getBoundingClientRect();
+    const outer = view.getBoundingClientRect();
+    const dx = shiftInto(box.left, box.right, outer.left + MARGIN, outer.right - MARGIN);
+    const dy = shiftInto(box.top, box.bottom, outer.top + MARGIN, outer.bottom - MARGIN);
+    if (dx || dy) {
+      state.x += dx;
+      state.y += dy;
+      state.fitted = false;
+      apply();
     }
   }
 
@@ -90,9 +117,13 @@
     selected = null;
     if (state.tree !== message.tree) {
       state.tree = message.tree;
-      initial();
+      state.fitted = true; // a new tree opens fitted (and is fitted when the view gets a size)
+    }
+    if (state.fitted) {
+      fit();
     } else {
       apply();
+      keepInView(message.changed);
     }
     select(message.selected, false);
     document.body.dataset.tree = message.tree;
@@ -140,6 +171,7 @@
     view.classList.add('panning');
     state.x += dx;
     state.y += dy;
+    state.fitted = false;
     drag.x = event.clientX;
     drag.y = event.clientY;
     apply();
@@ -166,6 +198,13 @@
     }
   });
 
+  function pan(dx, dy) {
+    state.x += dx;
+    state.y += dy;
+    state.fitted = false;
+    apply();
+  }
+
   view.addEventListener('keydown', (event) => {
     const step = 48;
     const w = view.clientWidth / 2;
@@ -183,20 +222,16 @@
         fit();
         break;
       case 'ArrowLeft':
-        state.x += step;
-        apply();
+        pan(step, 0);
         break;
       case 'ArrowRight':
-        state.x -= step;
-        apply();
+        pan(-step, 0);
         break;
       case 'ArrowUp':
-        state.y += step;
-        apply();
+        pan(0, step);
         break;
       case 'ArrowDown':
-        state.y -= step;
-        apply();
+        pan(0, -step);
         break;
       case 'Enter':
         if (selected) {
@@ -222,7 +257,7 @@
   ports.addEventListener('change', options);
   expand.addEventListener('change', options);
 
-  window.addEventListener('resize', () => apply());
+  window.addEventListener('resize', () => (state.fitted ? fit() : apply()));
   apply();
   vscode.postMessage({ type: 'ready' });
   if (ports.checked || expand.checked) {

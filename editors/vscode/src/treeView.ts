@@ -1,7 +1,9 @@
 // "bt-lsp: Show Tree": a webview beside the editor with the picture of the behavior tree under
 // the cursor, drawn by the server (`bt-lsp.renderTree`). It follows the text as the user types
-// (after the diagnostics' debounce), highlights the node under the cursor, and a click on a node
-// selects its element in the XML; a double click on a SubTree node opens the tree it calls.
+// (after the diagnostics' debounce), keeping the node the typing made or changed in view (the
+// server names it from the range the edits replaced), highlights the node under the cursor, and a
+// click on a node selects its element in the XML; a double click on a SubTree node opens the tree
+// it calls.
 
 import * as vscode from 'vscode';
 import type { LanguageClient } from 'vscode-languageclient/node';
@@ -32,6 +34,29 @@ interface Rendered {
   svg: string;
   trees: string[];
   nodes: TreeNode[];
+  changed?: string | null;
+}
+
+/** A span of the text in UTF-16 offsets, as VS Code counts them. */
+interface Span {
+  start: number;
+  end: number;
+}
+
+/**
+ * ``edited`` (a span of the text before ``change``) as a span of the text after it, joined with
+ * the text ``change`` wrote: what the edits so far replaced, in the text as it is now.
+ */
+function addEdit(edited: Span | undefined, change: { rangeOffset: number; rangeLength: number; text: string }): Span {
+  const start = change.rangeOffset;
+  const oldEnd = start + change.rangeLength;
+  const newEnd = start + change.text.length;
+  if (!edited) {
+    return { start, end: newEnd };
+  }
+  const moved = (offset: number): number =>
+    offset <= start ? offset : offset >= oldEnd ? offset + newEnd - oldEnd : newEnd;
+  return { start: Math.min(start, moved(edited.start)), end: Math.max(newEnd, moved(edited.end)) };
 }
 
 type FromWebview =
@@ -67,6 +92,8 @@ class TreePanel {
   private timer: ReturnType<typeof setTimeout> | undefined;
   private generation = 0;
   private ready = false;
+  /** What the edits since the last picture replaced, for the server to name the node changed. */
+  private edited: Span | undefined;
   private options = { ports: false, expandSubtrees: false };
 
   constructor(
@@ -91,6 +118,9 @@ class TreePanel {
       this.panel.webview.onDidReceiveMessage((m: FromWebview) => void this.onMessage(m)),
       vscode.workspace.onDidChangeTextDocument((e) => {
         if (e.document === this.document && e.contentChanges.length > 0) {
+          for (const change of e.contentChanges) {
+            this.edited = addEdit(this.edited, change);
+          }
           this.schedule();
         }
       }),
@@ -113,6 +143,7 @@ class TreePanel {
 
   follow(editor: vscode.TextEditor): void {
     this.document = editor.document;
+    this.edited = undefined;
     this.position = editor.selection.active;
     this.panel.title = `Tree: ${editor.document.uri.path.split('/').pop() ?? ''}`;
     void this.refresh();
@@ -169,6 +200,12 @@ class TreePanel {
     }
     const generation = ++this.generation;
     const position = this.position ?? new vscode.Position(0, 0);
+    const version = doc.version;
+    const edited = this.edited;
+    const at = (offset: number) => {
+      const p = doc.positionAt(offset);
+      return { line: p.line, character: p.character };
+    };
     try {
       const result = (await client.sendRequest('workspace/executeCommand', {
         command: COMMAND,
@@ -178,11 +215,15 @@ class TreePanel {
             position: { line: position.line, character: position.character },
             ports: this.options.ports,
             expandSubtrees: this.options.expandSubtrees,
+            ...(edited ? { edited: { start: at(edited.start), end: at(edited.end) } } : {}),
           },
         ],
       })) as Rendered | null;
       if (generation !== this.generation) {
         return; // a newer request is on its way
+      }
+      if (doc.version === version) {
+        this.edited = undefined; // drawn: later edits start a new span
       }
       this.rendered = result ?? undefined;
       if (!result) {
@@ -196,6 +237,7 @@ class TreePanel {
         trees: result.trees,
         nodes: result.nodes.map((n) => ({ id: n.id, kind: n.kind, subtree: n.subtree ?? null })),
         selected: this.nodeAt(position)?.id ?? null,
+        changed: result.changed ?? null,
       });
     } catch (error) {
       this.log.warn(`bt-lsp: drawing the tree: ${error instanceof Error ? error.message : String(error)}`);

@@ -1,15 +1,17 @@
-"""A tidy top-down layout of a picture (Reingold–Tilford, with boxes of any width).
+"""A tidy top-down layout of a picture in which every subtree has a band of its own.
 
-Each subtree is laid out once, bottom-up, as its left and right contours (the extremes of
-its boxes at each depth below its root, relative to the root's centre); a subtree is put
-to the right of its left siblings as close as their contours allow, and a parent is
-centred above its first and last children.  Both passes walk the pre-order list of nodes
-(children after their parent), so no Python recursion happens whatever the depth.  A
-contour is moved by an offset and merged by rewriting the shallower side's rows, so a
-merge costs the depth of the shallower subtree and a chain of decorators costs one step
-per node.
+Each subtree is laid out once, bottom-up, as a band: the horizontal extent of all its boxes.
+A node's children's bands are put side by side in XML order, :data:`SIBLING_GAP` apart, and
+the node is centred above its first and last children; its band is the union of theirs and
+its own box.  Sibling subtrees therefore never interleave (a deep subtree is never tucked
+under a shallow neighbour, as a contour-packing layout does), which is what keeps the
+connectors clear: a parent's connector runs down from its box, along the gap between its row
+and its children's row, and down into each child, all inside the parent's band, where the
+only boxes are the parent's and its children's.  Both passes walk the pre-order list of
+nodes (children after their parent), so no Python recursion happens whatever the depth.
 
-Rows are as tall as their tallest box, so boxes of different heights never meet.
+Rows are as tall as their tallest box, so boxes of different heights never meet, and the
+connectors' horizontal run (:func:`bus_y`) lies in the gap below the whole row.
 """
 
 from __future__ import annotations
@@ -79,26 +81,10 @@ def measure(node: Node, lines: list[str]) -> tuple[float, float]:
     return w, len(lines) * LINE_H + 2 * PAD_Y
 
 
-class _Contour:
-    """One side of a subtree: x per row (deepest first) as ``values[j] + offset``."""
-
-    __slots__ = ("offset", "values")
-
-    def __init__(self, values: list[float], offset: float) -> None:
-        self.values = values
-        self.offset = offset
-
-
-def _overlay(top: _Contour, under: _Contour) -> _Contour:
-    """``top``'s rows where it has them, ``under``'s below: the deeper one's list is kept
-    and the other's rows are written over its top rows, so the cost is the shallower's."""
-    if len(top.values) >= len(under.values):
-        return top
-    base = len(under.values) - len(top.values)
-    vals, d = under.values, top.offset - under.offset
-    for j, v in enumerate(top.values):
-        vals[base + j] = v + d
-    return under
+def bus_y(child: Box) -> float:
+    """The height of the horizontal run of the connectors to ``child`` and its siblings:
+    the middle of the gap above their row (every box of the row above ends over it)."""
+    return child.y - LEVEL_GAP / 2
 
 
 def layout(picture: Picture) -> Layout:
@@ -106,45 +92,27 @@ def layout(picture: Picture) -> Layout:
     n = len(nodes)
     lines = [node_lines(nd) for nd in nodes]
     sizes = [measure(nd, ls) for nd, ls in zip(nodes, lines, strict=True)]
-    rel = [0.0] * n  # x of a node's centre relative to its parent's centre
-    # Each subtree's contours as (values, offset): the deepest row first, the subtree's own
-    # row last, each value plus the offset giving an x relative to the subtree root's centre.
-    # Moving a contour changes its offset; merging two rewrites the rows of the shallower.
-    left: list[_Contour | None] = [None] * n
-    right: list[_Contour | None] = [None] * n
+    band = [0.0] * n  # the width of each subtree's band
+    centre = [0.0] * n  # a node's centre, from the left of its band
+    start = [0.0] * n  # the left of a node's band, from the left of its parent's band
     for i in range(n - 1, -1, -1):  # children (later in pre-order) before parents
-        half = sizes[i][0] / 2
+        w = sizes[i][0]
         kids = nodes[i].children
         if not kids:
-            left[i], right[i] = _Contour([-half], 0.0), _Contour([half], 0.0)
+            band[i], centre[i] = w, w / 2
             continue
-        acc_l, acc_r = left[kids[0]], right[kids[0]]
-        assert acc_l is not None and acc_r is not None
-        offsets = [0.0]
-        for k in kids[1:]:
-            cl, cr = left[k], right[k]
-            assert cl is not None and cr is not None
-            left[k] = right[k] = None
-            a, c = acc_r.values, cl.values
-            m = min(len(a), len(c))
-            na, nc = len(a) - 1, len(c) - 1
-            shift = (
-                max([a[na - d] - c[nc - d] for d in range(m)]) + acc_r.offset - cl.offset
-            ) + SIBLING_GAP
-            offsets.append(shift)
-            cl.offset += shift
-            cr.offset += shift
-            acc_l = _overlay(acc_l, cl)  # the left side: earlier siblings first
-            acc_r = _overlay(cr, acc_r)  # the right side: this sibling first
-        left[kids[0]] = right[kids[0]] = None
-        mid = (offsets[0] + offsets[-1]) / 2
-        for k, off in zip(kids, offsets, strict=True):
-            rel[k] = off - mid
-        acc_l.offset -= mid
-        acc_r.offset -= mid
-        acc_l.values.append(-half - acc_l.offset)
-        acc_r.values.append(half - acc_r.offset)
-        left[i], right[i] = acc_l, acc_r
+        x = 0.0
+        for k in kids:
+            start[k] = x
+            x += band[k] + SIBLING_GAP
+        first, last = kids[0], kids[-1]
+        c = (start[first] + centre[first] + start[last] + centre[last]) / 2
+        lo = min(0.0, c - w / 2)  # a box wider than its children's bands widens its own
+        hi = max(x - SIBLING_GAP, c + w / 2)
+        if lo < 0.0:
+            for k in kids:
+                start[k] -= lo
+        band[i], centre[i] = hi - lo, c - lo
 
     # Row heights and tops.
     depth_h: list[float] = []
@@ -156,18 +124,14 @@ def layout(picture: Picture) -> Layout:
     for h in depth_h[:-1]:
         tops.append(tops[-1] + h + LEVEL_GAP)
 
-    cx = [0.0] * n
+    left = [0.0] * n  # the left of each band in the picture
+    left[0] = MARGIN
     for i in range(1, n):  # parents (earlier in pre-order) before children
-        cx[i] = cx[nodes[i].parent] + rel[i]
-    root_l, root_r = left[0], right[0]
-    assert root_l is not None and root_r is not None
-    lo = min(root_l.values) + root_l.offset
-    hi = max(root_r.values) + root_r.offset
-    shift = MARGIN - lo
+        left[i] = left[nodes[i].parent] + start[i]
     boxes = [
-        Box(cx[i] + shift - sizes[i][0] / 2, tops[nodes[i].depth], sizes[i][0], sizes[i][1])
+        Box(left[i] + centre[i] - sizes[i][0] / 2, tops[nodes[i].depth], sizes[i][0], sizes[i][1])
         for i in range(n)
     ]
-    width = hi - lo + 2 * MARGIN
+    width = band[0] + 2 * MARGIN
     height = tops[-1] + depth_h[-1] + MARGIN
     return Layout(boxes, lines, width, height)

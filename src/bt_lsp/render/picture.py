@@ -344,3 +344,24 @@ def _give_problems(
             node = nodes[idx]
             node.severity = found[0].severity
             node.problems = tuple(f"{d.code}: {d.message}" for d in found)
+
+
+def changed_node(picture: Picture, start: int, end: int) -> Node | None:
+    """The node an edit of ``[start, end)`` (code points of the rendered document, the text
+    as it is now) made or changed, for a viewer to keep it in view: the first node whose
+    element lies inside the span (an element typed or pasted), else the innermost one
+    whose element holds ``start`` (an attribute edited, a child deleted; an empty span
+    also at the element's end, where a deletion or the last keystroke was); ``None`` when
+    the edit is outside the tree.  Only nodes of the rendered document count; of the
+    copies an expansion drew of one element, the first (or the deepest, for ``start``)."""
+    start, end = min(start, end), max(start, end)
+    holding: Node | None = None
+    for node in picture.nodes:
+        if node.source is not None:
+            continue
+        if node.index > 0 and start <= node.start and node.end <= end:
+            return node
+        holds = node.start <= start < node.end or start == end == node.end
+        if holds and (holding is None or node.depth > holding.depth):
+            holding = node
+    return holding

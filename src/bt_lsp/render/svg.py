@@ -5,7 +5,9 @@ are CSS variables with light defaults and dark ones under ``prefers-color-scheme
 default first asks for the VS Code theme variable, so the same SVG follows the editor's
 theme inside a webview.  Every node is a ``<g class="node …" id="nK">`` carrying its
 source span (``data-start``/``data-end``, code points), so a viewer can map a click to the
-text and the text back to a node.
+text and the text back to a node.  The ``viewBox`` is the whole picture and ``width`` and
+``height`` its natural size; opened on its own it is scaled down to fit the window, so it
+never opens cut off.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from bt_lsp.render.layout import (
     PAD_Y,
     Box,
     Layout,
+    bus_y,
     layout,
 )
 from bt_lsp.render.picture import Node, Picture
@@ -98,6 +101,9 @@ _KINDS = ("tree", "control", "decorator", "action", "condition", "subtree", "unk
 STYLE = (
     f".bt-tree{{{_vars(False)}}}"
     f"@media (prefers-color-scheme: dark){{.bt-tree{{{_vars(True)}}}}}"
+    # Opened on its own (a browser, an image viewer), the picture is scaled down to fit the
+    # window; inside a page or an <img>, the page sizes it.
+    ".bt-tree:root{max-width:100vw;max-height:100vh}"
     ".bt-tree{background:var(--bt-bg);font:12px ui-monospace,SFMono-Regular,Menlo,Consolas,"
     "'DejaVu Sans Mono',monospace}"
     ".bt-tree text{fill:var(--bt-fg);white-space:pre;pointer-events:none}"
@@ -228,10 +234,12 @@ def _node(node: Node, b: Box, lines: list[str]) -> str:
 
 
 def _edge(pb: Box, cb: Box, inlined: bool) -> str:
+    """Down from the parent, along the gap above the child's row, down into the child: every
+    segment stays in the parent's band and out of the rows' boxes (see layout)."""
     cls = "edge inlined" if inlined else "edge"
     return (
-        f'<path class="{cls}" d="M{pb.x + pb.w / 2:.1f} {pb.y + pb.h:.1f}'
-        f'V{(pb.y + pb.h + cb.y) / 2:.1f}H{cb.x + cb.w / 2:.1f}V{cb.y:.1f}"/>'
+        f'<path class="{cls}" d="M{pb.cx:.1f} {pb.bottom:.1f}'
+        f'V{bus_y(cb):.1f}H{cb.cx:.1f}V{cb.y:.1f}"/>'
     )
 
 

@@ -1,12 +1,16 @@
 """``workspace/executeCommand`` ``bt-lsp.renderTree``: the picture of the tree at a position.
 
-Arguments: one object ``{uri, position?, tree?, format?, ports?, expandSubtrees?}``; the
-tree is the one named by ``tree``, else the one holding ``position``, else the document's
-main tree.  The answer is ``{tree, format, svg | text, trees, nodes}``: ``trees`` lists the
-document's tree IDs, and each node has its SVG ``id``, its element's ``range`` (in the
-negotiated position encoding; with ``uri`` when it comes from another document, an
-expanded SubTree of an included file), ``kind``, ``type``, ``name``, and for a SubTree the
-``target`` location of the tree it calls.  ``null`` when the document has no tree.
+Arguments: one object ``{uri, position?, tree?, format?, ports?, expandSubtrees?, edited?}``;
+the tree is the one named by ``tree``, else the one holding ``position``, else the
+document's main tree.  The answer is ``{tree, format, svg | text, trees, nodes, changed}``:
+``trees`` lists the document's tree IDs, and each node has its SVG ``id``, its element's
+``range`` (in the negotiated position encoding; with ``uri`` when it comes from another
+document, an expanded SubTree of an included file), ``kind``, ``type``, ``name``, and for a
+SubTree the ``target`` location of the tree it calls.  ``edited``, the range of the text
+the client's edits since its last picture replaced (in the document as it is now), gives
+``changed``: the ``id`` of the node those edits made or changed, for the client to keep it
+in view (``null`` without ``edited`` or for an edit outside the tree).  ``null`` when the
+document has no tree.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from bt_lsp.render import (
     FORMATS,
     Format,
     Picture,
+    changed_node,
     document_trees,
     find_tree,
     render,
@@ -57,15 +62,26 @@ def _options(args: tuple[Any, ...]) -> Mapping[str, Any]:
     return opts
 
 
-def _position(raw: object) -> tuple[int, int] | None:
+def _position(raw: object, name: str = "position") -> tuple[int, int] | None:
     if raw is None:
         return None
     if not isinstance(raw, Mapping):
-        raise JsonRpcInvalidParams(f"{COMMAND}: 'position' must be {{line, character}}")
+        raise JsonRpcInvalidParams(f"{COMMAND}: '{name}' must be {{line, character}}")
     line, character = raw.get("line"), raw.get("character")
     if not isinstance(line, int) or not isinstance(character, int) or line < 0 or character < 0:
-        raise JsonRpcInvalidParams(f"{COMMAND}: 'position' must be {{line, character}}")
+        raise JsonRpcInvalidParams(f"{COMMAND}: '{name}' must be {{line, character}}")
     return line, character
+
+
+def _edited(raw: object) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    if raw is None:
+        return None
+    if not isinstance(raw, Mapping):
+        raise JsonRpcInvalidParams(f"{COMMAND}: 'edited' must be a range {{start, end}}")
+    start, end = _position(raw.get("start"), "edited"), _position(raw.get("end"), "edited")
+    if start is None or end is None:
+        raise JsonRpcInvalidParams(f"{COMMAND}: 'edited' must be a range {{start, end}}")
+    return start, end
 
 
 def range_json(doc: Document, start: int, end: int, enc: Encoding) -> dict[str, Any]:
@@ -142,6 +158,7 @@ def _nodes(
 
 def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
     opts = _options(args)
+    edited = _edited(opts.get("edited"))
     uri = opts["uri"]
     od = ls.get(uri)
     if od is None:
@@ -199,6 +216,12 @@ def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
             found = resolve(node.subtree)
             if found is not None:
                 targets[node.subtree] = (found.source, found.element)
+    changed: str | None = None
+    if edited is not None:
+        (sl, sc), (el, ec) = edited
+        lines = od.doc.lines
+        hit = changed_node(picture, lines.offset(sl, sc, enc), lines.offset(el, ec, enc))
+        changed = hit.id if hit is not None else None
     places = Places(ls, uri, od.doc)
     return {
         "tree": picture.tree_id,
@@ -207,6 +230,7 @@ def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
         "trees": [tree_id_of(t) for t in trees],
         "truncated": picture.truncated,
         "nodes": _nodes(picture, places, targets, enc),
+        "changed": changed,
     }
 
 
