@@ -38,7 +38,12 @@ from bt_lsp.rules.diagnostics import XML_UNESCAPED_CHAR, Diagnostic
 from bt_lsp.rules.names import is_allowed_port_name
 from bt_lsp.rules.semantics.base import edit_distance
 from bt_lsp.rules.semantics.document import MISSING_FORMAT
-from bt_lsp.rules.semantics.nodes import ID_ON_COMPACT_NODE, UNKNOWN_NODE, UnknownNodeData
+from bt_lsp.rules.semantics.nodes import (
+    ID_ON_COMPACT_NODE,
+    SINGLE_CHILD_CONTROL,
+    UNKNOWN_NODE,
+    UnknownNodeData,
+)
 from bt_lsp.rules.semantics.ports import (
     MISSING_PORT_WITHOUT_DEFAULT,
     MISSING_REQUIRED_PORT,
@@ -204,6 +209,34 @@ def _new_tree(text: str, model: Model, tree_id: str) -> TextEdit | None:
     return _insert_before_end_tag(text, root, lines, unit, nl)
 
 
+def _unwrap(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
+    """Replace a control with its one child, the child's lines moved left by the depth
+    the control gave them; offered only when nothing but blanks surrounds the child (a
+    comment there would be lost)."""
+    el = _element_at(doc, doc.model, diag.start)
+    if el is None or len(el.children) != 1 or el.end < 0:
+        return []
+    child = doc.model.elements[el.children[0]]
+    text = doc.text
+    if child.end < 0 or el.end_name_start < 0:
+        return []
+    inner_start = el.token_start + doc.scan.tokens[el.token_index].length
+    end_tag = el.end_name_start - 2  # the '</' of the end tag
+    if text[inner_start : child.token_start].strip() or text[child.end : end_tag].strip():
+        return []
+    body = text[child.token_start : child.end]
+    outer = _line_indent(text, el.token_start)
+    inner = _line_indent(text, child.token_start)
+    if outer is not None and inner is not None and inner.startswith(outer):
+        extra = inner[len(outer) :]
+        lines = body.splitlines(keepends=True)
+        body = lines[0] + "".join(
+            line[len(extra) :] if line.startswith(extra) else line for line in lines[1:]
+        )
+    edit = TextEdit(el.token_start, el.end, body)
+    return [_fix(SINGLE_CHILD_CONTROL, "unwrap", (edit,), diag, element=el.name)]
+
+
 # The fixes of each code that has some (their titles are defined with the code).
 _FIXERS: Mapping[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = MappingProxyType(
     {
@@ -215,6 +248,7 @@ _FIXERS: Mapping[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = Ma
         MISSING_REQUIRED_PORT.code: _missing_ports,
         MISSING_PORT_WITHOUT_DEFAULT.code: _missing_ports,
         UNKNOWN_SUBTREE.code: _unknown_subtree,
+        SINGLE_CHILD_CONTROL.code: _unwrap,
     }
 )
 

@@ -35,6 +35,11 @@
   ``Parallel``, or ``max_failures`` of a ``ParallelAll``, larger than its number of
   children (negative values count from the end and never exceed it): the node throws at
   its first tick.  Range: the value.
+* ``single-child-control`` (hint): a ``Sequence``, ``Fallback`` or another control node
+  that only passes its one child's status on; not reported when the control carries a
+  ``_``-attribute (a pre- or postcondition hung on it).  Range: the element name.  Fix:
+  replace the control with its child (unsafe: the tree's shape, seen in Groot and the
+  loggers, changes).
 """
 
 from __future__ import annotations
@@ -267,6 +272,32 @@ PARALLEL_THRESHOLD: Final = define(
         """,
     since="Every version.",
 )
+SINGLE_CHILD_CONTROL: Final = define(
+    "single-child-control",
+    Severity.HINT,
+    "a `Sequence`, `Fallback` or similar control node with exactly one child",
+    BT,
+    fixes={"unwrap": unsafe("Replace <{element}> with its child")},
+    doc="""
+        A `Sequence`, `Fallback`, `SequenceWithMemory`, `ReactiveSequence`,
+        `ReactiveFallback`, `AsyncSequence` or `AsyncFallback` with exactly one child ticks
+        that child and returns its status (`SUCCESS`, `FAILURE`, `RUNNING`, or `SKIPPED` when
+        the child was skipped): it behaves like the child alone. BehaviorTree.CPP loads and
+        runs it; it is usually a leftover of an edit, or a node whose siblings were never
+        written. Not reported when the control has a `_`-attribute (a precondition such as
+        `_skipIf`, or a postcondition): that is then a place to hang it.
+        """,
+    why="The extra node adds depth to the tree and its logs without doing anything.",
+    bad="""
+        <Sequence>
+          <MoveBase goal="{goal}"/>
+        </Sequence>
+        """,
+    good="""
+        <MoveBase goal="{goal}"/>
+        """,
+    since="Every version.",
+)
 
 
 _BUILTIN_LOWER: Final[Mapping[str, str]] = MappingProxyType({k.lower(): k for k in BUILTINS})
@@ -333,6 +364,8 @@ def check_node(st: State, el: Element) -> Resolved | None:
         _unregistered(st, type_id, start, end, name in EXPLICIT_TAGS)
         return None
     _children(st, el, res)
+    if len(el.children) == 1 and res.origin == "builtin" and res.id in _PASS_THROUGH:
+        _single_child(st, el, res.id)
     if res.id == "ReactiveSequence":
         _reactive(st, el)
     elif res.id == "Parallel":
@@ -570,6 +603,33 @@ _TICK_CHILD_COUNT: Final = MappingProxyType(
 
 def _is_switch(type_id: str) -> bool:
     return type_id.startswith("Switch") and type_id[6:].isdigit()
+
+
+# The controls that, with one child, tick it and return its status unchanged.
+_PASS_THROUGH: Final = frozenset(
+    {
+        "Sequence",
+        "Fallback",
+        "SequenceWithMemory",
+        "ReactiveSequence",
+        "ReactiveFallback",
+        "AsyncSequence",
+        "AsyncFallback",
+        "SequenceStar",  # version 3's SequenceWithMemory
+    }
+)
+
+
+def _single_child(st: State, el: Element, type_id: str) -> None:
+    if any(a.name.startswith("_") for a in el.attrs):
+        return  # a pre- or postcondition hangs on the control
+    st.add(
+        el.name_start,
+        el.name_end,
+        "single-child-control",
+        f"This {type_id} has one child, so it returns what its child returns; replace it "
+        "with its child, or add the siblings it was meant for",
+    )
 
 
 def _reactive(st: State, el: Element) -> None:
