@@ -73,7 +73,7 @@ def test_unwrap_moves_the_child_left() -> None:
         "</root>\n"
     )
     # Both controls have one child: the outer one's fix comes first.
-    check_fix(before, after, "Replace <Sequence> with its child")
+    check_fix(before, after, "Replace <Sequence> with its child", CODE)
 
 
 def test_no_unwrap_that_would_lose_a_comment() -> None:
@@ -83,7 +83,7 @@ def test_no_unwrap_that_would_lose_a_comment() -> None:
             f"<Sequence>{inside}</Sequence></BehaviorTree></root>"
         )
         assert check(text, only=CODE), "the control is reported either way"
-        return [f.title for f in fixes(Document(text))]
+        return [f.title for f in fixes(Document(text), [CODE])]
 
     assert offered("<AlwaysSuccess/>") == ["Replace <Sequence> with its child"]
     assert offered("<!-- later: Dock --><AlwaysSuccess/>") == []
