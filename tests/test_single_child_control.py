@@ -39,6 +39,13 @@ def test_not_with_two_children_a_condition_or_another_kind_of_node() -> None:
     assert check(text, only=CODE) == []
 
 
+def test_not_while_the_control_is_being_typed() -> None:
+    typed = '<root BTCPP_format="4"><BehaviorTree ID="A"><⟦Sequence⟧><AlwaysSuccess/>'
+    assert check(typed + "</Sequence></BehaviorTree></root>", only=CODE) == marks(typed, CODE)
+    # No end tag yet: the parser closes the control at the tree's end tag.
+    assert check(typed + "</BehaviorTree></root>", only=CODE) == []
+
+
 def test_version_3_sequence_star() -> None:
     text = (
         '<root><BehaviorTree ID="T">'

@@ -37,7 +37,7 @@
   its first tick.  Range: the value.
 * ``single-child-control`` (hint): a ``Sequence``, ``Fallback`` or another control node
   that only passes its one child's status on; not reported when the control carries a
-  ``_``-attribute (a pre- or postcondition hung on it).  Range: the element name.  Fix:
+  ``_``-attribute (a pre- or postcondition hung on it) or has no end tag (being typed).  Range: the element name.  Fix:
   replace the control with its child (unsafe: the tree's shape, seen in Groot and the
   loggers, changes).
 """
@@ -621,6 +621,8 @@ _PASS_THROUGH: Final = frozenset(
 
 
 def _single_child(st: State, el: Element, type_id: str) -> None:
+    if el.end_name_start < 0:
+        return  # not closed: its other children may not be typed yet
     if any(a.name.startswith("_") for a in el.attrs):
         return  # a pre- or postcondition hangs on the control
     st.add(
