@@ -17,6 +17,7 @@ from bt_lsp.rules.builtins_v3 import V3_BUILTINS
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
+from tests.pinned import pinned
 
 E, W, H = Severity.ERROR, Severity.WARNING, Severity.HINT
 SUB = '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree>'
@@ -32,7 +33,7 @@ def doc(body: str, fmt: str = "") -> Document:
 def codes(body: str, version: str | None) -> list[tuple[str, Severity]]:
     d = doc(body, "" if version == "3" else 'BTCPP_format="4"')
     ctx = Context.combine(d, [], path="/w/t.xml", btcpp_version=version)
-    return [(x.code, x.severity) for x in semantics.check(d, ctx)]
+    return [(x.code, x.severity) for x in pinned(semantics.check(d, ctx))]
 
 
 def test_the_v3_table() -> None:
