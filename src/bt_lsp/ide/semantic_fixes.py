@@ -2,7 +2,9 @@
 
 Pure: they return edits.  Each fix leaves the document well-formed.  Whether a fix is
 safe is defined with its code (``fixes=`` of :func:`bt_lsp.rules.codes.define`); the first
-safe fix of a diagnostic is its preferred one.
+safe fix of a diagnostic is its preferred one.  A rule that defines its code with a
+``fixer=`` makes its fixes beside itself (:data:`bt_lsp.rules.codes.Fixer`); the codes
+below have theirs here.
 
 * ``missing-format``: add ``BTCPP_format="4"`` to ``<root>`` (safe where the project is
   known to build against version 4).
@@ -32,18 +34,13 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from bt_lsp.ide.fix import Fix
-from bt_lsp.rules.codes import Applicability, Code
+from bt_lsp.rules.codes import Applicability, Code, all_defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import XML_UNESCAPED_CHAR, Diagnostic
 from bt_lsp.rules.names import is_allowed_port_name
 from bt_lsp.rules.semantics.base import edit_distance
 from bt_lsp.rules.semantics.document import MISSING_FORMAT
-from bt_lsp.rules.semantics.nodes import (
-    ID_ON_COMPACT_NODE,
-    SINGLE_CHILD_CONTROL,
-    UNKNOWN_NODE,
-    UnknownNodeData,
-)
+from bt_lsp.rules.semantics.nodes import ID_ON_COMPACT_NODE, UNKNOWN_NODE, UnknownNodeData
 from bt_lsp.rules.semantics.ports import (
     MISSING_PORT_WITHOUT_DEFAULT,
     MISSING_REQUIRED_PORT,
@@ -68,7 +65,19 @@ def fixes_for_rule(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
     """The quick fixes of one diagnostic of a rule other than the name rules; the preferred
     one first."""
     fixer = _FIXERS.get(diag.code)
-    return fixer(doc, ctx, diag) if fixer is not None else []
+    if fixer is not None:
+        return fixer(doc, ctx, diag)
+    code = all_defined().get(diag.code)
+    if code is None or code.fixer is None:
+        return []
+    out: list[Fix] = []
+    for f in code.fixer(doc, ctx, diag):
+        kind = code.applicability(f.key)
+        # The first safe fix is the preferred one (fix-all and check --fix make it).
+        preferred = kind is Applicability.SAFE and not any(x.preferred for x in out)
+        title = code.fix_title(f.key, **f.values)
+        out.append(Fix(title, f.edits, preferred, diag, applicability=kind))
+    return out
 
 
 def _fix(
@@ -209,34 +218,6 @@ def _new_tree(text: str, model: Model, tree_id: str) -> TextEdit | None:
     return _insert_before_end_tag(text, root, lines, unit, nl)
 
 
-def _unwrap(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
-    """Replace a control with its one child, the child's lines moved left by the depth
-    the control gave them; offered only when nothing but blanks surrounds the child (a
-    comment there would be lost)."""
-    el = _element_at(doc, doc.model, diag.start)
-    if el is None or len(el.children) != 1 or el.end < 0:
-        return []
-    child = doc.model.elements[el.children[0]]
-    text = doc.text
-    if child.end < 0 or el.end_name_start < 0:
-        return []
-    inner_start = el.token_start + doc.scan.tokens[el.token_index].length
-    end_tag = el.end_name_start - 2  # the '</' of the end tag
-    if text[inner_start : child.token_start].strip() or text[child.end : end_tag].strip():
-        return []
-    body = text[child.token_start : child.end]
-    outer = _line_indent(text, el.token_start)
-    inner = _line_indent(text, child.token_start)
-    if outer is not None and inner is not None and inner.startswith(outer):
-        extra = inner[len(outer) :]
-        lines = body.splitlines(keepends=True)
-        body = lines[0] + "".join(
-            line[len(extra) :] if line.startswith(extra) else line for line in lines[1:]
-        )
-    edit = TextEdit(el.token_start, el.end, body)
-    return [_fix(SINGLE_CHILD_CONTROL, "unwrap", (edit,), diag, element=el.name)]
-
-
 # The fixes of each code that has some (their titles are defined with the code).
 _FIXERS: Mapping[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = MappingProxyType(
     {
@@ -248,7 +229,6 @@ _FIXERS: Mapping[str, Callable[[Document, Context, Diagnostic], list[Fix]]] = Ma
         MISSING_REQUIRED_PORT.code: _missing_ports,
         MISSING_PORT_WITHOUT_DEFAULT.code: _missing_ports,
         UNKNOWN_SUBTREE.code: _unknown_subtree,
-        SINGLE_CHILD_CONTROL.code: _unwrap,
     }
 )
 

@@ -37,9 +37,9 @@
   its first tick.  Range: the value.
 * ``single-child-control`` (hint): a ``Sequence``, ``Fallback`` or another control node
   that only passes its one child's status on; not reported when the control carries a
-  ``_``-attribute (a pre- or postcondition hung on it) or has no end tag (being typed).  Range: the element name.  Fix:
-  replace the control with its child (unsafe: the tree's shape, seen in Groot and the
-  loggers, changes).
+  ``_``-attribute (a pre- or postcondition hung on it) or has no end tag (being typed).
+  Range: the element name.  Fix: replace the control with its child (unsafe: the tree's
+  shape, seen in Groot and the loggers, changes).
 """
 
 from __future__ import annotations
@@ -56,6 +56,7 @@ from bt_lsp.rules.codes import (
     BT,
     Applicability,
     FixData,
+    FixEdits,
     Severity,
     define,
     display_only,
@@ -64,8 +65,11 @@ from bt_lsp.rules.codes import (
 )
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.conversions import is_blackboard_reference
+from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
 
@@ -272,6 +276,39 @@ PARALLEL_THRESHOLD: Final = define(
         """,
     since="Every version.",
 )
+
+
+def _unwrap(doc: Document, ctx: Context, diag: Diagnostic) -> list[FixEdits]:
+    """``single-child-control``'s fix: the control replaced with its child, whose lines
+    move left by the depth the control gave them.  Not offered when anything but blanks
+    surrounds the child (a comment there would be lost)."""
+    model = doc.model
+    el = next((e for e in model.elements if e.name_start == diag.start), None)
+    if el is None or len(el.children) != 1 or el.end_name_start < 0:
+        return []
+    child = model.elements[el.children[0]]
+    text = doc.text
+    end_tag = el.end_name_start - 2  # its '</'
+    around = text[el.token_start + el.length : child.token_start] + text[child.end : end_tag]
+    if child.end < 0 or around.strip():
+        return []
+    body = text[child.token_start : child.end]
+    outer, inner = _indent(text, el.token_start), _indent(text, child.token_start)
+    if outer is not None and inner is not None and inner.startswith(outer):
+        extra = inner[len(outer) :]
+        first, *rest = body.splitlines(keepends=True)
+        body = first + "".join(line.removeprefix(extra) for line in rest)
+    edit = TextEdit(el.token_start, el.end, body)
+    return [FixEdits("unwrap", (edit,), {"element": el.name})]
+
+
+def _indent(text: str, offset: int) -> str | None:
+    """The blanks between the start of ``offset``'s line and it (``None``: not blanks)."""
+    start = max(text.rfind("\n", 0, offset), text.rfind("\r", 0, offset)) + 1
+    lead = text[start:offset]
+    return lead if lead.strip(" \t") == "" else None
+
+
 SINGLE_CHILD_CONTROL: Final = define(
     "single-child-control",
     Severity.HINT,
@@ -297,6 +334,7 @@ SINGLE_CHILD_CONTROL: Final = define(
         <MoveBase goal="{goal}"/>
         """,
     since="Every version.",
+    fixer=_unwrap,
 )
 
 
