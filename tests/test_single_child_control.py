@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from bt_lsp.ide.fix_all import fix_document
 from bt_lsp.rules import semantics
+from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
 from tests.annotated import check_fix, fixes
@@ -94,3 +96,14 @@ def test_no_unwrap_that_would_lose_a_comment() -> None:
 
     assert offered("<AlwaysSuccess/>") == ["Replace <Sequence> with its child"]
     assert offered("<!-- later: Dock --><AlwaysSuccess/>") == []
+
+
+def test_unwrap_is_never_applied_in_bulk() -> None:
+    doc = Document(
+        '<root BTCPP_format="4"><BehaviorTree ID="T">'
+        "<Sequence><AlwaysSuccess/></Sequence></BehaviorTree></root>"
+    )
+    ctx = Context.from_document(doc)
+    diags = analyze(doc, ctx)
+    assert [d.code for d in diags] == [CODE]
+    assert fix_document(doc, ctx, diags, unsafe=True).edits == []

@@ -38,8 +38,8 @@
 * ``single-child-control`` (hint): a ``Sequence``, ``Fallback`` or another control node
   that only passes its one child's status on; not reported when the control carries a
   ``_``-attribute (a pre- or postcondition hung on it) or has no end tag (being typed).
-  Range: the element name.  Fix: replace the control with its child (unsafe: the tree's
-  shape, seen in Groot and the loggers, changes).
+  Range: the element name.  Fix: replace the control with its child (offered in the
+  editor only: the author may rather add the missing siblings).
 """
 
 from __future__ import annotations
@@ -314,7 +314,8 @@ SINGLE_CHILD_CONTROL: Final = define(
     Severity.HINT,
     "a `Sequence`, `Fallback` or similar control node with exactly one child",
     BT,
-    fixes={"unwrap": unsafe("Replace <{element}> with its child")},
+    # Never in bulk: whether the control goes or gets its siblings is the author's call.
+    fixes={"unwrap": display_only("Replace <{element}> with its child")},
     doc="""
         A `Sequence`, `Fallback`, `SequenceWithMemory`, `ReactiveSequence`,
         `ReactiveFallback`, `AsyncSequence` or `AsyncFallback` with exactly one child ticks
