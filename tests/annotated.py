@@ -31,6 +31,10 @@ size limit.
 
 A ``bt-lsp.toml`` (or ``pyproject.toml``) among the files is the configuration of the
 others; its annotations are its ``config-error``, if it has one.
+
+A one-file fixture may end with the result of a quick fix: a ``<!-- fixed: TITLE -->``
+line, then the whole document once the first fix called ``TITLE`` is applied
+(:func:`split_fixed`; several such sections, one per fix).
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ import tempfile
 from collections.abc import Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Final
 
 from bt_lsp.ide.fix import Fix
 from bt_lsp.ide.name_fixes import fixes_for_name
@@ -134,6 +139,27 @@ def parse(fixture: str, path: str = "fixture.xml") -> Fixture:
             start, end = (row, first), (row, first + len(body))
         expected.append(Expected(start, end, m["severity"], m["code"], m["message"] or ""))
     return Fixture(path, "\n".join(kept), sorted(expected), directives)
+
+
+_FIXED: Final = re.compile(r"<!-- fixed: (?P<title>.+) -->")
+
+
+def split_fixed(fixture: str) -> tuple[str, list[tuple[str, str]]]:
+    """The fixture before its first ``<!-- fixed: TITLE -->`` line, and each such section
+    as (``TITLE``, the document it holds), each text ending with one line end."""
+    head: list[str] = []
+    sections: list[tuple[str, list[str]]] = []
+    for line in _lines(fixture):
+        m = _FIXED.fullmatch(line.strip())
+        if m is not None:
+            sections.append((m["title"], []))
+        else:
+            (sections[-1][1] if sections else head).append(line)
+
+    def text(lines: list[str]) -> str:
+        return "\n".join(lines).rstrip("\n") + "\n"
+
+    return text(head) if sections else fixture, [(t, text(ls)) for t, ls in sections]
 
 
 def split_files(fixture: str) -> list[Fixture]:
