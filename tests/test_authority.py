@@ -22,7 +22,7 @@ from bt_lsp.rules import semantics
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context, is_generated_catalog
 from bt_lsp.syntax.document import Document
-from tests.pinned import later_severities, main  # bt-lsp as the tests know it
+from tests.pinned import later_severities, main, pinned  # bt-lsp as the tests know it
 
 E, W, H = Severity.ERROR, Severity.WARNING, Severity.HINT
 DATA = Path(__file__).parent / "data"
@@ -44,7 +44,7 @@ def catalog() -> tuple[str, Document]:
 def found(text: str, **kw: object) -> list[tuple[str, Severity, str]]:
     doc = Document(text, "/w/tree.xml")
     ctx = Context.combine(doc, [], path="/w/tree.xml", **kw)  # type: ignore[arg-type]
-    return [(d.code, d.severity, d.message) for d in semantics.check(doc, ctx)]
+    return [(d.code, d.severity, d.message) for d in pinned(semantics.check(doc, ctx))]
 
 
 def codes(text: str, **kw: object) -> list[tuple[str, Severity]]:

@@ -1011,14 +1011,14 @@ def test_a_missing_builtin_port_says_when_and_how_the_library_fails(body: str, s
 
 def test_an_enum_literal_is_converted_when_the_node_reads_it() -> None:
     doc = Document(T('<Precondition if="a" else="xyz"><AlwaysSuccess/></Precondition>'))
-    (d,) = semantics.check(doc, Context())
+    (d,) = pinned(semantics.check(doc, Context()))
     assert d.code == "invalid-port-value" and "only when the node reads it" in d.message
 
 
 def test_controls_that_count_children_at_tick_say_so() -> None:
     """4.8.2 loads <IfThenElse> with one child and throws at its first tick."""
     doc = Document(T("<IfThenElse><AlwaysSuccess/></IfThenElse>"))
-    (d,) = semantics.check(doc, Context())
+    (d,) = pinned(semantics.check(doc, Context()))
     assert d.code == "child-count" and d.message.endswith(
         "throws at its first tick: 'IfThenElseNode must have either 2 or 3 children'"
     )

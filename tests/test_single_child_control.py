@@ -8,6 +8,7 @@ from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
 from tests.annotated import check_fix, fixes
+from tests.pinned import pinned
 from tests.rulecheck import check, marks
 
 HEAD = '<root BTCPP_format="4">\n<BehaviorTree ID="T">\n<Sequence>\n'
@@ -104,6 +105,6 @@ def test_unwrap_is_never_applied_in_bulk() -> None:
         "<Sequence><AlwaysSuccess/></Sequence></BehaviorTree></root>"
     )
     ctx = Context.from_document(doc)
-    diags = analyze(doc, ctx)
+    diags = pinned(analyze(doc, ctx), also=[CODE])
     assert [d.code for d in diags] == [CODE]
     assert fix_document(doc, ctx, diags, unsafe=True).edits == []
