@@ -1,14 +1,17 @@
 """Write (or check) the generated pages of the documentation site: the configuration
 reference from ``bt_lsp.project.schema`` and one page per diagnostic code from
 ``bt_lsp.rules.registry`` (its summary, severity, fixes and the optional prose that
-``rules.codes.define`` keeps beside each rule).
+``rules.codes.define`` keeps beside each rule); and every other list of the codes: the
+site's navigation (``mkdocs.yml``) and the codes the VS Code extension's ``btLsp.severity``
+setting completes (``editors/vscode/package.json``).
 
-python scripts/docs_gen.py          # write docs/configuration.md and docs/rules/*.md
+python scripts/docs_gen.py          # write them all
 python scripts/docs_gen.py --check  # exit 1 if a committed page differs (tests/test_docs.py)
 """
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 from pathlib import Path
@@ -254,13 +257,27 @@ def mkdocs_yml(text: str) -> str:
     return text[: start + len(NAV_BEGIN)] + lines + text[end:]
 
 
+PACKAGE_JSON = ROOT / "editors" / "vscode" / "package.json"
+
+
+def package_json(text: str) -> str:
+    """The VS Code manifest (``text``) with every code, in the registry's order, among the
+    properties of its ``btLsp.severity`` setting (the rest of the file as it is)."""
+    manifest = json.loads(text)
+    severity = manifest["contributes"]["configuration"]["properties"]["btLsp.severity"]
+    severity["properties"] = {c: {"type": "string", "enum": list(LEVELS)} for c in CODES}
+    return json.dumps(manifest, indent=2, ensure_ascii=False) + "\n"
+
+
 def pages() -> dict[Path, str]:
-    """Every generated file (the pages and ``mkdocs.yml``), by path."""
+    """Every generated file (the pages, ``mkdocs.yml`` and the VS Code manifest), by
+    path."""
     out = {DOCS / "configuration.md": configuration(), DOCS / "rules" / "index.md": rules_index()}
     for c in CODES.values():
         out[DOCS / "rules" / f"{c.code}.md"] = rule_page(c)
     yml = ROOT / "mkdocs.yml"
     out[yml] = mkdocs_yml(yml.read_text(encoding="utf-8"))
+    out[PACKAGE_JSON] = package_json(PACKAGE_JSON.read_text(encoding="utf-8"))
     return out
 
 

@@ -458,15 +458,17 @@ README_END = "<!-- ecosystem:end -->"
 def readme_table(
     report: Report, bt_files: dict[str, int | None], findings: Sequence[Finding]
 ) -> str:
-    """The README's table of the projects: what a check of each finds, and the triage."""
+    """The README's table of the projects: the errors and warnings a check of each finds,
+    and their triage.  Hints are left out: they are not triaged, and a new hint would make
+    the table stale though nothing it holds to a triage changed."""
     by_project: dict[str, Counter[str]] = {}
     for f in findings:
         if f.severity in ("error", "warning"):
             by_project.setdefault(f.project, Counter())[f.code] += 1
     sources = _bt_files_of_sources()
     lines = [
-        "| project | BT files | errors | warnings | hints | errors and warnings by code |",
-        "|---|---|---|---|---|---|",
+        "| project | BT files | errors | warnings | errors and warnings by code |",
+        "|---|---|---|---|---|",
     ]
     for project, c in sorted(report.counts_by_project.items()):
         counts = by_project.get(project, Counter())
@@ -474,7 +476,7 @@ def readme_table(
         files = bt_files.get(project) or sources.get(project)
         lines.append(
             f"| {project.replace('__', '/', 1)} | {files if files is not None else '?'} | "
-            f"{c['error']} | {c['warning']} | {c['hint']} | {top} |"
+            f"{c['error']} | {c['warning']} | {top} |"
         )
     errors = sum(c["error"] for c in report.counts_by_project.values())
     warnings = sum(c["warning"] for c in report.counts_by_project.values())

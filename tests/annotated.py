@@ -17,7 +17,10 @@ missing file, ``{size}`` for the size of the text in bytes (which its line ends 
 
 Annotation lines are removed (with their line ends) before the text is analysed, so they
 never shift what they annotate.  :func:`check` compares every diagnostic of the text,
-none left out, with LF and again with CRLF line ends.  A fixture of several files
+none left out, with LF and again with CRLF line ends: every diagnostic of the codes the
+whole-output tests know (:mod:`tests.pinned`), of the codes the fixture annotates and of
+the code it is named after, so that a rule added later does not change a fixture written
+for another.  A fixture of several files
 separates them with ``<!-- file: trees/dock.xml -->`` lines; each is written to a fresh
 folder, analysed in a workspace of all of them, and checked against its own annotations.
 
@@ -28,6 +31,10 @@ size limit.
 
 A ``bt-lsp.toml`` (or ``pyproject.toml``) among the files is the configuration of the
 others; its annotations are its ``config-error``, if it has one.
+
+A one-file fixture may end with the result of a quick fix: a ``<!-- fixed: TITLE -->``
+line, then the whole document once the first fix called ``TITLE`` is applied
+(:func:`split_fixed`; several such sections, one per fix).
 """
 
 from __future__ import annotations
@@ -36,8 +43,10 @@ import errno
 import os
 import re
 import tempfile
+from collections.abc import Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Final
 
 from bt_lsp.ide.fix import Fix
 from bt_lsp.ide.name_fixes import fixes_for_name
@@ -51,6 +60,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic, limited, size_limited
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
+from tests.pinned import pinned
 
 _LINE_END = re.compile(r"\r\n|\r|\n")
 _ANNOTATION = re.compile(
@@ -131,6 +141,27 @@ def parse(fixture: str, path: str = "fixture.xml") -> Fixture:
     return Fixture(path, "\n".join(kept), sorted(expected), directives)
 
 
+_FIXED: Final = re.compile(r"<!-- fixed: (?P<title>.+) -->")
+
+
+def split_fixed(fixture: str) -> tuple[str, list[tuple[str, str]]]:
+    """The fixture before its first ``<!-- fixed: TITLE -->`` line, and each such section
+    as (``TITLE``, the document it holds), each text ending with one line end."""
+    head: list[str] = []
+    sections: list[tuple[str, list[str]]] = []
+    for line in _lines(fixture):
+        m = _FIXED.fullmatch(line.strip())
+        if m is not None:
+            sections.append((m["title"], []))
+        else:
+            (sections[-1][1] if sections else head).append(line)
+
+    def text(lines: list[str]) -> str:
+        return "\n".join(lines).rstrip("\n") + "\n"
+
+    return text(head) if sections else fixture, [(t, text(ls)) for t, ls in sections]
+
+
 def split_files(fixture: str) -> list[Fixture]:
     """The files of a fixture (one, ``fixture.xml``, when it has no ``file:`` lines)."""
     parts: list[tuple[str, list[str]]] = []
@@ -172,22 +203,28 @@ def found(doc: Document, diags: list[Diagnostic], root: str | None = None) -> li
     return sorted(out)
 
 
-def _analyze(f: Fixture, text: str) -> tuple[Document, list[Diagnostic]]:
+def _analyze(f: Fixture, text: str, also: Collection[str]) -> tuple[Document, list[Diagnostic]]:
     doc = Document(text)
     limit = f.directives.get("max-document-bytes")
     if limit is not None and doc.utf8_size > limit:
-        return doc, size_limited(doc, limit)
-    diags = with_targets(doc, analyze(doc))
+        return doc, pinned(size_limited(doc, limit), also)
+    # Pinned before the cap, which then keeps what it kept when the fixture was written.
+    diags = pinned(with_targets(doc, analyze(doc)), also)
     maximum = f.directives.get("max-diagnostics")
     return doc, limited(diags, maximum) if maximum is not None else diags
 
 
-def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[Expected]]]:
-    """Each file of ``fixture`` with what bt-lsp reports for it, its line ends ``newline``."""
+def diagnostics(
+    fixture: str, newline: str = "\n", also: Collection[str] = ()
+) -> list[tuple[Fixture, list[Expected]]]:
+    """Each file of ``fixture`` with what bt-lsp reports for it, its line ends ``newline``:
+    the diagnostics of the pinned codes (:mod:`tests.pinned`), of those the fixture
+    annotates and of ``also``."""
     files = split_files(fixture)
+    also = {e.code for f in files for e in f.expected} | set(also)
     if len(files) == 1 and files[0].path == "fixture.xml":
         f = files[0]
-        doc, diags = _analyze(f, f.text.replace("\n", newline))
+        doc, diags = _analyze(f, f.text.replace("\n", newline), also)
         return [(f, found(doc, diags))]
     out = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -204,7 +241,8 @@ def diagnostics(fixture: str, newline: str = "\n") -> list[tuple[Fixture, list[E
                 continue
             opened = ws.document(path)
             assert opened is not None, f.path
-            out.append((f, found(opened, ws.diagnostics(path, opened), str(root))))
+            diags = pinned(ws.diagnostics(path, opened), also)
+            out.append((f, found(opened, diags, str(root))))
     return out
 
 
@@ -217,11 +255,12 @@ def _config_found(ws: ProjectIndex, path: Path, text: str) -> list[Expected]:
     return [Expected((row, start), (row, end), "error", "config-error", loaded.message)]
 
 
-def check(fixture: str) -> None:
+def check(fixture: str, code: str | None = None) -> None:
     """Assert that bt-lsp reports exactly the annotated diagnostics of ``fixture``, with LF
-    and with CRLF line ends."""
+    and with CRLF line ends (of the codes :func:`diagnostics` compares; ``code``: the code
+    the fixture is named after)."""
     for newline in ("\n", "\r\n"):
-        for f, got in diagnostics(fixture, newline):
+        for f, got in diagnostics(fixture, newline, [code] if code else []):
             # An annotation without a message leaves the message unchecked.
             unchecked = {(e.start, e.end, e.code) for e in f.expected if not e.message}
             got = sorted(
@@ -256,24 +295,26 @@ def render(text: str, diags: list[Expected]) -> str:
     return "\n".join(out)
 
 
-def fixes(doc: Document) -> list[Fix]:
+def fixes(doc: Document, also: Collection[str] = ()) -> list[Fix]:
     """Every quick fix offered for the diagnostics of ``doc`` alone, as the server offers
-    them (name fixes, then the rule's own)."""
+    them (name fixes, then the rule's own), of the pinned codes (:mod:`tests.pinned`) and
+    of ``also``."""
     out: list[Fix] = []
     ctx = Context.from_document(doc)
-    for d in analyze(doc):
+    for d in pinned(analyze(doc), also):
         out += fixes_for_name(doc, d)
         if not d.is_name_rule:
             out += fixes_for_rule(doc, ctx, d)
     return out
 
 
-def check_fix(before: str, after: str, title: str | None = None) -> None:
+def check_fix(before: str, after: str, title: str | None = None, code: str | None = None) -> None:
     """Assert that the fix called ``title`` (by default the first preferred one) turns
-    ``before`` into exactly ``after`` (whole texts), with LF and with CRLF line ends."""
+    ``before`` into exactly ``after`` (whole texts), with LF and with CRLF line ends.  The
+    fixes are those of :func:`fixes`: of the pinned codes and of ``code``."""
     for newline in ("\n", "\r\n"):
         doc = Document(parse(before).text.replace("\n", newline))
-        offered = fixes(doc)
+        offered = fixes(doc, [code] if code else [])
         chosen = [f for f in offered if (f.title == title if title else f.preferred)]
         assert chosen, f"no fix {title!r} among {[f.title for f in offered]}"
         assert apply_edits(doc.text, list(chosen[0].edits)) == after.replace("\n", newline)

@@ -17,6 +17,7 @@ from bt_lsp.rules.builtins_v3 import V3_BUILTINS
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.context import Context
 from bt_lsp.syntax.document import Document
+from tests.pinned import pinned
 
 E, W, H = Severity.ERROR, Severity.WARNING, Severity.HINT
 SUB = '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree>'
@@ -32,7 +33,7 @@ def doc(body: str, fmt: str = "") -> Document:
 def codes(body: str, version: str | None) -> list[tuple[str, Severity]]:
     d = doc(body, "" if version == "3" else 'BTCPP_format="4"')
     ctx = Context.combine(d, [], path="/w/t.xml", btcpp_version=version)
-    return [(x.code, x.severity) for x in semantics.check(d, ctx)]
+    return [(x.code, x.severity) for x in pinned(semantics.check(d, ctx))]
 
 
 def test_the_v3_table() -> None:
@@ -175,7 +176,7 @@ def test_a_v3_project_may_declare_a_node_named_like_a_4_x_builtin() -> None:
     d = Document(text, "/w/t.xml")
     ctx = v3_context(d)
     assert ctx.models["Sleep"].port("seconds") is not None
-    assert [x.code for x in semantics.check(d, ctx)] == []
+    assert [x.code for x in pinned(semantics.check(d, ctx))] == []
 
 
 @pytest.mark.parametrize("fmt", ["", 'BTCPP_format="3"', 'BTCPP_format="4"'])
@@ -183,7 +184,7 @@ def test_what_3_8_fails_on_is_an_error_in_a_v3_project(fmt: str) -> None:
     def found(body: str) -> list[tuple[str, Severity]]:
         d = doc(body, fmt)
         ctx = Context.combine(d, [], path="/w/t.xml", btcpp_version="3")
-        return [(x.code, x.severity) for x in semantics.check(d, ctx)]
+        return [(x.code, x.severity) for x in pinned(semantics.check(d, ctx))]
 
     # 3.8's XMLParser throws for an attribute that is not a port ("Possible typo?").
     assert found('<Delay delay_msec="1" dleay="2"><AlwaysSuccess/></Delay>') == [
@@ -202,7 +203,7 @@ def test_what_3_8_fails_on_is_an_error_in_a_v3_project(fmt: str) -> None:
 def test_definition_in_a_v3_document_leads_to_the_3_8_catalog() -> None:
     d = Document(V3_DOC, "/w/t.xml")
     cat = builtin_catalog("3")
-    assert analyze(Document(cat.text)) == []
+    assert pinned(analyze(Document(cat.text))) == []
     assert "BehaviorTree.CPP 3.8" in cat.text and 'ID="Script"' not in cat.text
     (place,) = definition(d, V3_DOC.index("SequenceStar") + 3, ctx=v3_context(d))
     assert place.path == BUILTIN_CATALOG_V3

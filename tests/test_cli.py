@@ -22,9 +22,9 @@ from lxml import etree
 
 from bt_lsp import __version__
 from bt_lsp.cli import fix_workspace
-from bt_lsp.cli.main import main
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.edits import TextEdit
+from tests.pinned import later_off, main, pinned  # bt-lsp as the tests know it
 from tests.test_fixes import AUTOREMAP, AUTOREMAP_WHY, PORTS, PORTS_FIXED
 
 # The system's own words for a missing file (the message quotes the OS error).
@@ -163,7 +163,8 @@ def test_serve_calls_server_lazily(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_check_does_not_import_the_server(work: Path) -> None:
     _put(work / "a.xml", CLEAN)
     code = (
-        "import sys; from bt_lsp.cli.main import main; rc = main(['check', 'a.xml']); "
+        f"import sys; from bt_lsp.cli.main import main; rc = main(['check', 'a.xml', "
+        f"*{later_off()!r}]); "
         "print(rc, sorted(m for m in sys.modules if m.split('.')[0] in "
         "('pygls', 'lsprotocol') or m.startswith('bt_lsp.server')))"
     )
@@ -187,7 +188,7 @@ def test_installed_entry_point(work: Path) -> None:
     _put(work / "trees" / "emoji.xml", EMOJI)
     _put(work / "trees" / "crlf.xml", CRLF)
     proc = subprocess.run(
-        [*_entry_point(), "check", "trees"], cwd=work, capture_output=True, text=True
+        [*_entry_point(), "check", "trees", *later_off()], cwd=work, capture_output=True, text=True
     )
     assert proc.returncode == 1, proc.stderr
     expected = [(f"trees/{p}", n) for p, n in CRLF_LINES + EMOJI_LINES]
@@ -221,7 +222,7 @@ def test_full_line_format(work: Path, capsys: pytest.CaptureFixture[str]) -> Non
     from bt_lsp.rules.analysis import analyze
     from bt_lsp.syntax.document import Document
 
-    (diag,) = analyze(Document(CRLF))
+    (diag,) = pinned(analyze(Document(CRLF)))
     assert capsys.readouterr().out == (
         f"crlf.xml:2:21: error model-name-forbidden-char {diag.message}\n"
     )

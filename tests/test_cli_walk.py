@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.project.config import anchor, excluded
 from bt_lsp.project.sniff import is_bt_file, top_element
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 PKG = Path(__file__).parent / "data" / "ros_pkg" / "my_robot_bt"
 

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.cli.project import workspace_of
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 CPP_PROJECT = Path(__file__).parent / "data" / "cpp_project"
 

@@ -9,13 +9,13 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.cpp.catalog import link
 from bt_lsp.cpp.extract import extract
 from bt_lsp.cpp.facts import AliasFacts
 from bt_lsp.cpp.library import library_facts
 from bt_lsp.project.cpp_scan import Scanner, find_cpp_files, scan
 from bt_lsp.rules.port_types import canonical, is_closed
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 FLEET = Path(__file__).parent / "data" / "cpp" / "aliases"
 

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.cpp.extract import extract
 from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.cpp_names import cpp_name_diagnostics
 from bt_lsp.rules.registry import CODES
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 SRC = """// ünïcödé 𝄞 before the literals
 class Pick : public BT::SyncActionNode {

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.project.cpp_models import CppModels
 from bt_lsp.project.cpp_scan import Scanner
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 WS = Path(__file__).parent / "data" / "cpp_project"
 MAIN = WS / "src" / "robot_nodes" / "trees" / "main.xml"

@@ -215,3 +215,16 @@ def test_a_relative_projects_dir_keys_findings_by_their_path_in_the_project(
     data = json.loads(summary.read_text(encoding="utf-8"))
     assert data["untriaged"] == []
     assert data["true_errors"] == 1
+
+
+def test_the_readme_table_does_not_change_with_a_new_hint(tmp_path: Path) -> None:
+    triage = _triage(tmp_path, "p\ta.xml\t3\tundeclared-port\ttrue\tclass: x")
+    loud = [_finding("a.xml", 3, "undeclared-port", "error")]
+    hint = _finding("a.xml", 4, "some-new-code", "hint")
+
+    def table(findings: list[object]) -> str:
+        text: str = eco.readme_table(eco.compare(findings, triage, ["p"]), {"p": 1}, findings)
+        return text
+
+    assert table(loud) == table([*loud, hint])
+    assert "| p | 1 | 1 | 0 | `undeclared-port` 1 |" in table(loud)

@@ -13,13 +13,13 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.ide.name_fixes import edits_in
 from bt_lsp.ide.name_fixes import fix_workspace as plan_workspace
 from bt_lsp.project.fileio import FileError, write_text_atomic
 from bt_lsp.rules.analysis import analyze
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 # Defines the tree the other file calls.
 DEFINES = (

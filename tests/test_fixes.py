@@ -14,6 +14,7 @@ from bt_lsp.rules.analysis import analyze
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import apply_edits
+from tests.pinned import pinned
 
 DOC = (
     '<root BTCPP_format="4" main_tree_to_execute="Main Tree">\n'
@@ -212,7 +213,7 @@ def _quick_fixes(doc: Document, needle: str, nth: int = 0) -> list[Fix]:
 
 
 def _semantic(doc: Document) -> list[str]:
-    return sorted(d.code for d in analyze(doc) if not d.is_name_rule)
+    return sorted(d.code for d in pinned(analyze(doc)) if not d.is_name_rule)
 
 
 def _renamed(doc: Document, needle: str, nth: int, new: str) -> RenamePlan:

@@ -1,6 +1,7 @@
 """Every diagnostic code, as its rule reads: ``tests/fixtures/<code>.xml`` reports it (and
 everything else it reports is annotated too), ``<code>.ok.xml`` is the near miss that
-must not (see :mod:`tests.annotated` for the form)."""
+must not, and its ``<!-- fixed: TITLE -->`` sections are what its fixes make (see
+:mod:`tests.annotated` for the form)."""
 
 from __future__ import annotations
 
@@ -12,19 +13,40 @@ from bt_lsp.rules.codes import Severity
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
-from tests.annotated import check, check_fix, diagnostics, found, parse, render, split_files
+from tests.annotated import (
+    check,
+    check_fix,
+    diagnostics,
+    found,
+    parse,
+    render,
+    split_files,
+    split_fixed,
+)
 
 FIXTURES = Path(__file__).parent / "fixtures"
 FILES = sorted(FIXTURES.glob("*.xml"))
 
 
+def _text(path: Path) -> str:
+    """The fixture without its fixed sections."""
+    return split_fixed(path.read_text(encoding="utf-8"))[0]
+
+
 def _codes(path: Path) -> set[str]:
-    return {e.code for f in split_files(path.read_text(encoding="utf-8")) for e in f.expected}
+    return {e.code for f in split_files(_text(path)) for e in f.expected}
 
 
 @pytest.mark.parametrize("path", FILES, ids=[p.name for p in FILES])
 def test_fixture(path: Path) -> None:
-    check(path.read_text(encoding="utf-8"))
+    named = path.name.removesuffix(".xml").removesuffix(".ok")
+    code = named if named in CODES else None
+    text, fixed = split_fixed(path.read_text(encoding="utf-8"))
+    check(text, code)
+    if fixed:
+        assert len(split_files(text)) == 1, "a fixed section follows a one-file fixture"
+    for title, after in fixed:
+        check_fix(text, after, title, code)
 
 
 # A fixture may hold its near miss itself, after this line (instead of a ``.ok.xml``).
@@ -41,7 +63,7 @@ def test_every_code_has_a_positive_and_a_negative_fixture(code: str) -> None:
         return
     # The near miss in the same file: nothing of ``code`` reported after the line (every
     # finding of a fixture is annotated, so the fixture's own check proves it).
-    files = [f for f in split_files(positive.read_text(encoding="utf-8")) if NEAR_MISS in f.text]
+    files = [f for f in split_files(_text(positive)) if NEAR_MISS in f.text]
     assert files, f"write {negative.name}, or a near miss after '{NEAR_MISS}' in {positive.name}"
     for f in files:
         line = f.text[: f.text.index(NEAR_MISS)].count("\n")
@@ -94,7 +116,7 @@ def test_other_forms_of_ranges() -> None:
 
 def test_render_writes_what_parse_reads() -> None:
     for path in FILES[:10]:
-        for f in split_files(path.read_text(encoding="utf-8")):
+        for f in split_files(_text(path)):
             assert parse(render(f.text, f.expected)).expected == f.expected
 
 
@@ -136,6 +158,20 @@ def test_non_bmp_characters_count_one_column() -> None:
   </BehaviorTree>
 </root>"""
     )
+
+
+def test_a_fixed_section_is_the_whole_document_after_the_fix() -> None:
+    title = "Rename 'Main Tree' to 'Main_Tree' (1 place)"
+    after = (
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="Main_Tree">\n    <AlwaysSuccess/>\n'
+        "  </BehaviorTree>\n</root>\n"
+    )
+    text, fixed = split_fixed(f"{MARKED}\n<!-- fixed: {title} -->\n{after}")
+    assert (text, fixed) == (MARKED + "\n", [(title, after)])
+    check_fix(text, after, title)
+    with pytest.raises(AssertionError):
+        check_fix(text, after.replace("Main_Tree", "MainTree"), title)  # not what it makes
+    assert split_fixed(MARKED) == (MARKED, [])
 
 
 # -- fixes, whole texts before and after ---------------------------------------------------

@@ -14,12 +14,13 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.decls import ModelDecl
 from bt_lsp.rules.port_types import canonical, is_closed
 from bt_lsp.syntax.document import Document
+from tests.pinned import pinned
 
 E, W, H = Severity.ERROR, Severity.WARNING, Severity.HINT
 
 
 def found(doc: Document, ctx: Context) -> list[tuple[str, Severity]]:
-    return sorted((d.code, d.severity) for d in semantics.check(doc, ctx))
+    return sorted((d.code, d.severity) for d in pinned(semantics.check(doc, ctx)))
 
 
 def write(path: Path, text: str) -> Path:
@@ -147,7 +148,7 @@ def test_duplicate_subtree_name_is_a_warning_and_not_for_v3() -> None:
         '<BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree></root>'
     )
     doc = Document(text.format(root='BTCPP_format="4"'))
-    diags = semantics.check(doc, Context.from_document(doc))
+    diags = pinned(semantics.check(doc, Context.from_document(doc)))
     assert [(d.code, d.severity) for d in diags] == [("duplicate-subtree-name", W)]
     assert "January 2026" in diags[0].message
     doc = Document(text.format(root=""))
@@ -158,7 +159,7 @@ def test_missing_format_names_the_version() -> None:
     doc = Document(
         '<root main_tree_to_execute="T"><BehaviorTree ID="T"><AlwaysSuccess/></BehaviorTree></root>'
     )
-    v4 = semantics.check(doc, Context.combine(doc, [], btcpp_version="4"))
+    v4 = pinned(semantics.check(doc, Context.combine(doc, [], btcpp_version="4")))
     assert [(d.code, d.severity) for d in v4] == [("missing-format", W)]
     assert "BehaviorTree.CPP 4 loads the file and prints a warning" in v4[0].message
     unknown = semantics.check(doc, Context.combine(doc, [], btcpp_version=None))

@@ -2,12 +2,15 @@
 
 Each case is an XML text with ``⟦…⟧`` around every expected diagnostic and the list of
 expected (code, severity) pairs in the order of the marks; the check must report exactly
-these, nothing more.  The rows of bt-xml.md §f that can be checked statically are all here
-(named after the row), plus every code of :mod:`bt_lsp.rules.semantics`.
+these, nothing more (of the codes these cases were written against, :mod:`tests.pinned`,
+and of the codes a case expects).  The rows of bt-xml.md §f that can be checked
+statically are all here (named after the row), plus every code of
+:mod:`bt_lsp.rules.semantics`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from pathlib import Path
 
 import pytest
@@ -19,6 +22,7 @@ from bt_lsp.rules.context import Context
 from bt_lsp.rules.registry import CODES
 from bt_lsp.syntax.document import Document
 from tests.marks import unmark
+from tests.pinned import pinned
 
 E, W, INFO, H = Severity.ERROR, Severity.WARNING, Severity.INFORMATION, Severity.HINT
 
@@ -761,9 +765,12 @@ CASES: list[tuple[str, str, Expected]] = [
 ]
 
 
-def semantic(doc: Document, ctx: Context | None = None) -> list[tuple[int, int, str, Severity]]:
+def semantic(
+    doc: Document, ctx: Context | None = None, also: Collection[str] = ()
+) -> list[tuple[int, int, str, Severity]]:
+    """What the semantic rules report on ``doc``: the pinned codes and ``also``."""
     found = semantics.check(doc, ctx if ctx is not None else Context.from_document(doc))
-    return sorted((d.start, d.end, d.code, d.severity) for d in found)
+    return sorted((d.start, d.end, d.code, d.severity) for d in pinned(found, also))
 
 
 Found = list[tuple[int, int, str, Severity]]
@@ -780,7 +787,7 @@ def expect(marked: str, expected: Expected) -> tuple[Document, Found]:
 @pytest.mark.parametrize(("marked", "expected"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
 def test_case(marked: str, expected: Expected) -> None:
     doc, want = expect(marked, expected)
-    assert semantic(doc) == want
+    assert semantic(doc, also=[code for code, _ in expected]) == want
 
 
 def test_every_semantic_code_has_a_case() -> None:
@@ -1004,14 +1011,14 @@ def test_a_missing_builtin_port_says_when_and_how_the_library_fails(body: str, s
 
 def test_an_enum_literal_is_converted_when_the_node_reads_it() -> None:
     doc = Document(T('<Precondition if="a" else="xyz"><AlwaysSuccess/></Precondition>'))
-    (d,) = semantics.check(doc, Context())
+    (d,) = pinned(semantics.check(doc, Context()))
     assert d.code == "invalid-port-value" and "only when the node reads it" in d.message
 
 
 def test_controls_that_count_children_at_tick_say_so() -> None:
     """4.8.2 loads <IfThenElse> with one child and throws at its first tick."""
     doc = Document(T("<IfThenElse><AlwaysSuccess/></IfThenElse>"))
-    (d,) = semantics.check(doc, Context())
+    (d,) = pinned(semantics.check(doc, Context()))
     assert d.code == "child-count" and d.message.endswith(
         "throws at its first tick: 'IfThenElseNode must have either 2 or 3 children'"
     )

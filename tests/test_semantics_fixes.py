@@ -12,7 +12,7 @@ from bt_lsp.ide.fix_all import fix_document
 from bt_lsp.ide.name_fixes import Fix
 from bt_lsp.rules import semantics
 from bt_lsp.rules.analysis import analyze
-from bt_lsp.rules.codes import Applicability, Severity
+from bt_lsp.rules.codes import BT, Applicability, Code, FixEdits, Severity, safe, unsafe
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.semantics.nodes import UnknownNodeData
@@ -20,6 +20,7 @@ from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.edits import TextEdit, apply_edits
 from bt_lsp.syntax.values import decode_value, raw_offsets, raw_span
 from tests.marks import unmark
+from tests.pinned import pinned
 from tests.test_semantics import CASES, TM, R, T
 
 
@@ -35,7 +36,8 @@ def applied(doc: Document, fix: Fix) -> Document:
 
 
 def codes(doc: Document) -> list[str]:
-    return [d.code for d in analyze(doc)]
+    """The codes ``doc`` gets, of those the tests were written against."""
+    return [d.code for d in pinned(analyze(doc))]
 
 
 def well_formed(text: str) -> bool:
@@ -330,7 +332,7 @@ def test_unknown_subtree_creates_a_tree_that_loads_and_fails() -> None:
         "</root>\r\n"
     )
     assert well_formed(new.text)
-    assert [d.code for d in analyze(new)] == ["unknown-subtree"]  # 'Dokc' is left
+    assert codes(new) == ["unknown-subtree"]  # 'Dokc' is left
 
 
 def test_fix_all_applies_the_safe_fixes_and_the_unsafe_ones_when_asked() -> None:
@@ -341,7 +343,7 @@ def test_fix_all_applies_the_safe_fixes_and_the_unsafe_ones_when_asked() -> None
         "    </Sequence>\n  </BehaviorTree>\n</root>\n"
     )
     ctx = Context.from_document(doc)
-    diags = analyze(doc, ctx)
+    diags = pinned(analyze(doc, ctx))  # the fixes of the codes this test knows
     safe_only = fix_document(doc, ctx, diags)
     assert sorted(f.diagnostic.code for f in safe_only.rules) == [
         "id-on-compact-node",
@@ -357,3 +359,36 @@ def test_fix_all_applies_the_safe_fixes_and_the_unsafe_ones_when_asked() -> None
     assert '<Sequence><Repeat num_cycles=""><AlwaysSuccess/></Repeat></Sequence>' in text
     # Never in bulk, not even with unsafe fixes: declaring a model for a node.
     assert "TreeNodesModel" not in text
+
+
+def test_a_fixer_defined_beside_its_rule_makes_titled_fixes_the_first_safe_preferred(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    doc = Document(T("<AlwaysSuccess/>"))
+    edit = TextEdit(0, 0, "x")
+
+    def fixer(d: Document, c: Context, diag: Diagnostic) -> list[FixEdits]:
+        assert d is doc and diag.code == "demo"
+        return [
+            FixEdits("maybe", (edit,), {"what": "a"}),
+            FixEdits("sure", (edit,), {"what": "b"}),
+            FixEdits("sure", (edit,), {"what": "c"}),
+        ]
+
+    demo = Code(
+        "demo",
+        Severity.HINT,
+        "a demonstration",
+        BT,
+        {"sure": safe("Do {what}"), "maybe": unsafe("Perhaps {what}")},
+        fixer=fixer,
+    )
+    monkeypatch.setattr(semantic_fixes, "all_defined", lambda: {"demo": demo})
+    diag = Diagnostic(1, 5, "demo", "m", Severity.HINT)
+    found = semantic_fixes.fixes_for_rule(doc, Context.from_document(doc), diag)
+    assert [(f.title, f.preferred, f.applicability) for f in found] == [
+        ("Perhaps a", False, Applicability.UNSAFE),
+        ("Do b", True, Applicability.SAFE),
+        ("Do c", False, Applicability.SAFE),
+    ]
+    assert all(f.edits == (edit,) and f.diagnostic is diag for f in found)

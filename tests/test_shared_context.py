@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.cli.main import main
 from bt_lsp.project import index as index_module
 from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules import context as context_module
@@ -17,6 +16,7 @@ from bt_lsp.rules import shared_context
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.shared_context import SharedDecls
 from bt_lsp.syntax.document import Document
+from tests.pinned import main  # bt-lsp as the tests know it (tests/pinned.py)
 
 
 def _tree(tid: str, body: str = "<AlwaysSuccess/>") -> str:

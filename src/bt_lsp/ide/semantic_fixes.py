@@ -2,7 +2,9 @@
 
 Pure: they return edits.  Each fix leaves the document well-formed.  Whether a fix is
 safe is defined with its code (``fixes=`` of :func:`bt_lsp.rules.codes.define`); the first
-safe fix of a diagnostic is its preferred one.
+safe fix of a diagnostic is its preferred one.  A rule that defines its code with a
+``fixer=`` makes its fixes beside itself (:data:`bt_lsp.rules.codes.Fixer`); the codes
+below have theirs here.
 
 * ``missing-format``: add ``BTCPP_format="4"`` to ``<root>`` (safe where the project is
   known to build against version 4).
@@ -32,7 +34,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from bt_lsp.ide.fix import Fix
-from bt_lsp.rules.codes import Applicability, Code
+from bt_lsp.rules.codes import Applicability, Code, all_defined
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.diagnostics import XML_UNESCAPED_CHAR, Diagnostic
 from bt_lsp.rules.names import is_allowed_port_name
@@ -63,7 +65,19 @@ def fixes_for_rule(doc: Document, ctx: Context, diag: Diagnostic) -> list[Fix]:
     """The quick fixes of one diagnostic of a rule other than the name rules; the preferred
     one first."""
     fixer = _FIXERS.get(diag.code)
-    return fixer(doc, ctx, diag) if fixer is not None else []
+    if fixer is not None:
+        return fixer(doc, ctx, diag)
+    code = all_defined().get(diag.code)
+    if code is None or code.fixer is None:
+        return []
+    out: list[Fix] = []
+    for f in code.fixer(doc, ctx, diag):
+        kind = code.applicability(f.key)
+        # The first safe fix is the preferred one (fix-all and check --fix make it).
+        preferred = kind is Applicability.SAFE and not any(x.preferred for x in out)
+        title = code.fix_title(f.key, **f.values)
+        out.append(Fix(title, f.edits, preferred, diag, applicability=kind))
+    return out
 
 
 def _fix(

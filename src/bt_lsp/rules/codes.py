@@ -1,10 +1,11 @@
 """What a diagnostic code is, and how a rule defines one.
 
-A code's name, default severity, one-line summary (the README row) and the titles of its
-fixes are defined with :func:`define` in the module of the rule that reports it, beside
-the rule's messages; :mod:`bt_lsp.rules.registry` imports every such module and is the one
-table of all codes (the README's code table, the server's ``codeDescription`` links and
-the severity settings read it).  Codes are stable once released (see CHANGELOG.md).
+A code's name, default severity, one-line summary (the README row), the titles of its
+fixes and the function that makes them (``fixer``) are defined with :func:`define` in the
+module of the rule that reports it, beside the rule's messages;
+:mod:`bt_lsp.rules.registry` imports every such module and is the one table of all codes
+(the README's code table, the server's ``codeDescription`` links and the severity
+settings read it).  Codes are stable once released (see CHANGELOG.md).
 
 Each code has a page on the documentation site (``docs/rules/<code>.md``, written by
 ``scripts/docs_gen.py``); the optional prose of :func:`define` (``doc``, ``why``, ``bad``,
@@ -14,11 +15,18 @@ Each code has a page on the documentation site (``docs/rules/<code>.md``, writte
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum, IntEnum
 from types import MappingProxyType
-from typing import Final
+from typing import TYPE_CHECKING, Final, TypeAlias
+
+from bt_lsp.syntax.edits import TextEdit
+
+if TYPE_CHECKING:
+    from bt_lsp.rules.context import Context
+    from bt_lsp.rules.diagnostics import Diagnostic
+    from bt_lsp.syntax.document import Document
 
 #: The documentation site (MkDocs, ``mkdocs.yml``, published as the project's GitHub Pages);
 #: every code's page is ``rules/<code>/`` under it (:attr:`Code.url`).
@@ -96,6 +104,23 @@ def display_only(title: str, when: str = "") -> FixSpec:
     return FixSpec(title, Applicability.DISPLAY_ONLY, when)
 
 
+@dataclass(frozen=True, slots=True)
+class FixEdits:
+    """One fix a rule's ``fixer`` makes for one of its diagnostics: the key of the fix in
+    the code's ``fixes`` (its title and class), the edits of the document, and the values
+    the title names (``Replace <{element}> with its child``: ``element``)."""
+
+    key: str
+    edits: tuple[TextEdit, ...]
+    values: Mapping[str, object] = field(default_factory=lambda: MappingProxyType({}))
+
+
+#: What makes the fixes of a code's diagnostic, beside its rule: pure, from the document,
+#: its context and the diagnostic (the editor asks for them when the diagnostic is shown;
+#: fix-all and ``check --fix`` take the first safe one).
+Fixer: TypeAlias = "Callable[[Document, Context, Diagnostic], Sequence[FixEdits]]"
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Code:
     """One diagnostic code.  ``fixes`` are its quick fixes by key: each a title (a
@@ -115,6 +140,7 @@ class Code:
     bad: str = ""
     good: str = ""
     since: str = ""
+    fixer: Fixer | None = None
 
     @property
     def url(self) -> str:
@@ -169,11 +195,12 @@ def define(
     bad: str = "",
     good: str = "",
     since: str = "",
+    fixer: Fixer | None = None,
 ) -> Code:
     """Define (and register) a code; a name defined twice is a programming error, and so
     is a code defined once the registry is complete (after :func:`freeze`).  The prose
     (``doc`` … ``since``, see :class:`Code`) is optional: without it the code's page says
-    the summary."""
+    the summary.  ``fixer`` makes the fixes that ``fixes`` titles (see :data:`Fixer`)."""
     table = _DEFINED
     if not isinstance(table, dict):
         raise RuntimeError(
@@ -182,6 +209,8 @@ def define(
         )
     if code in table:
         raise ValueError(f"diagnostic code {code!r} is defined twice")
+    if fixer is not None and not fixes:
+        raise ValueError(f"diagnostic code {code!r} has a fixer but no fixes= to title them")
     found = table[code] = Code(
         code,
         severity,
@@ -193,6 +222,7 @@ def define(
         bad=_dedent(bad),
         good=_dedent(good),
         since=since.strip(),
+        fixer=fixer,
     )
     return found
 

@@ -35,6 +35,11 @@
   ``Parallel``, or ``max_failures`` of a ``ParallelAll``, larger than its number of
   children (negative values count from the end and never exceed it): the node throws at
   its first tick.  Range: the value.
+* ``single-child-control`` (hint): a ``Sequence``, ``Fallback`` or another control node
+  that only passes its one child's status on; not reported when the control carries a
+  ``_``-attribute (a pre- or postcondition hung on it) or has no end tag (being typed).
+  Range: the element name.  Fix: replace the control with its child (offered in the
+  editor only: the author may rather add the missing siblings).
 """
 
 from __future__ import annotations
@@ -51,6 +56,7 @@ from bt_lsp.rules.codes import (
     BT,
     Applicability,
     FixData,
+    FixEdits,
     Severity,
     define,
     display_only,
@@ -59,8 +65,11 @@ from bt_lsp.rules.codes import (
 )
 from bt_lsp.rules.context import Context
 from bt_lsp.rules.conversions import is_blackboard_reference
+from bt_lsp.rules.diagnostics import Diagnostic
 from bt_lsp.rules.names import NameKind, check_name
 from bt_lsp.rules.semantics.base import Resolved, State, edit_distance, quoted
+from bt_lsp.syntax.document import Document
+from bt_lsp.syntax.edits import TextEdit
 from bt_lsp.syntax.elements import EXPLICIT_TAGS, Element
 
 
@@ -269,6 +278,67 @@ PARALLEL_THRESHOLD: Final = define(
 )
 
 
+def _unwrap(doc: Document, ctx: Context, diag: Diagnostic) -> list[FixEdits]:
+    """``single-child-control``'s fix: the control replaced with its child, whose lines
+    move left by the depth the control gave them.  Not offered when anything but blanks
+    surrounds the child (a comment there would be lost)."""
+    model = doc.model
+    el = next((e for e in model.elements if e.name_start == diag.start), None)
+    if el is None or len(el.children) != 1 or el.end_name_start < 0:
+        return []
+    child = model.elements[el.children[0]]
+    text = doc.text
+    end_tag = el.end_name_start - 2  # its '</'
+    around = text[el.token_start + el.length : child.token_start] + text[child.end : end_tag]
+    if child.end < 0 or around.strip():
+        return []
+    body = text[child.token_start : child.end]
+    outer, inner = _indent(text, el.token_start), _indent(text, child.token_start)
+    if outer is not None and inner is not None and inner.startswith(outer):
+        extra = inner[len(outer) :]
+        first, *rest = body.splitlines(keepends=True)
+        body = first + "".join(line.removeprefix(extra) for line in rest)
+    edit = TextEdit(el.token_start, el.end, body)
+    return [FixEdits("unwrap", (edit,), {"element": el.name})]
+
+
+def _indent(text: str, offset: int) -> str | None:
+    """The blanks between the start of ``offset``'s line and it (``None``: not blanks)."""
+    start = max(text.rfind("\n", 0, offset), text.rfind("\r", 0, offset)) + 1
+    lead = text[start:offset]
+    return lead if lead.strip(" \t") == "" else None
+
+
+SINGLE_CHILD_CONTROL: Final = define(
+    "single-child-control",
+    Severity.HINT,
+    "a `Sequence`, `Fallback` or similar control node with exactly one child",
+    BT,
+    # Never in bulk: whether the control goes or gets its siblings is the author's call.
+    fixes={"unwrap": display_only("Replace <{element}> with its child")},
+    doc="""
+        A `Sequence`, `Fallback`, `SequenceWithMemory`, `ReactiveSequence`,
+        `ReactiveFallback`, `AsyncSequence` or `AsyncFallback` with exactly one child ticks
+        that child and returns its status (`SUCCESS`, `FAILURE`, `RUNNING`, or `SKIPPED` when
+        the child was skipped): it behaves like the child alone. BehaviorTree.CPP loads and
+        runs it; it is usually a leftover of an edit, or a node whose siblings were never
+        written. Not reported when the control has a `_`-attribute (a precondition such as
+        `_skipIf`, or a postcondition): that is then a place to hang it.
+        """,
+    why="The extra node adds depth to the tree and its logs without doing anything.",
+    bad="""
+        <Sequence>
+          <MoveBase goal="{goal}"/>
+        </Sequence>
+        """,
+    good="""
+        <MoveBase goal="{goal}"/>
+        """,
+    since="Every version.",
+    fixer=_unwrap,
+)
+
+
 _BUILTIN_LOWER: Final[Mapping[str, str]] = MappingProxyType({k.lower(): k for k in BUILTINS})
 _LEADING_INT: Final = re.compile(r"-?[0-9]+")
 # Entries of V3_RENAMES that are typos rather than version 3 names.
@@ -333,6 +403,8 @@ def check_node(st: State, el: Element) -> Resolved | None:
         _unregistered(st, type_id, start, end, name in EXPLICIT_TAGS)
         return None
     _children(st, el, res)
+    if len(el.children) == 1 and res.origin == "builtin" and res.id in _PASS_THROUGH:
+        _single_child(st, el, res.id)
     if res.id == "ReactiveSequence":
         _reactive(st, el)
     elif res.id == "Parallel":
@@ -570,6 +642,35 @@ _TICK_CHILD_COUNT: Final = MappingProxyType(
 
 def _is_switch(type_id: str) -> bool:
     return type_id.startswith("Switch") and type_id[6:].isdigit()
+
+
+# The controls that, with one child, tick it and return its status unchanged.
+_PASS_THROUGH: Final = frozenset(
+    {
+        "Sequence",
+        "Fallback",
+        "SequenceWithMemory",
+        "ReactiveSequence",
+        "ReactiveFallback",
+        "AsyncSequence",
+        "AsyncFallback",
+        "SequenceStar",  # version 3's SequenceWithMemory
+    }
+)
+
+
+def _single_child(st: State, el: Element, type_id: str) -> None:
+    if el.end_name_start < 0:
+        return  # not closed: its other children may not be typed yet
+    if any(a.name.startswith("_") for a in el.attrs):
+        return  # a pre- or postcondition hangs on the control
+    st.add(
+        el.name_start,
+        el.name_end,
+        "single-child-control",
+        f"This {type_id} has one child, so it returns what its child returns; replace it "
+        "with its child, or add the siblings it was meant for",
+    )
 
 
 def _reactive(st: State, el: Element) -> None:
