@@ -23,6 +23,9 @@ from packaging.requirements import Requirement
 
 import bt_lsp
 
+# The packages are built into editors/vscode/bundled/: one worker builds them (pytest -n).
+pytestmark = pytest.mark.xdist_group("vscode-bundle")
+
 ROOT = Path(__file__).resolve().parent.parent
 EXT = ROOT / "editors" / "vscode"
 BOOTSTRAP = EXT / "python" / "bootstrap.py"
