@@ -269,7 +269,7 @@ class _Builder:
         cols.tags.extend(repeat(tok, k))
         cols.zones.extend(bytes((zone,)) * k)
         run = starts[i:j]
-        cols.starts.extend(map((-origin).__add__, run) if origin else run)
+        cols.starts.extend(map((-origin).__add__, run) if origin else iter(run))
         cols.tindex.extend(range(i - self.tok_origin, j - self.tok_origin))
         cols.parents.extend(array("i", (stack[-1],)) * k)
         cols.depths.extend(array("i", (len(stack),)) * k)

@@ -403,8 +403,10 @@ def check_node(st: State, el: Element) -> Resolved | None:
         _unregistered(st, type_id, start, end, name in EXPLICIT_TAGS)
         return None
     _children(st, el, res)
-    if len(el.children) == 1 and res.origin == "builtin" and res.id in _PASS_THROUGH:
-        _single_child(st, el, res.id)
+    if res.origin == "builtin" and res.id in _PASS_THROUGH:
+        st.pure = False  # reads the children and the end tag, not the start tag alone
+        if len(el.children) == 1:
+            _single_child(st, el, res.id)
     if res.id == "ReactiveSequence":
         _reactive(st, el)
     elif res.id == "Parallel":
