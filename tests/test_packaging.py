@@ -20,6 +20,9 @@ import pytest
 
 import bt_lsp
 
+# On the worker that builds the VS Code packages (pytest -n): they share editors/vscode/.
+pytestmark = pytest.mark.xdist_group("vscode-bundle")
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
