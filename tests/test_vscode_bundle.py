@@ -23,8 +23,9 @@ from packaging.requirements import Requirement
 
 import bt_lsp
 
-# The packages are built into editors/vscode/bundled/: one worker builds them (pytest -n).
-pytestmark = pytest.mark.xdist_group("vscode-bundle")
+# The packages are built into editors/vscode/bundled/ and the wheel in the source tree's
+# build/: slow, and on one worker under pytest -n.
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("vscode-bundle")]
 
 ROOT = Path(__file__).resolve().parent.parent
 EXT = ROOT / "editors" / "vscode"
