@@ -16,7 +16,7 @@ import pytest
 pytest.importorskip("behaviortreepy")
 pytest.importorskip("zmq")
 
-from tests.e2e.test_neovim import (  # noqa: E402
+from tests.e2e.test_neovim import (
     INIT,
     MARK,
     NVIM_DIR,
@@ -27,7 +27,7 @@ from tests.e2e.test_neovim import (  # noqa: E402
     _workspace,
     target,
 )
-from tests.live.harness import Executor, free_port  # noqa: E402
+from tests.live.harness import Executor, free_port
 
 pytestmark = pytest.mark.e2e
 
