@@ -230,7 +230,7 @@ class Watcher:
                 item = self._queries.get_nowait()
             except queue.Empty:
                 return
-            if item is not _STOP:
+            if item is not _STOP and item[1].set_running_or_notify_cancel():
                 item[1].set_exception(LiveError("the live session is stopped"))
 
     def _attach(self, link: Link) -> First:
@@ -281,7 +281,7 @@ class Watcher:
                 )
 
     def _answer(self, link: Link, names: Sequence[str], answer: Future[dict[str, Any]]) -> None:
-        if answer.done():  # (cancelled: the hover gave up)
+        if not answer.set_running_or_notify_cancel():  # the hover gave up
             return
         if not self._connected:
             answer.set_exception(LiveError(f"the executor at {self.address} is not connected"))
