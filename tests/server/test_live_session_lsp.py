@@ -13,6 +13,7 @@ import os
 import re
 import struct
 import threading
+import time
 from collections.abc import AsyncIterator, Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -331,12 +332,16 @@ class FakePeer:
     """A ZeroMQ REP socket on ``port``: answers FULLTREE with a tree (unless
     ``tree_too``), a recording start with a timestamp, and garbage to the rest."""
 
-    def __init__(self, port: int, *, tree_too: bool = False) -> None:
+    def __init__(
+        self, port: int, *, tree_too: bool = False, tree: bytes | None = None, slow: float = 0
+    ) -> None:
         self.context = zmq.Context()
         self.sock = self.context.socket(zmq.REP)
         self.sock.setsockopt(zmq.LINGER, 0)
         self.sock.bind(f"tcp://127.0.0.1:{port}")
         self.tree_too = tree_too
+        self.tree = tree
+        self.slow = slow  # seconds before answering BLACKBOARD (with a good STATUS)
         self.requests = 0
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._serve, daemon=True)
@@ -355,7 +360,14 @@ class FakePeer:
             _, kind, _ = struct.unpack("<BBI", head)
             reply = head + b"\x07" * 16
             if kind == ord("T") and not self.tree_too:
-                self.sock.send_multipart([reply, FAKE_TREE])
+                self.sock.send_multipart([reply, self.tree or FAKE_TREE])
+            elif kind == ord("S") and self.slow:
+                self.sock.send_multipart([reply, b"\x01\x00\x01"])  # uid 1 RUNNING
+            elif kind == ord("t") and self.slow:
+                self.sock.send_multipart([reply, b""])
+            elif kind == ord("B") and self.slow:
+                time.sleep(self.slow)  # the answer goes to a socket given up on
+                self.sock.send_multipart([reply, b"\xc0"])
             elif kind == ord("r"):
                 self.sock.send_multipart([reply, b"1700000000000000"])
             else:
@@ -401,3 +413,36 @@ async def test_a_peer_answering_garbage_is_reported_and_the_server_keeps_serving
             assert peer.requests > asked  # still polling, though every answer is bad
     finally:
         peer.close()
+
+
+SCRIPT_TREE = (
+    b'<root><BehaviorTree ID="Main" _fullpath="">'
+    b'<Script code="k := 1" _uid="1"/></BehaviorTree></root>'
+)
+SCRIPT_DOC = """\
+<root BTCPP_format="4">
+  <BehaviorTree ID="Main">
+    <Script code="k := 1"/>
+  </BehaviorTree>
+</root>
+"""
+
+
+@clients("vscode")
+async def test_a_hover_waits_half_a_second_at_most_for_a_value(client: BtClient) -> None:
+    uri = client.open(SCRIPT_DOC, name="slow")
+    port = free_port()
+    peer = FakePeer(port, tree=SCRIPT_TREE, slow=3.0)
+    try:
+        async with _connected(client, {"uri": uri, "port": port}) as result:
+            assert result["nodes"] == 1
+            pos = client.pos(SCRIPT_DOC, SCRIPT_DOC.index("k :="))
+            loop = asyncio.get_running_loop()
+            start = loop.time()
+            hover = await client.hover(uri, pos)
+            took = loop.time() - start
+    finally:
+        peer.close()
+    assert hover is not None and isinstance(hover.contents, types.MarkupContent)
+    assert "`k`: no answer from the executor within 0.5 s" in hover.contents.value
+    assert 0.4 < took < 1.5, took
