@@ -2,7 +2,8 @@
 them) against a real BehaviorTree.CPP 4.8.2 executor (tests/live/executor.py) running the
 file Neovim edits: each node's start tag name gets an extmark in the namespace
 "bt_lsp_live" with its status's highlight group and " ● <status>" after the line, the
-running Sleep node among them; `:BtLspMonitorStop` removes every mark."""
+running Sleep node among them; the executor killed, the marks go and the loss is said;
+`:BtLspMonitorStop` ends the session."""
 
 from __future__ import annotations
 
@@ -76,6 +77,7 @@ def test_bt_lsp_monitor(tmp_path: Path, target: Target) -> None:
         env = _env(tmp_path)
         env.setdefault("BT_LSP_E2E_WAIT_MS", "30000")  # a busy machine starts slowly
         env["BT_LSP_E2E_ADDRESS"] = f"127.0.0.1:{port}"
+        env["BT_LSP_E2E_EXECUTOR_PID"] = str(executor.proc.pid)
         lines = TREE.splitlines()
         sleep_row = next(i for i, ln in enumerate(lines) if "<Sleep" in ln)
         env["BT_LSP_E2E_LINE"] = str(sleep_row + 1)
@@ -129,9 +131,18 @@ def test_bt_lsp_monitor(tmp_path: Path, target: Target) -> None:
         "idle": "Comment",
         "skipped": "Comment",
     }, why
-    assert "bt-lsp: watching tree Main at 127.0.0.1" in events["marks"]["messages"], why
+    messages = events["marks"]["messages"]
+    assert "bt-lsp: watching tree Main at 127.0.0.1" in messages, why
+    assert "deprecated" not in messages.lower(), why
+
+    # The executor killed: every mark removed, the loss said.
+    lost = events["lost"]["last"]
+    assert lost["connected"] is False and lost["nodes"] == [], why
+    assert "connection lost" in lost["message"], why
+    assert "bt-lsp live: connection lost" in events["lost"]["messages"], why
 
     # :BtLspMonitorStop: no mark left, the last notification says disconnected.
     stopped = events["stopped"]
     assert stopped["marks"] == [], why
     assert stopped["last"]["connected"] is False and stopped["last"]["nodes"] == [], why
+    assert stopped["last"]["message"] == "disconnected", why

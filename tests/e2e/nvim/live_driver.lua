@@ -4,8 +4,9 @@
 -- after printing {"event": "error"}.
 --
 -- BT_LSP_E2E_LINE: the 1-based line of a node that runs for a while (a Sleep): the driver
--- waits until it is marked running, prints the marks, then runs :BtLspMonitorStop and
--- waits until no mark is left.
+-- waits until it is marked running and prints the marks; kills the executor
+-- (BT_LSP_E2E_EXECUTOR_PID) and waits until the marks are gone; then runs
+-- :BtLspMonitorStop.
 
 local e2e = dofile(debug.getinfo(1, "S").source:sub(2):match("^(.*)[/\\]") .. "/common.lua")
 local emit, wait = e2e.emit, e2e.wait
@@ -49,9 +50,12 @@ e2e.run(function()
     return false
   end)
   vim.cmd("BtLspMonitor " .. os.getenv("BT_LSP_E2E_ADDRESS"))
-  wait("the answer to bt-lsp.liveConnect", function()
+  wait("the first bt-lsp/liveStatus", function()
     local last = live.last()
     return last ~= nil and last.connected
+  end)
+  wait("the answer to bt-lsp.liveConnect", function()
+    return e2e.messages():find("bt-lsp: watching tree", 1, true) ~= nil
   end)
   local line = tonumber(os.getenv("BT_LSP_E2E_LINE")) - 1
   local seen = nil
@@ -69,6 +73,17 @@ e2e.run(function()
     links[status] = link_of(group)
   end
   emit("marks", { marks = seen, links = links, messages = e2e.messages() })
+  -- The executor stops: its marks go, the notification says the connection is lost.
+  local uv = vim.uv or vim.loop
+  uv.kill(tonumber(os.getenv("BT_LSP_E2E_EXECUTOR_PID")), 9)
+  wait("the connection lost", function()
+    local last = live.last()
+    return last ~= nil and not last.connected
+  end)
+  wait("no mark left once lost", function()
+    return #marks(bufnr) == 0
+  end)
+  emit("lost", { last = live.last(), messages = e2e.messages() })
   local stopped = false
   require("bt_lsp").monitor_stop(function()
     stopped = true
