@@ -435,7 +435,7 @@ SCRIPT_DOC = """\
 async def test_a_hover_waits_half_a_second_at_most_for_a_value(client: BtClient) -> None:
     uri = client.open(SCRIPT_DOC, name="slow")
     port = free_port()
-    peer = FakePeer(port, tree=SCRIPT_TREE, slow=3.0)
+    peer = FakePeer(port, tree=SCRIPT_TREE, slow=1.2)
     try:
         async with _connected(client, {"uri": uri, "port": port}) as result:
             assert result["nodes"] == 1

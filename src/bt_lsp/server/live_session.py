@@ -58,8 +58,11 @@ def _options(args: tuple[Any, ...]) -> _Options:
     if len(args) != 1 or not isinstance(args[0], Mapping):
         raise JsonRpcInvalidParams(f"{CONNECT} takes one object: {{uri, host?, port?, rateHz?}}")
     raw = args[0]
-    uri, host = raw.get("uri"), raw.get("host", DEFAULT_HOST)
-    port, rate = raw.get("port", DEFAULT_PORT), raw.get("rateHz", DEFAULT_RATE)
+    # (An option given as null is the default, as one left out.)
+    uri = raw.get("uri")
+    host = DEFAULT_HOST if raw.get("host") is None else raw["host"]
+    port = DEFAULT_PORT if raw.get("port") is None else raw["port"]
+    rate = DEFAULT_RATE if raw.get("rateHz") is None else raw["rateHz"]
     if not isinstance(uri, str):
         raise JsonRpcInvalidParams(f"{CONNECT}: 'uri' must be a string")
     if (
@@ -156,6 +159,11 @@ class LiveMonitor:
             first: First = await asyncio.wait_for(
                 asyncio.wrap_future(watcher.start()), CONNECT_TIMEOUT + 5
             )
+        except asyncio.CancelledError:  # the client cancelled the request
+            if self._session is session:
+                self._session = None
+            watcher.stop(0)
+            raise
         except (LiveError, TimeoutError) as e:
             if self._session is session:
                 self._session = None
@@ -189,9 +197,7 @@ class LiveMonitor:
         }
 
     async def disconnect(self, *args: Any) -> None:
-        if len(args) > 1 or (
-            args and args[0] not in (None, {}) and not isinstance(args[0], Mapping)
-        ):
+        if len(args) > 1 or (args and args[0] is not None and not isinstance(args[0], Mapping)):
             raise JsonRpcInvalidParams(f"{DISCONNECT} takes no argument (or {{}})")
         await self._end("disconnected")
 
