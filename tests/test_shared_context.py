@@ -169,7 +169,7 @@ def test_a_folder_above_the_servers_cap_knows_every_tree(
     _folder(folder, 30)
     assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
     assert "error" not in capsys.readouterr().out
-    assert len(ProjectIndex([folder]).files()) == 10  # the server's cap is unchanged
+    assert len(ProjectIndex([folder]).files.paths()) == 10  # the server's cap is unchanged
 
 
 def test_a_folder_check_parses_each_file_once(

@@ -23,7 +23,7 @@ Nothing here ever fetches a URL or follows a DOCTYPE.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from bt_lsp.ide.name_targets import with_targets
@@ -70,24 +70,24 @@ class ProjectIndex:
         self.settings_index = SettingsIndex(self.roots, settings, self.configs, overrides)
         self.documents = Documents(settings.max_document_bytes)
         # Every file of the folders with ``all_files``, not the first MAX_WORKSPACE_FILES.
-        self.workspace_files = WorkspaceFiles(
+        self.files = WorkspaceFiles(
             self.roots, self.settings_index, self.documents, all_files=all_files
         )
         self.packages = Packages()
         # Installed ROS packages (AMENT_PREFIX_PATH unless given) and their catalogs.
         self.ros = RosIndex(self.packages, ament_prefix_path)
         self.scope = PackageScope(
-            self.settings_index, self.packages, self.ros, self.workspace_files, self.documents
+            self.settings_index, self.packages, self.ros, self.files, self.documents
         )
         self.versions = BtcppVersions(
             self.settings_index, self.packages, self.scope, self.documents
         )
-        self.include_graph = IncludeGraph(self.documents, self.settings_index, self.scope)
+        self.includes = IncludeGraph(self.documents, self.settings_index, self.scope)
         self.contexts = FileContexts(
             self.documents,
-            self.workspace_files,
+            self.files,
             self.settings_index,
-            self.include_graph,
+            self.includes,
             self.scope,
             self.versions,
         )
@@ -117,7 +117,7 @@ class ProjectIndex:
         """A file was created, changed or deleted on disk (workspace/didChangeWatchedFiles)."""
         p = normalize(path)
         self.documents.forget(p)
-        self.workspace_files.forget()
+        self.files.forget()
         if self.configs.changed(p) | self.packages.changed(p):
             self.settings_index.forget()
             self.ros.changed()
@@ -139,14 +139,14 @@ class ProjectIndex:
         cpp = self.cpp is not None and self.cpp.revalidate()
         if cpp:
             self.documents.generation += 1
-        if self.workspace_files.revalidate(self.file_changed):
+        if self.files.revalidate(self.file_changed):
             return True
         return bool(changed) or cpp
 
     def refresh(self) -> None:
         """Forget everything read from disk (for clients that do not report file changes)."""
         self.documents.forget_all()
-        self.workspace_files.forget()
+        self.files.forget()
         self.settings_index.forget()
         self.configs.changed(Path(CONFIG_FILE))
         self.packages.changed(Path("package.xml"))
@@ -164,66 +164,9 @@ class ProjectIndex:
         ``path`` may be one, and then every file's settings are made again."""
         if not self.settings_index.config_edited(path, text):
             return False
-        self.workspace_files.forget()  # its exclude globs may have changed
+        self.files.forget()  # its exclude globs may have changed
         self.documents.generation += 1
         return True
-
-    # -- delegated ---------------------------------------------------------------------------
-
-    @property
-    def settings(self) -> Settings:
-        return self.settings_index.editor
-
-    def is_open(self, path: Path) -> bool:
-        return self.documents.is_open(path)
-
-    def read_document(self, path: Path, text: str) -> Document | None:
-        return self.documents.read_document(path, text)
-
-    def read_error(self, path: Path) -> str | None:
-        return self.documents.read_error(path)
-
-    def files(self) -> list[Path]:
-        return self.workspace_files.paths()
-
-    def is_excluded(self, path: Path, is_dir: bool = False) -> bool:
-        return self.workspace_files.is_excluded(path, is_dir)
-
-    def model_files(self) -> list[Path]:
-        return self.settings_index.model_files()
-
-    def includes(self, path: Path, doc: Document | None = None) -> list[Include]:
-        return self.include_graph.of(path, doc)
-
-    def include_closure(self, path: Path, doc: Document | None = None) -> list[Path]:
-        return self.include_graph.closure(path, doc)
-
-    def include_diagnostics(self, path: Path, doc: Document) -> list[Diagnostic]:
-        return self.include_graph.diagnostics(path, doc)
-
-    def dependents(self, path: Path) -> list[Path]:
-        return self.include_graph.dependents(path)
-
-    def catalog_files(self, path: Path) -> list[Path]:
-        return self.scope.catalog_files(path)
-
-    def model_catalogs(self, path: Path) -> list[Path]:
-        return self.scope.model_catalogs(path)
-
-    def ros_catalogs(self, path: Path) -> list[Path]:
-        return self.scope.ros_catalogs(path)
-
-    def package_folders(self, path: Path) -> list[Path]:
-        return self.scope.package_folders(path)
-
-    def unrelated_catalogs(self, path: Path) -> set[Path]:
-        return self.scope.unrelated_catalogs(path)
-
-    def workspace_packages(self) -> Mapping[str, Path]:
-        return self.scope.workspace_packages()
-
-    def ros_package(self, name: str, settings: Settings | None = None) -> Path | None:
-        return self.scope.ros_package(name, settings)
 
     # -- what the front ends ask ----------------------------------------------------------------
 
@@ -243,7 +186,7 @@ class ProjectIndex:
     def bt_documents(self) -> Iterator[tuple[Path, Document]]:
         """The workspace's BT documents, open ones as edited (see
         :meth:`WorkspaceFiles.bt_documents`)."""
-        return self.workspace_files.bt_documents()
+        return self.files.bt_documents()
 
     def other_documents(self, path: Path, doc: Document | None = None) -> dict[str, Document]:
         """The other BT documents of the workspace, by path (see
@@ -269,7 +212,7 @@ class ProjectIndex:
             return limited(cpp_diagnostics(doc.text, self.cpp.scanner if self.cpp else None))
         ctx = self.context_for(path, doc)
         out = analysis.analyze(doc, ctx)
-        out.extend(self.include_graph.diagnostics(path, doc))
+        out.extend(self.includes.diagnostics(path, doc))
         out.sort(key=lambda d: (d.start, d.end, d.code))
         out = limited(out)
         if any(d.is_name_rule for d in out):  # where a name must change first, if not here

@@ -61,7 +61,7 @@ def tree_resolver(
     workspace files'; each found with its file's path as its source."""
     ctx = ctx if ctx is not None else workspace.context_for(path, doc)
     others: dict[str, Model] = {}
-    for p in workspace.include_closure(path, doc):
+    for p in workspace.includes.closure(path, doc):
         d = workspace.document(p)
         if d is not None:
             others[str(p)] = d.model
