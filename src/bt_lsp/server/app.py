@@ -417,6 +417,7 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 def create_server() -> BtServer:
     from bt_lsp.server import actions, completion, documents, hover, live_session, navigation
+    from bt_lsp.server import replay as replay_command
     from bt_lsp.server import live as live_command
     from bt_lsp.server import render as render_command
 
@@ -529,6 +530,7 @@ def create_server() -> BtServer:
     render_command.register(server)
     live_command.register(server)
     live_session.register(server)
+    replay_command.register(server)
     return server
 
 
