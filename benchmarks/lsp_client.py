@@ -85,6 +85,9 @@ class LspClient:
         self.log: list[str] = []  # window/logMessage and showMessage texts
         self.last_answer_at = 0.0  # when the latest answer to a request arrived
         self.counts: dict[str, int] = {}  # publishDiagnostics received, by URI
+        # Other notifications asked for (watch): the wall-clock time each arrived, and its
+        # params (wall clock, to compare with another process's timestamps).
+        self.watched: dict[str, list[tuple[float, Any]]] = {}
         self._closing = False
         self._reader = asyncio.get_running_loop().create_task(self._read_loop())
 
@@ -176,8 +179,15 @@ class LspClient:
             self._waiters = keep
         elif method in ("window/logMessage", "window/showMessage"):
             self.log.append(str(params.get("message", "")))
+        elif method in self.watched:
+            self.watched[method].append((time.time(), params))
 
     # -- API ------------------------------------------------------------------------------
+
+    def watch(self, method: str) -> list[tuple[float, Any]]:
+        """Keep every ``method`` notification from now on, with the wall-clock time it
+        arrived; the list fills as they come."""
+        return self.watched.setdefault(method, [])
 
     def notify(self, method: str, params: Any) -> float:
         """Send a notification; returns the time just before it was written."""

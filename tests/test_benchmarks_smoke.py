@@ -273,3 +273,40 @@ def test_folder_check_writes_small_trees_that_call_each_other(tmp_path: Path) ->
     assert (
         etree.fromstring((tmp_path / "models.xml").read_bytes()).find("TreeNodesModel") is not None
     )
+
+
+def test_live_latency_matches_each_change_with_its_logged_transition(tmp_path: Path) -> None:
+    """The live benchmark's arithmetic: a status a notification reports changed is timed
+    from the executor's transition of that node to it; the first notification is the
+    baseline, an IDLE is not timed, a status the log never had is counted unmatched."""
+    import struct
+
+    import live_latency
+
+    start = 1_700_000_000_000_000
+    xml = (
+        b'<root BTCPP_format="4"><BehaviorTree ID="Main" _fullpath="">'
+        b'<Sequence name="all" _uid="1"><Sleep name="a" _uid="2"/><Sleep name="b" _uid="3"/>'
+        b"</Sequence></BehaviorTree></root>"
+    )
+
+    def rec(us: int, uid: int, status: int) -> bytes:
+        return us.to_bytes(6, "little") + uid.to_bytes(2, "little") + bytes([status])
+
+    log = tmp_path / "run.btlog"
+    head = b"BTCPP4-FileLogger2\x01" + struct.pack("<i", len(xml)) + xml
+    log.write_bytes(
+        head + struct.pack("<q", start) + rec(0, 1, 1) + rec(0, 2, 1) + rec(40_000, 2, 2)
+        + rec(40_000, 3, 1)
+    )  # fmt: skip
+    t0 = start / 1e6
+
+    def note(at: float, a: str, b: str) -> tuple[float, dict[str, Any]]:
+        statuses = {1: "running", 2: a, 3: b}
+        return t0 + at, {"nodes": [{"uid": u, "status": s} for u, s in statuses.items()]}
+
+    notes = [note(0.01, "running", "idle"), note(0.1, "success", "running"),
+             note(0.2, "success", "failure")]  # fmt: skip
+    lat, matched, unmatched = live_latency._latencies(notes, log)
+    assert matched == 2 and unmatched == 1  # b never failed in the log
+    assert [round(x, 3) for x in lat] == [0.06, 0.06]
