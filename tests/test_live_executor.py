@@ -7,10 +7,8 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -307,42 +305,6 @@ def test_monitor_once_without_an_executor_fails_cleanly(
     port = free_port()
     assert main(["monitor", f"127.0.0.1:{port}", "--once", "--timeout", "0.3"]) == 1
     assert "no answer" in capsys.readouterr().err
-
-
-@pytest.mark.skipif(os.environ.get("BT_LSP_LIVE_FIGURES") is None, reason="measurement only")
-def test_figures(port: int) -> None:
-    """Prints the status round trip and the CPU of polling a 500-node tree at 10 Hz."""
-    ex = Executor(port, nodes=500, lifetime=60)
-    try:
-        with Groot2Client("127.0.0.1", port) as c:
-            assert len(c.read_tree().nodes) == 500
-            times = []
-            for _ in range(500):
-                t0 = time.perf_counter()
-                c.status()
-                times.append(time.perf_counter() - t0)
-            times.sort()
-            print(f"\nstatus round trip, 500 nodes: median {times[250] * 1e6:.0f} us, "
-                  f"p99 {times[495] * 1e6:.0f} us")  # fmt: skip
-
-            def executor_cpu() -> float:
-                fields = Path(f"/proc/{ex.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
-                return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-            idle0, wall0 = executor_cpu(), time.monotonic()
-            time.sleep(10)
-            idle = (executor_cpu() - idle0) / (time.monotonic() - wall0)
-            cpu0, ex0, wall0 = time.process_time(), executor_cpu(), time.monotonic()
-            for _ in range(100):
-                c.status()
-                time.sleep(0.1)
-            wall = time.monotonic() - wall0
-            cpu = (time.process_time() - cpu0) / wall
-            busy = (executor_cpu() - ex0) / wall
-            print(f"client CPU polling at 10 Hz: {100 * cpu:.2f}% of one core")
-            print(f"executor CPU: {100 * idle:.2f}% unpolled, {100 * busy:.2f}% polled")
-    finally:
-        ex.kill()
 
 
 class FakeExecutor:
