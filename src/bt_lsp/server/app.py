@@ -417,9 +417,9 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 def create_server() -> BtServer:
     from bt_lsp.server import actions, completion, documents, hover, live_session, navigation
-    from bt_lsp.server import replay as replay_command
     from bt_lsp.server import live as live_command
     from bt_lsp.server import render as render_command
+    from bt_lsp.server import replay as replay_command
 
     server = BtServer()
 
