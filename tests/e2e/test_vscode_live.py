@@ -1,10 +1,10 @@
 """ "bt-lsp: Connect to a Running Tree" in a real VS Code (code-server driven by headless
 Chromium) against a real BehaviorTree.CPP 4.8.2 executor (behaviortreepy) with a Groot2
-publisher: the address is validated, the Show Tree view colours its nodes with their running
-statuses (also after it draws the tree again), the editor writes each status after its node's
-tag name, the status bar says connected; with the executor killed it says lost and the
-statuses go; with the executor started again on the same port it reconnects; disconnecting
-turns everything off.
+publisher: the address is validated; the Show Tree view colours its nodes with their running
+statuses (also when it draws the tree again, after an edit or after another file); the editor
+writes each status after its node's tag name (also in a new editor of the file); the status
+bar says connected; with the executor killed it says lost and the statuses go; with the
+executor started again on the same port it reconnects; disconnecting turns everything off.
 
 Needs what tests/e2e/test_vscode.py needs (`editors/vscode/e2e/setup.sh`). Its screenshot goes
 to `.e2e-artifacts/vscode/live.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
@@ -68,6 +68,14 @@ MISSION = """\
   </BehaviorTree>
 </root>
 """
+# Another tree file: the Show Tree view follows it, and comes back.
+OTHER = """\
+<root BTCPP_format="4">
+  <BehaviorTree ID="Other">
+    <Sequence><AlwaysSuccess/><AlwaysSuccess/></Sequence>
+  </BehaviorTree>
+</root>
+"""
 STATUSES = {"idle", "running", "success", "failure", "skipped"}
 
 
@@ -80,7 +88,7 @@ def test_vscode_live_tree(tmp_path: Path) -> None:
         )
     assert DRIVER.exists(), DRIVER
     port = free_port()
-    with _code_server(tmp_path, {"mission.xml": MISSION}) as code_server:
+    with _code_server(tmp_path, {"mission.xml": MISSION, "other.xml": OTHER}) as code_server:
         tree = code_server.workspace / "mission.xml"
         executor = Executor(port, lifetime=EXECUTOR_LIFETIME_S, tree=tree)
         try:
@@ -98,6 +106,7 @@ def _drive(
     config = {
         "url": code_server.url,
         "file": "mission.xml",
+        "otherFile": "other.xml",
         "address": f"127.0.0.1:{port}",
         "badAddress": "127.0.0.1:99999",
         "badAddressMessage": "between 1 and 65534",
@@ -188,6 +197,15 @@ def _check(result: dict[str, object], context: str, port: int) -> None:
     redrawn = result["redrawn"]
     assert isinstance(redrawn, dict)
     assert redrawn["renders"] > mix["renders"] and redrawn["live"] == connected["live"], context
+
+    # Another file in front: its picture has no statuses (not part of the running tree);
+    # back to the tree's file, its new editor and its picture have them again.
+    other = result["other"]
+    assert isinstance(other, dict)
+    assert len(other["nodes"]) == 4 and other["live"] == 0, context
+    back = result["back"]
+    assert isinstance(back, dict)
+    assert back["live"] == connected["live"] and back["after"], context
 
     # The executor killed: lost, and no stale status left in the picture or the editor.
     lost = result["lost"]

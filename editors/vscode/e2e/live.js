@@ -3,7 +3,7 @@
 // installed) against a real BehaviorTree.CPP executor, from headless Chromium, and prints what a
 // user would see as one JSON object on the last line of stdout.
 //
-//   node live.js '{"url": "http://127.0.0.1:PORT/?folder=/ws", "file": "mission.xml",
+//   node live.js '{"url": "http://127.0.0.1:PORT/?folder=/ws", "file": "mission.xml", "otherFile": "b.xml",
 //                  "address": "127.0.0.1:41000", "badAddress": "127.0.0.1:99999",
 //                  "executorPid": 1234, "restart": ["/usr/bin/python3", "executor.py", ...],
 //                  "shotDir": "/tmp/shots"}'
@@ -12,7 +12,8 @@
 // "bt-lsp: Connect to a Running Tree", type badAddress (read the input box's validation message),
 // then address; wait until the picture's nodes have live-* classes, the editor shows the statuses'
 // after-texts and the status bar says connected; screenshot; type a space at the end of line 1
-// and read the classes of the picture drawn again; kill the executor (executorPid) and
+// and read the classes of the picture drawn again; open otherFile (its picture has no statuses),
+// then the file again (its editor and picture get their statuses back); kill the executor (executorPid) and
 // wait for the status bar to say lost (reading the classes and after-texts left); start the
 // executor again with `restart` (its "ready" line) and wait for connected and statuses again; run
 // "bt-lsp: Disconnect from the Running Tree" and wait for off.
@@ -183,8 +184,8 @@ async function main(page) {
   result.mix = await until(async () => {
     const s = await snapshot(page, frame);
     const kinds = new Set(Object.values(s.classes));
-    return kinds.has('live-running') && kinds.size >= 3 && s.after.length > 0 ? s : null;
-  }, STEP_TIMEOUT, 100) || (await snapshot(page, frame));
+    return kinds.has('live-running') && kinds.has('live-failure') && kinds.size >= 3 && s.after.length > 0 ? s : null;
+  }, STEP_TIMEOUT, 50) || (await snapshot(page, frame));
   await page.screenshot({ path: path.join(config.shotDir, 'live.png') });
 
   mark('edit: the picture is drawn again');
@@ -196,6 +197,15 @@ async function main(page) {
     const s = await snapshot(page, frame);
     return s.renders > renders ? s : null;
   }, STEP_TIMEOUT, 100) || (await snapshot(page, frame));
+
+  mark('another file, then back');
+  await openFile(page, config.otherFile);
+  result.other = await until(async () => {
+    const s = await snapshot(page, frame);
+    return s.nodes.length !== result.mix.nodes.length ? s : null;
+  }, STEP_TIMEOUT, 100) || (await snapshot(page, frame));
+  await page.click(`.tabs-container .tab[aria-label*="${config.file}"]`); // its tab, still open
+  result.back = await waitLive(page, frame, 'connected') || (await snapshot(page, frame));
 
   mark('executor killed');
   process.kill(config.executorPid, 'SIGKILL');
