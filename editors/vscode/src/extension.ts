@@ -14,6 +14,7 @@ import {
 import { Bundle, findBundle } from './bundled';
 import { registerDebugAdapter } from './debugAdapter';
 import { LiveView } from './live';
+import { registerReplay } from './replay';
 import { resolveServerCommand } from './serverCommand';
 import { ServerStatus } from './status';
 import { registerTreeView } from './treeView';
@@ -88,6 +89,7 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
     }),
   );
   registerTreeView(context, () => client, log, live);
+  registerReplay(context, () => client, log, live);
   registerDebugAdapter(context, log, () => bundle);
   return enqueue(startClient);
 }

@@ -2,7 +2,8 @@
 // Groot2Publisher, maps its tree onto the XML and sends each node's status as it changes
 // (`bt-lsp/liveStatus`). Here: the commands, a status bar item (connected, lost, off), one
 // decoration per status on the nodes' tag names in every visible editor of their files, and
-// the statuses by place for the Show Tree view.
+// the statuses by place for the Show Tree view. A `.btlog` replay (replay.ts) shows its
+// statuses the same way, in place of a connection.
 
 import * as vscode from 'vscode';
 import { ExecuteCommandRequest, type LanguageClient } from 'vscode-languageclient/node';
@@ -13,6 +14,7 @@ import {
   LIVE_STATUS,
   LIVE_STATUSES,
   LiveConnectResult,
+  LiveNode,
   LiveNodeStatus,
   LiveStatusParams,
   LspRange,
@@ -21,7 +23,7 @@ import {
   strongerStatus,
 } from './liveProtocol';
 
-type State = 'off' | 'connecting' | 'connected' | 'lost';
+type State = 'off' | 'connecting' | 'connected' | 'lost' | 'replay';
 
 /** Colours from the theme (the Show Tree view uses the same `charts.*` ones). */
 const STYLES: Record<LiveNodeStatus, { color: string; background?: string }> = {
@@ -95,6 +97,9 @@ export class LiveView implements vscode.Disposable {
   private disposed = false;
   /** Fired when the statuses change (the Show Tree view colours its nodes again). */
   readonly onDidChange = this.changed.event;
+  private readonly replayEnded = new vscode.EventEmitter<void>();
+  /** Fired when a replay ends because of a connection or the disconnect command. */
+  readonly onDidEndReplay = this.replayEnded.event;
 
   constructor(
     private readonly context: vscode.ExtensionContext,
@@ -104,6 +109,7 @@ export class LiveView implements vscode.Disposable {
     this.disposables.push(
       this.item,
       this.changed,
+      this.replayEnded,
       vscode.commands.registerCommand('btLsp.connectLive', () => this.connect()),
       vscode.commands.registerCommand('btLsp.disconnectLive', () => this.disconnect()),
       vscode.window.onDidChangeVisibleTextEditors((editors) => editors.forEach((e) => this.decorate(e))),
@@ -132,6 +138,9 @@ export class LiveView implements vscode.Disposable {
       return;
     }
     this.session = this.seen = this.closed = undefined;
+    if (this.state === 'replay') {
+      return; // a replay needs no server once it has the log's places
+    }
     if (this.state !== 'off') {
       this.setState('off', reason);
     }
@@ -162,6 +171,7 @@ export class LiveView implements vscode.Disposable {
       void vscode.window.showErrorMessage('bt-lsp: the language server is not running (see the bt-lsp output).');
       return;
     }
+    this.endReplay();
     const value = await vscode.window.showInputBox({
       title: 'bt-lsp: Connect to a Running Tree',
       prompt: "host:port of the executor's Groot2Publisher (bt-lsp connects; it never listens)",
@@ -231,6 +241,10 @@ export class LiveView implements vscode.Disposable {
   }
 
   private async disconnect(): Promise<void> {
+    if (this.state === 'replay') {
+      this.endReplay();
+      return;
+    }
     const client = this.client;
     this.closed = this.session ?? this.seen;
     this.setState('off', 'disconnected');
@@ -254,6 +268,9 @@ export class LiveView implements vscode.Disposable {
     if ((this.session !== undefined && status.session < this.session) || status.session === this.closed) {
       return; // an older session's, or the one just disconnected
     }
+    if (this.state === 'replay') {
+      return; // a session's late word while a log is replayed
+    }
     this.seen = status.session;
     const message = typeof status.message === 'string' ? status.message : '';
     if (status.connected) {
@@ -262,6 +279,28 @@ export class LiveView implements vscode.Disposable {
       this.setState('lost', message || 'the connection to the executor is lost; retrying');
     }
     this.update(Array.isArray(status.nodes) ? status.nodes : []);
+  }
+
+  /**
+   * Shows the statuses of a replayed log (`message` in the status bar's tooltip) in place of a
+   * connection, which ends.
+   */
+  async showReplay(nodes: LiveNode[], message: string): Promise<void> {
+    if (this.state !== 'replay' && this.state !== 'off') {
+      await this.disconnect();
+    }
+    this.setState('replay', message);
+    this.update(nodes);
+  }
+
+  /** Ends a replay: the statuses go, and its timeline closes. */
+  endReplay(): void {
+    if (this.state !== 'replay') {
+      return;
+    }
+    this.setState('off', 'the replay ended');
+    this.clear();
+    this.replayEnded.fire();
   }
 
   /** The nodes' statuses by file and place; the decorations and the tree view follow. */
@@ -316,10 +355,20 @@ export class LiveView implements vscode.Disposable {
 
   private setState(state: State, message: string): void {
     this.state = state;
-    const icon = { off: '$(circle-slash)', connecting: '$(sync~spin)', connected: '$(pulse)', lost: '$(debug-disconnect)' }[state];
+    const icon = {
+      off: '$(circle-slash)',
+      connecting: '$(sync~spin)',
+      connected: '$(pulse)',
+      lost: '$(debug-disconnect)',
+      replay: '$(history)',
+    }[state];
     this.item.text = `${icon} BT live: ${state}`;
     const action =
-      state === 'off' ? 'Click to connect to a running tree.' : 'Click to disconnect from the running tree.';
+      state === 'off'
+        ? 'Click to connect to a running tree.'
+        : state === 'replay'
+          ? 'Click to end the replay.'
+          : 'Click to disconnect from the running tree.';
     this.item.tooltip = `${message}\n\n${action}`;
     this.item.command = state === 'off' ? 'btLsp.connectLive' : 'btLsp.disconnectLive';
     this.item.backgroundColor =
