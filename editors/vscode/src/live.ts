@@ -84,6 +84,8 @@ export class LiveView implements vscode.Disposable {
   private closed: number | undefined;
   /** The session of the last notification applied. */
   private seen: number | undefined;
+  /** Counts connects and disconnects: a connect's answer after a later one is stale. */
+  private attempt = 0;
   /** uri -> status -> ranges, for the decorations. */
   private ranges = new Map<string, Map<LiveNodeStatus, vscode.Range[]>>();
   /** uri -> "line:character" of a tag name's start -> status, for the Show Tree view. */
@@ -191,6 +193,7 @@ export class LiveView implements vscode.Disposable {
       return; // the input box does not accept it
     }
     const where = value.trim();
+    const attempt = ++this.attempt;
     void this.context.workspaceState.update(ADDRESS_KEY, where);
     this.closed = undefined;
     this.setState('connecting', `connecting to ${where}`);
@@ -208,6 +211,9 @@ export class LiveView implements vscode.Disposable {
     } catch (error) {
       const reason = errorText(error);
       this.log.warn(`Connecting to the running tree at ${where}: ${reason}`);
+      if (attempt !== this.attempt) {
+        return; // disconnected or connected elsewhere meanwhile
+      }
       if (this.state === 'connecting') {
         this.setState('off', `could not connect to ${where}: ${reason}`);
       }
@@ -217,6 +223,11 @@ export class LiveView implements vscode.Disposable {
     if (client !== this.client) {
       return; // the server restarted meanwhile
     }
+    if (attempt !== this.attempt) {
+      // Disconnected meanwhile: the session's word changes nothing.
+      this.session = this.closed = result.session;
+      return;
+    }
     this.session = result.session;
     const mismatches = Array.isArray(result.mismatches) ? result.mismatches : [];
     this.log.info(
@@ -224,9 +235,14 @@ export class LiveView implements vscode.Disposable {
         `${mismatches.length} differences from the text`,
     );
     mismatches.forEach((m) => this.log.info(`  ${m.message ?? JSON.stringify(m)}`));
-    if (this.seen !== result.session) {
-      // No notification of this session yet: say what the answer says until one comes.
-      this.setState('connected', `connected to ${where} (tree ${result.tree ?? '?'}, ${result.nodes} nodes)`);
+    if (this.state === 'connecting') {
+      // No notification of this session yet (or only one saying it is lost): say what the
+      // answer says until the next one comes.
+      if (this.seen === result.session) {
+        this.setState('lost', `the connection to ${where} is lost; retrying`);
+      } else {
+        this.setState('connected', `connected to ${where} (tree ${result.tree ?? '?'}, ${result.nodes} nodes)`);
+      }
     }
     if (mismatches.length > 0) {
       const showOutput = 'Show Output';
@@ -246,6 +262,7 @@ export class LiveView implements vscode.Disposable {
       return;
     }
     const client = this.client;
+    this.attempt++;
     this.closed = this.session ?? this.seen;
     this.setState('off', 'disconnected');
     this.clear();
@@ -268,14 +285,14 @@ export class LiveView implements vscode.Disposable {
     if ((this.session !== undefined && status.session < this.session) || status.session === this.closed) {
       return; // an older session's, or the one just disconnected
     }
-    if (this.state === 'replay') {
-      return; // a session's late word while a log is replayed
+    if (this.state === 'off' || this.state === 'replay') {
+      return; // a late word of a session ended here (disconnected, or a log replayed since)
     }
     this.seen = status.session;
     const message = typeof status.message === 'string' ? status.message : '';
     if (status.connected) {
       this.setState('connected', message || `connected (tree ${status.tree ?? '?'})`);
-    } else if (this.state !== 'off' && this.state !== 'connecting') {
+    } else if (this.state !== 'connecting') {
       this.setState('lost', message || 'the connection to the executor is lost; retrying');
     }
     this.update(Array.isArray(status.nodes) ? status.nodes : []);
