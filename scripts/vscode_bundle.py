@@ -2,7 +2,7 @@
 
 Each package (``bt-lsp-<target>.vsix``) holds bt-lsp's wheel, built from this checkout, and the
 wheels of its dependencies for that platform and for each bundled CPython minor version
-(lxml and tree-sitter are binary and built per version), with ``bundled/manifest.json``
+(lxml, pyzmq and tree-sitter are binary and built per version), with ``bundled/manifest.json``
 saying which wheels belong to which version. At first start the extension runs
 ``python/bootstrap.py`` with the Python it found, which unpacks them into the extension's
 storage.
@@ -70,7 +70,7 @@ def build_wheel(out: Path) -> Path:
 
 def _dependencies() -> list[str]:
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    return list(project["dependencies"])
+    return [*project["dependencies"], *project["optional-dependencies"]["live"]]
 
 
 def _resolution_key(target: str, python: str) -> str:

@@ -191,3 +191,22 @@ def test_documented_pictures_are_current(capsys: pytest.CaptureFixture[str]) -> 
     assert shown == now and ("subtree", "Dock") in now and ("action", "Align") in now
     assert "](tree/mission.svg)" in readme and "/editors/vscode/images/tree.png)" in readme
     assert (ROOT / "editors" / "vscode" / "images" / "tree.png").is_file()
+
+
+def test_configured_severities_colour_the_nodes(
+    ws: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The badges are what `check` reports with the project's configuration: a code made a
+    warning draws a warning, a code turned off draws none."""
+
+    def inverter_class() -> str:
+        assert main(["render", str(ws / "main.xml")]) == 0
+        svg = _svg(capsys.readouterr().out)
+        return _attr(
+            next(g for g in svg.iter(f"{SVG}g") if g.get("data-type") == "Inverter"), "class"
+        )
+
+    (ws / "bt-lsp.toml").write_text('[severity]\nchild-count = "warning"\n')
+    assert "sev-warning" in inverter_class()
+    (ws / "bt-lsp.toml").write_text('[severity]\nchild-count = "off"\n')
+    assert "sev-" not in inverter_class()

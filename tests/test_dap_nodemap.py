@@ -119,14 +119,20 @@ def test_columns_are_utf16() -> None:
 
 
 def test_where_the_text_differs_nothing_is_matched() -> None:
-    # A renamed node, and a node added to the Sequence (its children no longer line up).
+    # A renamed node: it stands for no running node; its siblings still match.
     renamed = mapped(TEXT.replace('name="ok"', 'name="fine"'))
     assert uids_at(renamed, 6, 37) == ()
-    assert uids_at(renamed, 6) == (7,)  # its siblings still match
+    assert uids_at(renamed, 6) == (7,)
+    # A node added to the Sequence since the executor started: it stands for none, and the
+    # siblings around it keep theirs (the children are aligned, not paired by position).
     added = mapped(TEXT.replace('<Script code="x := 1"/>', '<Script code="x := 1"/><Sleep/>'))
     assert uids_at(added, 2) == (1,)
-    assert uids_at(added, 3) == () and uids_at(added, 6) == ()
+    assert uids_at(added, 3) == (2,)
+    assert uids_at(added, 3, 30) == ()  # the <Sleep/> after the Script
+    assert uids_at(added, 4) == (3,) and uids_at(added, 6) == (7,)
     assert uids_at(added, 13) == (4, 6)  # the subtree is matched on its own
+    removed = mapped(TEXT.replace('<Script code="x := 1"/>', ""))
+    assert uids_at(removed, 4) == (3,) and uids_at(removed, 6, 37) == (8,)
     retyped = mapped(TEXT.replace("AlwaysSuccess name", "AlwaysFailure name"))
     assert uids_at(retyped, 6, 37) == ()
     other_call = mapped(TEXT.replace('<SubTree ID="Sub" name="sub1"/>',

@@ -174,7 +174,7 @@ def test_definition_across_files_prefers_the_include_closure(tmp_path: Path) -> 
     assert doc is not None
     others = {str(p): d for p, d in ws.bt_documents() if p != main}
     ctx = ws.context_for(main, doc)
-    includes = links(ws.includes(main, doc))
+    includes = links(ws.includes.of(main, doc))
     off = doc.text.index('"Dock"') + 2
     (place,) = definition(doc, off, others, ctx=ctx, includes=includes)
     assert place.path == str(dock)

@@ -71,11 +71,11 @@ def test_installed_packages_resolve_includes_and_ship_catalogs(tmp_path: Path) -
     write(app / "package.xml", manifest("app", "nav2_behavior_tree", "my_trees"))
     main = write(app / "behavior_trees" / "main.xml", MAIN)
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(tmp_path / "nowhere"), str(prefix)])
-    assert ws.ros_package("my_trees") == prefix / "share" / "my_trees"
-    assert ws.catalog_files(main) == [
+    assert ws.scope.ros_package("my_trees") == prefix / "share" / "my_trees"
+    assert ws.scope.catalog_files(main) == [
         prefix / "share" / "nav2_behavior_tree" / "nav2_tree_nodes.xml"
     ]
-    [inc] = ws.includes(main)
+    [inc] = ws.includes.of(main)
     assert inc.target == prefix / "share" / "my_trees" / "trees" / "sub.xml"
     found = codes(ws, main)
     assert "include-ros-pkg" not in found  # resolved
@@ -93,7 +93,7 @@ def test_catalogs_only_for_packages_that_depend(tmp_path: Path) -> None:
     write(other / "package.xml", manifest("other", "rclcpp"))
     tree = write(other / "trees" / "t.xml", MAIN)
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(prefix)])
-    assert ws.catalog_files(tree) == []
+    assert ws.scope.catalog_files(tree) == []
     assert "unknown-node" in codes(ws, tree)
 
 
@@ -111,13 +111,13 @@ def test_colcon_src_packages_see_their_own_and_their_dependencies_catalogs(
     # The build and install folders are never the workspace's packages.
     write(tmp_path / "ws" / "install" / "lib" / "package.xml", manifest("lib"))
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[])
-    assert ws.workspace_packages() == {
+    assert ws.scope.workspace_packages() == {
         "app": src / "app",
         "lib": src / "lib",
         "solo": src / "solo",
     }
-    assert ws.catalog_files(app_tree) == [app_catalog, lib_catalog]
-    assert ws.catalog_files(solo_tree) == []
+    assert ws.scope.catalog_files(app_tree) == [app_catalog, lib_catalog]
+    assert ws.scope.catalog_files(solo_tree) == []
     assert "unknown-node" not in codes(ws, app_tree)
 
 
@@ -128,10 +128,10 @@ def test_configured_packages_come_first(tmp_path: Path) -> None:
     ws = Workspace(
         [tmp_path], Settings(ros_packages={"my_trees": str(mine)}), ament_prefix_path=[str(prefix)]
     )
-    assert ws.ros_package("my_trees", ws.settings) == mine
+    assert ws.scope.ros_package("my_trees", ws.settings_index.editor) == mine
     write(tmp_path / "bt-lsp.toml", '[ros-packages]\nmy_trees = "elsewhere"\n')
     f = write(tmp_path / "t.xml", MAIN)
-    [inc] = ws.includes(f)
+    [inc] = ws.includes.of(f)
     assert inc.target == tmp_path / "elsewhere" / "trees" / "sub.xml"
 
 
@@ -140,10 +140,10 @@ def test_a_new_catalog_is_heard(tmp_path: Path) -> None:
     write(src / "app" / "package.xml", manifest("app"))
     tree = write(src / "app" / "trees" / "t.xml", MAIN)
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[])
-    assert ws.catalog_files(tree) == []
+    assert ws.scope.catalog_files(tree) == []
     cat = write(src / "app" / "nodes.xml", CATALOG)
     ws.file_changed(cat)
-    assert ws.catalog_files(tree) == [cat]
+    assert ws.scope.catalog_files(tree) == [cat]
 
 
 def severities(ws: Workspace, path: Path) -> dict[str, str]:
@@ -196,8 +196,8 @@ def test_dependencies_are_followed_transitively_and_cycles_end(tmp_path: Path) -
     tree = write(src / "app" / "trees" / "t.xml", NAV_TREE)
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(prefix)])
     nav2 = share / "nav2_behavior_tree" / "nav2_tree_nodes.xml"
-    assert ws.catalog_files(tree) == [lib_catalog, nav2]
-    assert ws.package_folders(tree) == [
+    assert ws.scope.catalog_files(tree) == [lib_catalog, nav2]
+    assert ws.scope.package_folders(tree) == [
         src / "app",
         src / "lib",
         share / "loop_a",
@@ -233,14 +233,14 @@ def test_excluded_files_are_not_part_of_the_workspace(tmp_path: Path) -> None:
     write(tmp_path / "scratch.xml", models)
     kept = write(tmp_path / "trees" / "t.xml", MAIN)
     ws = Workspace([tmp_path], ament_prefix_path=[])
-    assert ws.files() == [kept]
+    assert ws.files.paths() == [kept]
     # An open excluded document is not part of the workspace either.
     scratch = tmp_path / "scratch.xml"
     ws.open(scratch, Document(models, str(scratch)))
     assert [p for p, _ in ws.bt_documents()] == [kept]
     # Editing the configuration brings them back.
     ws.config_edited(tmp_path / "bt-lsp.toml", "exclude = []\n")
-    assert ws.files() == [tmp_path / "old" / "models.xml", scratch, kept]
+    assert ws.files.paths() == [tmp_path / "old" / "models.xml", scratch, kept]
 
 
 def test_catalogs_are_found_up_to_three_folders_down(tmp_path: Path) -> None:
@@ -254,8 +254,8 @@ def test_catalogs_are_found_up_to_three_folders_down(tmp_path: Path) -> None:
     write(app / "package.xml", manifest("app", "lib"))
     tree = write(app / "t.xml", MAIN.replace("ComputePathToPose", "LibNode"))
     ws = Workspace([tmp_path / "ws"], ament_prefix_path=[str(tmp_path / "opt")])
-    assert ws.catalog_files(tree) == [deep]
+    assert ws.scope.catalog_files(tree) == [deep]
     # A catalog added deep inside is heard.
     later = write(share / "x" / "y" / "more.xml", CATALOG)
     ws.file_changed(later)
-    assert ws.catalog_files(tree) == [later, deep]
+    assert ws.scope.catalog_files(tree) == [later, deep]

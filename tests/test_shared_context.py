@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.project import index as index_module
+from bt_lsp.project import workspace_files
+from bt_lsp.project.include_graph import IncludeGraph
 from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules import context as context_module
 from bt_lsp.rules import shared_context
@@ -129,19 +130,19 @@ def _work_per_file(tmp_path: Path, n: int, monkeypatch: pytest.MonkeyPatch) -> f
     declarations, its includes), per file checked, over a check of ``n`` files."""
     calls = itertools.count()
     real_facts = context_module.facts_of
-    real_includes = ProjectIndex.includes
+    real_includes = IncludeGraph.of
 
     def facts_of(*args: object, **kw: object) -> object:
         next(calls)
         return real_facts(*args, **kw)  # type: ignore[arg-type]
 
-    def includes(self: ProjectIndex, *args: object, **kw: object) -> object:
+    def includes(self: IncludeGraph, *args: object, **kw: object) -> object:
         next(calls)
         return real_includes(self, *args, **kw)  # type: ignore[arg-type]
 
     monkeypatch.setattr(context_module, "facts_of", facts_of)
     monkeypatch.setattr(shared_context, "facts_of", facts_of)
-    monkeypatch.setattr(index_module.ProjectIndex, "includes", includes)
+    monkeypatch.setattr(IncludeGraph, "of", includes)
     folder = tmp_path / f"n{n}"
     _folder(folder, n)
     assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
@@ -163,12 +164,12 @@ def test_a_folder_above_the_servers_cap_knows_every_tree(
 ) -> None:
     """The server's workspace holds at most MAX_WORKSPACE_FILES files; check reads every
     file it checks, so a tree defined in any of them is known (it was an error beyond)."""
-    monkeypatch.setattr(index_module, "MAX_WORKSPACE_FILES", 10)
+    monkeypatch.setattr(workspace_files, "MAX_WORKSPACE_FILES", 10)
     folder = tmp_path / "many"
     _folder(folder, 30)
     assert main(["check", "--no-cpp", "--no-progress", str(folder)]) == 0
     assert "error" not in capsys.readouterr().out
-    assert len(ProjectIndex([folder]).files()) == 10  # the server's cap is unchanged
+    assert len(ProjectIndex([folder]).files.paths()) == 10  # the server's cap is unchanged
 
 
 def test_a_folder_check_parses_each_file_once(

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from bt_lsp.project import index as index_module
+from bt_lsp.project import file_context
 from bt_lsp.project.index import ProjectIndex
 from bt_lsp.rules import shared_context
 from bt_lsp.rules.semantics import sections as section_checks
@@ -95,7 +95,7 @@ def test_edits_of_the_only_open_document_combine_the_workspace_once(
         made.append(args)
         return real(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(index_module, "SharedDecls", counted)
+    monkeypatch.setattr(file_context, "SharedDecls", counted)
     for k in range(4):
         _type(doc, f'name="s{k}"')
         _analysed(ws, path, doc)

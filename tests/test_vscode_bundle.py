@@ -56,10 +56,11 @@ def _pins() -> dict[str, str]:
 
 def test_pins_satisfy_the_dependencies() -> None:
     """A dependency raised in pyproject.toml without a new pin would bundle a version bt-lsp
-    refuses (pip download then fails at package time; this says why first)."""
+    refuses (pip download then fails at package time; this says why first).  The ``live``
+    extra is bundled too: the extension's server connects to running trees."""
     pins = _pins()
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    for spec in project["dependencies"]:
+    for spec in [*project["dependencies"], *project["optional-dependencies"]["live"]]:
         req = Requirement(spec)
         name = req.name.lower().replace("_", "-")
         assert name in pins, f"{name} is not pinned in {REQUIREMENTS.name}"
@@ -221,7 +222,7 @@ def test_platform_package_holds_its_wheels(packages: dict[str, Path], target: st
         assert set(by_dist) == {"bt-lsp", *pins}, (key, sorted(by_dist))
         assert f"bt_lsp-{bt_lsp.__version__}-py3-none-any.whl" in wheels
         for dist, (_, py, abi, plat) in by_dist.items():
-            if dist in ("lxml", "tree-sitter", "tree-sitter-cpp"):
+            if dist in ("lxml", "pyzmq", "tree-sitter", "tree-sitter-cpp"):
                 # Binary: for this CPython version (or the stable ABI) and this platform.
                 minor = int(py.removeprefix("cp3"))
                 stable = abi == "abi3" and minor <= int(key.removeprefix("cp3"))
@@ -240,7 +241,8 @@ def test_linux_package_runs_bt_lsp_from_its_wheels(
     packages: dict[str, Path], tmp_path: Path
 ) -> None:
     """Unpacked with the base interpreter (no site-packages of the virtual environment), the
-    bundle alone checks a tree: lxml and tree-sitter come from its wheels."""
+    bundle alone checks a tree (lxml and tree-sitter come from its wheels) and has what the
+    live monitor needs (pyzmq's ZeroMQ and rich)."""
     with zipfile.ZipFile(packages["linux-x64"]) as vsix:
         vsix.extractall(tmp_path / "vsix")
     ext = tmp_path / "vsix" / "extension"
@@ -261,7 +263,10 @@ def test_linux_package_runs_bt_lsp_from_its_wheels(
     )
     code = (
         "import sys; sys.path.insert(0, sys.argv[1]); import lxml, tree_sitter_cpp, bt_lsp;"
-        "assert all(m.__file__.startswith(sys.argv[1]) for m in (lxml, tree_sitter_cpp, bt_lsp));"
+        "import zmq, rich, bt_lsp.live.client;"
+        "mods = (lxml, tree_sitter_cpp, bt_lsp, zmq, rich);"
+        "assert all(m.__file__.startswith(sys.argv[1]) for m in mods), mods;"
+        "assert zmq.zmq_version_info() >= (4,);"
         "from bt_lsp.cli.main import main; sys.exit(main(['check', sys.argv[2]]))"
     )
     checked = subprocess.run(

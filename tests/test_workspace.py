@@ -24,7 +24,7 @@ def write(path: Path, text: str) -> Path:
 def diags(ws: ProjectIndex, path: Path) -> list[tuple[str, str]]:
     doc = ws.document(path)
     assert doc is not None
-    return [(d.code, doc.text[d.start : d.end]) for d in ws.include_diagnostics(path, doc)]
+    return [(d.code, doc.text[d.start : d.end]) for d in ws.includes.diagnostics(path, doc)]
 
 
 def test_include_resolved_relative_to_the_including_file(tmp_path: Path) -> None:
@@ -32,7 +32,7 @@ def test_include_resolved_relative_to_the_including_file(tmp_path: Path) -> None
     b = write(tmp_path / "trees" / "b.xml", tree(includes=("c.xml",)))
     c = write(tmp_path / "trees" / "c.xml", tree())
     ws = ProjectIndex([tmp_path])
-    assert ws.include_closure(a) == [b, c]
+    assert ws.includes.closure(a) == [b, c]
     assert diags(ws, a) == []
 
 
@@ -74,7 +74,7 @@ def test_open_document_overrides_disk_and_dependents(tmp_path: Path) -> None:
     assert diags(ws, a) == [("include-not-found", "missing.xml")]
     ws.open(a, Document(tree(includes=("b.xml",)), str(a)))
     ws.open(b, Document(tree(), str(b)))
-    assert ws.dependents(b) == [a]
+    assert ws.includes.dependents(b) == [a]
 
 
 def test_file_changed_invalidates_cache(tmp_path: Path) -> None:
@@ -90,9 +90,9 @@ def test_ros_pkg_resolved_through_settings(tmp_path: Path) -> None:
     a = write(tmp_path / "a.xml", '<root><include ros_pkg="pkg" path="t/b.xml"/></root>')
     write(tmp_path / "share" / "pkg" / "t" / "b.xml", tree())
     ws = ProjectIndex([tmp_path], Settings(ros_packages={"pkg": str(tmp_path / "share" / "pkg")}))
-    assert len(ws.include_closure(a)) == 1
+    assert len(ws.includes.closure(a)) == 1
     ws2 = ProjectIndex([tmp_path])
-    assert ws2.include_closure(a) == []  # unmapped: the include-ros-pkg rule reports it
+    assert ws2.includes.closure(a) == []  # unmapped: the include-ros-pkg rule reports it
 
 
 def test_workspace_files_skip_build_and_hidden_dirs_and_non_bt(tmp_path: Path) -> None:
@@ -110,7 +110,7 @@ def test_include_closure_is_bounded_and_iterative(tmp_path: Path) -> None:
         write(tmp_path / f"f{i}.xml", tree(includes=(f"f{i + 1}.xml",)))
     write(tmp_path / f"f{n}.xml", tree())
     ws = ProjectIndex([tmp_path])
-    assert len(ws.include_closure(normalize(tmp_path / "f0.xml"))) == n
+    assert len(ws.includes.closure(normalize(tmp_path / "f0.xml"))) == n
 
 
 def test_revalidate_finds_files_created_and_deleted_in_the_workspace(tmp_path: Path) -> None:
@@ -121,16 +121,16 @@ def test_revalidate_finds_files_created_and_deleted_in_the_workspace(tmp_path: P
 
     a = write(tmp_path / "a.xml", tree())
     ws = ProjectIndex([tmp_path])
-    assert ws.files() == [a]
+    assert ws.files.paths() == [a]
     assert not ws.revalidate()
 
     sub = tmp_path / "sub"
     sub.mkdir()
     generation = ws.generation
     assert not ws.revalidate()  # walked again, no BT file more: nothing changed
-    assert ws.files() == [a] and ws.generation == generation
+    assert ws.files.paths() == [a] and ws.generation == generation
     b = write(sub / "b.xml", tree())
-    assert ws.revalidate() and ws.files() == [a, b] and ws.generation > generation
+    assert ws.revalidate() and ws.files.paths() == [a, b] and ws.generation > generation
 
     swap = sub / ".b.xml.swp"  # an editor's temporary file: the same BT files
     swap.write_text("x", encoding="utf-8")
@@ -139,4 +139,4 @@ def test_revalidate_finds_files_created_and_deleted_in_the_workspace(tmp_path: P
 
     ws.document(b)  # read, then deleted
     os.remove(b)
-    assert ws.revalidate() and ws.files() == [a] and ws.document(b) is None
+    assert ws.revalidate() and ws.files.paths() == [a] and ws.document(b) is None

@@ -3,6 +3,7 @@ executor subprocess, whose printed lines are read with bounded waits."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import selectors
 import socket
@@ -13,6 +14,16 @@ from pathlib import Path
 
 EXECUTOR = Path(__file__).parent / "executor.py"
 LIFETIME = 25.0  # seconds an executor runs at most
+
+
+def thread_names(pid: int) -> list[str]:
+    """The names of process ``pid``'s threads now (Linux's /proc; ZeroMQ names its own
+    ``ZMQbg/...``, Python's are the program's name)."""
+    names = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        with contextlib.suppress(OSError):  # (a thread that ended meanwhile)
+            names.append((task / "comm").read_text().strip())
+    return names
 
 
 def free_port() -> int:

@@ -241,7 +241,8 @@ class TreePanel {
         tree: result.tree,
         trees: result.trees,
         nodes: result.nodes.map((n) => ({ id: n.id, kind: n.kind, subtree: n.subtree ?? null })),
-        selected: this.nodeAt(position)?.id ?? null,
+        // The cursor now, not when the request left: it may have moved while the server drew.
+        selected: this.nodeAt(this.position ?? position)?.id ?? null,
         changed: result.changed ?? null,
       });
       this.postLive();

@@ -167,7 +167,7 @@ def check_file(
         return result
     try:
         # The workspace has usually read the file already (for the other files' sake).
-        shared = project.read_document(normalize(path), decoded.text) if project else None
+        shared = project.documents.read_document(normalize(path), decoded.text) if project else None
         doc = shared if shared is not None else Document(decoded.text, path)
         if Path(path).suffix in CPP_SUFFIXES:  # the name rules where names are born
             facts = Scanner().facts(path, decoded.text.encode("utf-8", "surrogatepass"))

@@ -66,7 +66,7 @@ class SourceMap:
         if self.file is not None:
             doc = self.workspace.document(self.file)
             if doc is None:
-                error = self.workspace.read_error(self.file) or "cannot be read"
+                error = self.workspace.documents.read_error(self.file) or "cannot be read"
                 return f"{self.target}: {error}"
             return self.file, doc
         found = [(p, d) for p, d in self.workspace.bt_documents() if find_tree(d.model, tree_id)]

@@ -236,7 +236,7 @@ def included_back(workspace: ProjectIndex, files: Sequence[str], not_bt: Set[str
     for f in files:
         if not f.endswith(".xml") or normalize(f) in by_path:
             continue
-        for p in workspace.include_closure(normalize(f)):
+        for p in workspace.includes.closure(normalize(f)):
             hit = by_path.get(p)
             if hit is not None:
                 out.add(hit)

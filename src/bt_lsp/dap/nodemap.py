@@ -1,13 +1,11 @@
 """A tree file's lines and the running tree's nodes: which uids a breakpoint line stands for.
 
-:func:`match_elements` is the one place that decides which element of the text each
-running node came from, kept deliberately simple so that a fuller mapping can replace it:
-each ``<BehaviorTree ID=X>`` of the file is matched with every instance of X in the
-running tree (the main tree, and each SubTree node calling X), then children are matched
-in order, and only where the element and the node agree on the type (the registration ID,
-or the tree a SubTree calls) and the instance name, and a list of children has as many
-elements as the node has children.  Where the text differs, nothing below is matched: a
-breakpoint there is reported unverified, never put on another node.
+:func:`match_elements` decides which element of the text each running node came from,
+with the live view's mapping (:mod:`bt_lsp.live.mapping`): each ``<BehaviorTree ID=X>``
+of the file is matched with every instance of X in the running tree (the main tree, and
+each SubTree node calling X), children aligned in order.  Where an element's type or
+instance name differs from its running node's, it stands for no node: a breakpoint there
+is reported unverified, never put on another node.
 
 Pure: text in, offsets and lines out (lines 0-based, columns in UTF-16 code units, as the
 Debug Adapter Protocol counts them).
@@ -15,13 +13,14 @@ Debug Adapter Protocol counts them).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Final
 
-from bt_lsp.live.tree import LiveNode, LiveTree
+from bt_lsp.live.mapping import map_each_tree
+from bt_lsp.live.tree import LiveTree
 from bt_lsp.syntax.document import Document
-from bt_lsp.syntax.elements import Element, Zone
+from bt_lsp.syntax.elements import Zone
+from bt_lsp.syntax.model import Model
 
 MAX_LABEL: Final = 80
 
@@ -36,49 +35,21 @@ class NodeAt:
     label: str
 
 
-def _same(el: Element, node: LiveNode) -> bool:
-    """Whether an element of the text may be the running node (type and name agree)."""
-    if el.name == "SubTree":
-        name = el.value("name")
-        return (
-            node.tag == "SubTree"
-            and node.subtree == el.value("ID")
-            and (name is None or name == node.name)
-        )
-    node_id = el.node_id
-    return (
-        node_id is not None and node_id == node.tag and (el.value("name") or node_id) == node.name
-    )
-
-
-def match_elements(tree: LiveTree, elements: Sequence[Element]) -> dict[int, list[int]]:
+def match_elements(tree: LiveTree, model: Model) -> dict[int, list[int]]:
     """The running nodes each element of the text stands for: element index -> uids.
 
-    An element of a tree called from several places stands for several nodes."""
-    instances: dict[str, list[LiveNode]] = {tree.tree_id: [tree.root]}
-    for node in tree.nodes.values():
-        if node.subtree is not None and node.children:
-            instances.setdefault(node.subtree, []).append(node.children[0])
+    An element of a tree called from several places stands for several nodes.  The text
+    is aligned with the running tree as the live view does (:func:`map_each_tree`), so an
+    element inserted or removed elsewhere leaves the others matched; an element whose
+    type or instance name differs from its running node's stands for none."""
+    tm = map_each_tree(tree, model)
+    unsure = {m.uid for m in tm.mismatches if m.kind in ("renamed", "changed")}
+    index = {el.name_start: i for i, el in enumerate(model.elements) if el.zone == Zone.NODE}
     out: dict[int, list[int]] = {}
-    for el in elements:
-        if el.zone != Zone.TREE or el.name != "BehaviorTree":
-            continue
-        roots = [c for c in el.children if elements[c].zone == Zone.NODE]
-        if len(roots) != 1:
-            continue
-        for live_root in instances.get(el.value("ID") or "", ()):
-            stack = [(roots[0], live_root)]
-            while stack:
-                i, node = stack.pop()
-                element = elements[i]
-                if not _same(element, node):
-                    continue
-                out.setdefault(i, []).append(node.uid)
-                if node.subtree is not None:
-                    continue  # the tree it calls is matched from its own <BehaviorTree>
-                kids = [c for c in element.children if elements[c].zone == Zone.NODE]
-                if len(kids) == len(node.children):
-                    stack.extend(zip(kids, node.children, strict=True))
+    for uid, place in tm.places.items():
+        i = index.get(place.start)
+        if i is not None and uid not in unsure:
+            out.setdefault(i, []).append(uid)
     return out
 
 
@@ -88,6 +59,7 @@ class SourceMap:
     def __init__(self, text: str) -> None:
         doc = Document(text)
         self._lines = doc.lines
+        self._model = doc.model
         self._elements = doc.model.elements
         self._by_line: dict[int, list[int]] = {}
         self._spans: list[tuple[int, int, int]] = []  # (first line, last line, element)
@@ -109,7 +81,7 @@ class SourceMap:
 
     def match(self, tree: LiveTree | None) -> None:
         """Match the elements with a running tree (None: forget the last one)."""
-        self._uids = match_elements(tree, self._elements) if tree is not None else {}
+        self._uids = match_elements(tree, self._model) if tree is not None else {}
         self._places = {uid: i for i, uids in self._uids.items() for uid in uids}
 
     def node_at(self, line: int, column: int | None = None) -> NodeAt | None:

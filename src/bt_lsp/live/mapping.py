@@ -177,8 +177,12 @@ def _overlap(a: Sequence[_Key], b: Sequence[_Key]) -> float:
 
 
 class _Mapper:
-    def __init__(self, resolve: Resolver) -> None:
+    """``follow``: a SubTree instance's children are mapped onto the tree it calls (else
+    they are left to a later :meth:`run` on that tree: :func:`map_each_tree`)."""
+
+    def __init__(self, resolve: Resolver, follow: bool = True) -> None:
         self.resolve = resolve
+        self.follow = follow
         self.places: dict[int, Place] = {}
         self.mismatches: list[Mismatch] = []
         self.missing: set[int] = set()
@@ -186,8 +190,8 @@ class _Mapper:
         # (running nodes, their enclosing instance's path, their counterparts' candidates)
         self.work: list[tuple[Sequence[LiveNode], str, list[_Src]]] = []
 
-    def run(self, roots: Sequence[LiveNode], candidates: list[_Src]) -> None:
-        self.work.append((roots, "", candidates))
+    def run(self, roots: Sequence[LiveNode], candidates: list[_Src], prefix: str = "") -> None:
+        self.work.append((roots, prefix, candidates))
         while self.work:
             nodes, prefix, srcs = self.work.pop()
             self._children(nodes, prefix, srcs)
@@ -243,6 +247,8 @@ class _Mapper:
         if node.subtree is None:
             kids = src.children() if src.element.name != "SubTree" else []
             self.work.append((node.children, prefix, kids))
+            return
+        if not self.follow:
             return
         # A SubTree instance: its tree as the executor loaded it, else the one the text
         # now calls there.
@@ -308,6 +314,27 @@ def map_tree(live: LiveTree, model: Model, resolve: Resolver | None = None) -> T
     tree = _Src(target.model, target.element, target.source)
     mapper.run((live.root,), tree.children())
     return _result(live, mapper, tree.place)
+
+
+def map_each_tree(live: LiveTree, model: Model) -> TreeMap:
+    """Each ``<BehaviorTree>`` of one document mapped onto every running instance of its ID
+    (the main tree, each SubTree node calling it), for a file seen alone (a debugger's
+    breakpoints): a tree the file does not declare is left to its own file, and neither
+    its nodes nor what differs there are reported."""
+    instances: dict[str, list[tuple[Sequence[LiveNode], str]]] = {
+        live.tree_id: [((live.root,), "")]
+    }
+    for node in live.nodes.values():
+        if node.subtree is not None and node.children:
+            instances.setdefault(node.subtree, []).append((node.children, node.path))
+    mapper = _Mapper(lambda _: None, follow=False)
+    for el in model.elements:
+        if el.zone != Zone.TREE or el.name != "BehaviorTree":
+            continue
+        tree = _Src(model, el, None)
+        for nodes, prefix in instances.get(el.value("ID") or "", ()):
+            mapper.run(nodes, tree.children(), prefix)
+    return _result(live, mapper, None)
 
 
 def _result(live: LiveTree, mapper: _Mapper, tree: Place | None) -> TreeMap:

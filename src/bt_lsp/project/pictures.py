@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from bt_lsp.project.index import ProjectIndex
+from bt_lsp.project.index import ProjectIndex, normalize
 from bt_lsp.render import Format, Picture, Resolver, render, workspace_resolver
 from bt_lsp.rules.context import Context
-from bt_lsp.rules.diagnostics import Diagnostic
+from bt_lsp.rules.diagnostics import Diagnostic, with_severities
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.elements import Element
 from bt_lsp.syntax.model import Model
@@ -33,7 +33,9 @@ def draw(
     severity settings), SubTree calls resolved in its include closure and the workspace."""
     ctx = workspace.context_for(path, doc)
     if diagnostics is None:
-        diagnostics = workspace.diagnostics(path, doc)
+        # The file's configured severities, as `check` applies them ("off" drops a code).
+        severities = workspace.settings_for(normalize(path)).severity
+        diagnostics = with_severities(workspace.diagnostics(path, doc), severities)
     if expand_subtrees:
         resolve = tree_resolver(workspace, path, doc, ctx)
     else:
@@ -59,7 +61,7 @@ def tree_resolver(
     workspace files'; each found with its file's path as its source."""
     ctx = ctx if ctx is not None else workspace.context_for(path, doc)
     others: dict[str, Model] = {}
-    for p in workspace.include_closure(path, doc):
+    for p in workspace.includes.closure(path, doc):
         d = workspace.document(p)
         if d is not None:
             others[str(p)] = d.model

@@ -13,7 +13,7 @@ import time
 import traceback
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException, JsonRpcInternalError, JsonRpcMethodNotFound
@@ -44,6 +44,9 @@ from bt_lsp.server.protocol import BtProtocol
 from bt_lsp.server.state import OpenDocument
 from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.text import Encoding, normalize_encoding
+
+if TYPE_CHECKING:
+    from bt_lsp.server.live_session import LiveMonitor
 
 log = logging.getLogger(__name__)
 
@@ -93,6 +96,7 @@ class BtServer(LanguageServer):
         self.versions_logged: dict[Path, tuple[str | None, str]] = {}
         self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
         self.background = Background(self)  # large documents are analysed off the loop
+        self.live: LiveMonitor | None = None  # a running tree watched (server/live_session.py)
 
     @property
     def bt_protocol(self) -> BtProtocol:
@@ -104,6 +108,12 @@ class BtServer(LanguageServer):
 
     def start_tcp(self, host: str, port: int) -> None:
         transport.start_tcp(self, host, port)
+
+    def shutdown(self) -> None:
+        """The connection ends: no thread watching an executor is left behind."""
+        if self.live is not None:
+            self.live.stop()
+        super().shutdown()  # type: ignore[no-untyped-call]
 
     # -- state ----------------------------------------------------------------------------
 
@@ -406,7 +416,8 @@ def _section(raw: object) -> Mapping[str, Any]:
 
 
 def create_server() -> BtServer:
-    from bt_lsp.server import actions, completion, documents, hover, navigation
+    from bt_lsp.server import actions, completion, documents, hover, live_session, navigation
+    from bt_lsp.server import replay as replay_command
     from bt_lsp.server import live as live_command
     from bt_lsp.server import render as render_command
 
@@ -518,6 +529,8 @@ def create_server() -> BtServer:
     completion.register(server)
     render_command.register(server)
     live_command.register(server)
+    live_session.register(server)
+    replay_command.register(server)
     return server
 
 

@@ -48,14 +48,23 @@ def register(server: BtServer) -> None:
             found = root_hover(
                 od.doc, offset, detected.version, detected.source, markdown, detected.conflict
             )
+        live = ls.live.hover(od, offset, markdown) if ls.live is not None else None
         if found is None:
-            return None
+            if live is None:
+                return None
+            text, start, end = live
+            kind = types.MarkupKind.Markdown if markdown else types.MarkupKind.PlainText
+            return types.Hover(
+                contents=types.MarkupContent(kind=kind, value=text), range=req.range(start, end)
+            )
         learned = ls.cpp.hover_markdown(od, offset, found.markdown)  # where the C++ declares it
         text = found.text
         if learned is not None:
             if not found.markdown:
                 learned = _INLINE_CODE_RE.sub(r"'\1'", learned)
             text = f"{text}\n\n{learned}"
+        if live is not None:  # (written in the markup the client asked for, as found is)
+            text = f"{text}\n\n{live[0]}"
         kind = types.MarkupKind.Markdown if found.markdown else types.MarkupKind.PlainText
         return types.Hover(
             contents=types.MarkupContent(kind=kind, value=text),

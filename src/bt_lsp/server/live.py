@@ -15,15 +15,15 @@ XML (malformed, too large, a node without a uid) is InvalidParams, with the reas
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from pygls.exceptions import JsonRpcInvalidParams
 
 from bt_lsp.ide.places import Place
-from bt_lsp.live.mapping import Mismatch, map_tree
+from bt_lsp.live.mapping import Mismatch, TreeMap, map_tree
 from bt_lsp.live.protocol import ProtocolError
-from bt_lsp.live.tree import parse_tree_xml
+from bt_lsp.live.tree import LiveTree, parse_tree_xml
 from bt_lsp.project.pictures import tree_resolver
 from bt_lsp.render import workspace_resolver
 from bt_lsp.rules.context import Context
@@ -31,6 +31,7 @@ from bt_lsp.server.app import BtServer
 from bt_lsp.server.lookup import context_of, path_of
 from bt_lsp.server.navigation import RequestFailed
 from bt_lsp.server.render import Places, range_json
+from bt_lsp.server.state import OpenDocument
 
 COMMAND = "bt-lsp.mapRunningTree"
 
@@ -46,23 +47,25 @@ def _options(args: tuple[Any, ...]) -> tuple[str, str]:
     return uri, tree
 
 
-def map_running_tree(ls: BtServer, *args: Any) -> dict[str, Any]:
-    uri, xml = _options(args)
-    od = ls.get(uri)
-    if od is None:
-        raise RequestFailed(f"{uri} is not an open document")
-    try:
-        live = parse_tree_xml(xml)
-    except ProtocolError as e:
-        raise JsonRpcInvalidParams(f"{COMMAND}: {e}") from None
+def map_onto(ls: BtServer, od: OpenDocument, live: LiveTree) -> TreeMap:
+    """``live`` mapped onto the open document ``od``, the trees its includes and the
+    workspace declare (an untitled document sees only itself)."""
     doc = od.doc
     path = path_of(od)
     if path is not None:
         resolve = tree_resolver(ls.project, path, doc, context_of(ls, od))
-    else:  # an untitled document sees only itself
+    else:
         resolve = workspace_resolver(doc.model, Context.from_document(doc))
-    tm = map_tree(live, doc.model, resolve)
-    places = Places(ls, uri, doc)
+    return map_tree(live, doc.model, resolve)
+
+
+Locate = Callable[[Place], dict[str, Any] | None]
+
+
+def locator(ls: BtServer, od: OpenDocument) -> Locate:
+    """Where a mapped place is: ``{uri, range}`` in the negotiated encoding, or None for
+    a file that cannot be read."""
+    places = Places(ls, od.uri, od.doc)
     enc = ls.encoding
 
     def location(place: Place) -> dict[str, Any] | None:
@@ -72,14 +75,30 @@ def map_running_tree(ls: BtServer, *args: Any) -> dict[str, Any]:
         where, d = found
         return {"uri": where, "range": range_json(d, place.start, place.end, enc)}
 
-    def mismatch(m: Mismatch) -> dict[str, Any]:
-        item: dict[str, Any] = {"kind": m.kind, "message": m.message, "uid": m.uid}
-        if m.node is not None:
-            item.update(tag=m.node.tag, name=m.node.name, path=m.node.path)
-        if m.place is not None:
-            item.update(location(m.place) or {})
-        return item
+    return location
 
+
+def mismatch_json(m: Mismatch, location: Locate) -> dict[str, Any]:
+    """One mismatch as the commands answer it."""
+    item: dict[str, Any] = {"kind": m.kind, "message": m.message, "uid": m.uid}
+    if m.node is not None:
+        item.update(tag=m.node.tag, name=m.node.name, path=m.node.path)
+    if m.place is not None:
+        item.update(location(m.place) or {})
+    return item
+
+
+def map_running_tree(ls: BtServer, *args: Any) -> dict[str, Any]:
+    uri, xml = _options(args)
+    od = ls.get(uri)
+    if od is None:
+        raise RequestFailed(f"{uri} is not an open document")
+    try:
+        live = parse_tree_xml(xml)
+    except ProtocolError as e:
+        raise JsonRpcInvalidParams(f"{COMMAND}: {e}") from None
+    tm = map_onto(ls, od, live)
+    location = locator(ls, od)
     nodes = []
     for uid in sorted(tm.places):
         loc = location(tm.places[uid])
@@ -89,7 +108,7 @@ def map_running_tree(ls: BtServer, *args: Any) -> dict[str, Any]:
         "tree": tm.tree_id,
         "treeLocation": location(tm.tree) if tm.tree is not None else None,
         "nodes": nodes,
-        "mismatches": [mismatch(m) for m in tm.mismatches],
+        "mismatches": [mismatch_json(m, location) for m in tm.mismatches],
     }
 
 

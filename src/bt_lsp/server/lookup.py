@@ -115,7 +115,7 @@ def context_of(ls: BtServer, od: OpenDocument) -> Context:
 
 def includes_of(ls: BtServer, od: OpenDocument) -> list[Include]:
     path = path_of(od)
-    return ls.project.includes(path, od.doc) if path is not None else []
+    return ls.project.includes.of(path, od.doc) if path is not None else []
 
 
 def workspace_sources(ls: BtServer, skip: OpenDocument | None = None) -> dict[str, Source]:

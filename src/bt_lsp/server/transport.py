@@ -64,7 +64,7 @@ def start_io(server: BtServer, stdin: BinaryIO | None, stdout: BinaryIO | None) 
     except (KeyboardInterrupt, SystemExit):
         pass
     finally:
-        server.shutdown()  # type: ignore[no-untyped-call]
+        server.shutdown()
 
 
 def start_tcp(server: BtServer, host: str, port: int) -> None:
@@ -73,7 +73,7 @@ def start_tcp(server: BtServer, host: str, port: int) -> None:
     async def connection(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         server.protocol.set_writer(writer)
         await read_loop(server, reader.read, stop)
-        server.shutdown()  # type: ignore[no-untyped-call]
+        server.shutdown()
 
     async def main() -> None:
         tcp = await asyncio.start_server(connection, host, port)

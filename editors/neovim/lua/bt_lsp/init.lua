@@ -13,6 +13,7 @@ M.section = "btLsp"
 
 local uv = vim.uv or vim.loop
 local api = vim.api
+local live = require("bt_lsp.live")
 
 local defaults = {
   cmd = nil, -- nil: M.default_cmd()
@@ -198,6 +199,11 @@ local function base_config()
     init_options = settings,
     settings = { [M.section] = settings },
     on_attach = opts.on_attach,
+    on_exit = function(_, _, client_id)
+      vim.schedule(function()
+        live.client_stopped(client_id)
+      end)
+    end,
   }
   local capabilities = vim.lsp.protocol.make_client_capabilities()
   -- Neovim 0.7 answers workspace/configuration (from `settings`) but does not say so.
@@ -245,10 +251,12 @@ local function attach_0_7(bufnr, root)
   if id == nil then
     local config = base_config()
     config.root_dir = root
-    config.on_exit = function(_, _, client_id)
+    local stopped = config.on_exit
+    config.on_exit = function(code, signal, client_id)
       if state.clients[root] == client_id then
         state.clients[root] = nil
       end
+      stopped(code, signal, client_id)
     end
     id = vim.lsp.start_client(config)
     if id == nil then
@@ -387,6 +395,41 @@ function M.tree_path(tree, bufnr)
   return ("%s/%s-%s.svg"):format(dir, safe(stem), safe(tree))
 end
 
+-- The bt-lsp client attached to `bufnr`, or nil.
+local function buffer_client(bufnr)
+  local found = nil
+  for _, c in ipairs(M.clients()) do
+    if vim.lsp.buf_is_attached(bufnr, c.id) then
+      found = c
+    end
+  end
+  return found
+end
+
+--- Shows the statuses of a running tree on the current buffer (:BtLspMonitor): the server
+--- connects to the executor's Groot2 publisher at `address` ("host:port", default
+--- 127.0.0.1:1667) and each node gets a highlight and " ● <status>" (bt_lsp.live).
+--- `on_done(result, error message)` is called with the server's answer.
+function M.monitor(address, on_done)
+  local bufnr = api.nvim_get_current_buf()
+  local client = buffer_client(bufnr)
+  if client == nil then
+    local message = "no bt-lsp server is running for this buffer"
+    vim.notify("bt-lsp: " .. message, vim.log.levels.ERROR)
+    if on_done then
+      on_done(nil, message)
+    end
+    return
+  end
+  live.start(client, bufnr, address, on_done)
+end
+
+--- Stops :BtLspMonitor (the marks are removed).
+function M.monitor_stop(on_done)
+  local client = buffer_client(api.nvim_get_current_buf()) or M.clients()[1]
+  live.stop(client, on_done)
+end
+
 --- Renders the behavior tree under the cursor to an SVG file (the server's bt-lsp.renderTree
 --- command) and opens it with the system viewer, or only prints its path. Options:
 ---   ports            show each node's ports
@@ -398,12 +441,7 @@ function M.tree(opts)
   opts = opts or {}
   local bufnr = api.nvim_get_current_buf()
   local done = opts.on_done or function() end
-  local client = nil
-  for _, c in ipairs(M.clients()) do
-    if vim.lsp.buf_is_attached(bufnr, c.id) then
-      client = c
-    end
-  end
+  local client = buffer_client(bufnr)
   local function fail(message)
     vim.notify("bt-lsp: " .. message, vim.log.levels.ERROR)
     done(nil, message)
@@ -452,6 +490,15 @@ function M.tree(opts)
 end
 
 local function create_commands()
+  api.nvim_create_user_command("BtLspMonitor", function(args)
+    M.monitor(args.args)
+  end, {
+    nargs = "?",
+    desc = "Show a running tree's node statuses on this buffer (host:port, default 127.0.0.1:1667)",
+  })
+  api.nvim_create_user_command("BtLspMonitorStop", function()
+    M.monitor_stop()
+  end, { desc = "Stop showing the running tree's node statuses" })
   api.nvim_create_user_command("BtLspRestart", function()
     M.restart()
   end, { desc = "Restart the bt-lsp language server" })
@@ -543,6 +590,15 @@ function M.setup(opts)
       end
     end,
     desc = "bt-lsp: start the server once a file looks like BehaviorTree.CPP XML",
+  })
+
+  -- The statuses of a running tree (:BtLspMonitor), for every bt-lsp client.
+  vim.lsp.handlers[live.NOTIFICATION] = live.on_status
+  live.define_highlights()
+  api.nvim_create_autocmd("ColorScheme", {
+    group = group,
+    callback = live.define_highlights,
+    desc = "bt-lsp: link the live status highlight groups again",
   })
 
   create_commands()
