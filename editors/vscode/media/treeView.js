@@ -3,7 +3,8 @@
 // same tree (or the fit, until the user zooms or pans) and scrolls the node an edit made or
 // changed into view, highlights the node the extension names, colours each node with the status
 // of its running node while the server watches a running tree (classes live-running,
-// live-success, live-failure, live-idle, live-skipped; kept across pictures), and reports clicks. No eval, no
+// live-success, live-failure, live-idle, live-skipped; each picture comes with its nodes'
+// statuses, and 'live' messages update them), and reports clicks. No eval, no
 // remote content: the CSP allows this script and styles carrying the page's nonce only.
 (function () {
   'use strict';
@@ -146,6 +147,7 @@
       keepInView(message.changed);
     }
     select(message.selected, false);
+    live = message.live && typeof message.live === 'object' ? message.live : {};
     applyLive();
     document.body.dataset.tree = message.tree;
     document.body.dataset.renders = String((parseInt(document.body.dataset.renders || '0', 10) || 0) + 1);

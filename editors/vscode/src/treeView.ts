@@ -244,27 +244,36 @@ class TreePanel {
         // The cursor now, not when the request left: it may have moved while the server drew.
         selected: this.nodeAt(this.position ?? position)?.id ?? null,
         changed: result.changed ?? null,
+        // The statuses of these nodes come with them: none of the last picture's is shown on
+        // a node of another tree with the same id.
+        live: this.liveStatuses(),
       });
-      this.postLive();
     } catch (error) {
       this.log.warn(`bt-lsp: drawing the tree: ${error instanceof Error ? error.message : String(error)}`);
       this.post({ type: 'message', text: 'The tree could not be drawn (see the bt-lsp output).' });
     }
   }
 
+  /** Sends the statuses again when they change (the picture's nodes stay). */
+  private postLive(): void {
+    if (this.document && this.rendered) {
+      this.post({ type: 'live', statuses: this.liveStatuses() });
+    }
+  }
+
   /**
    * The live status of each node drawn, by its SVG id: a node drawn stands for the running node
    * whose tag name starts where its element starts (the name follows the element's `<`), in the
-   * same file. Sent after each picture and each change of the statuses.
+   * same file. Sent with each picture and on each change of the statuses.
    */
-  private postLive(): void {
+  private liveStatuses(): Record<string, LiveNodeStatus> {
     const doc = this.document;
     const nodes = this.rendered?.nodes;
+    const statuses: Record<string, LiveNodeStatus> = {};
     if (!doc || !nodes) {
-      return;
+      return statuses;
     }
     const own = uriKey(doc.uri);
-    const statuses: Record<string, LiveNodeStatus> = {};
     if (this.live.active) {
       for (const node of nodes) {
         if (!node.range) {
@@ -278,7 +287,7 @@ class TreePanel {
         }
       }
     }
-    this.post({ type: 'live', statuses });
+    return statuses;
   }
 
   private post(message: unknown): void {
