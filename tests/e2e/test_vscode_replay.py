@@ -2,7 +2,7 @@
 log BehaviorTree.CPP 4.8.2 itself wrote (behaviortreepy's FileLogger2): the timeline opens in
 the panel area; at each position of its slider the Show Tree view's nodes and the editor's
 after-texts show the statuses the log gives after that many transitions (read here with
-`bt_lsp.live.btlog`, independently of the extension's reader); play runs to the end; stop
+`bt_lsp.live.btlog`, the extension's timeline counting them itself); play runs to the end; stop
 hides the timeline and clears everything.
 
 Needs what tests/e2e/test_vscode.py needs (`editors/vscode/e2e/setup.sh`). Its screenshot goes

@@ -1,24 +1,28 @@
 // "bt-lsp: Replay a .btlog": the log BT::FileLogger2 wrote, on a timeline in the panel area. The
-// server maps the log's tree onto the XML in front (`bt-lsp.mapRunningTree`); moving along the
+// server reads the log and maps its tree onto the XML in front (`bt-lsp.readLog`); moving along the
 // timeline (a slider, steps, play at a chosen speed) shows each node's status at that moment
 // as a live connection does (live.ts): after the tag names and in the Show Tree view.
 
 import * as vscode from 'vscode';
 import { ExecuteCommandRequest, type LanguageClient } from 'vscode-languageclient/node';
-import { BtLogError, Timeline, parseBtLog } from './btlog';
+import { Timeline } from './btlog';
 import { LiveView } from './live';
 import { LiveNode, LspRange } from './liveProtocol';
 
-const MAP_COMMAND = 'bt-lsp.mapRunningTree';
+const READ_LOG = 'bt-lsp.readLog';
 const VIEW_ID = 'btLsp.replay';
 const TICK_MS = 50;
 const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10];
-const MAX_LOG_BYTES = 512 * 1024 * 1024;
 
+/** What `bt-lsp.readLog` answers: `bt-lsp.mapRunningTree`'s answer for the log's tree, and the log. */
 interface Mapped {
   tree: string | null;
   nodes: { uid: number; uri: string; range: LspRange }[];
   mismatches: { message?: string }[];
+  startUs: number;
+  transitions: unknown[];
+  truncated: number;
+  partialBytes: number;
 }
 
 type FromWebview =
@@ -39,16 +43,19 @@ function nonce(): string {
   return out;
 }
 
-/** Each node's "Type name" in the log's tree XML, by its `_uid`, for the timeline's labels. */
-function nodeLabels(xml: string): Map<number, string> {
+/** Each mapped node's element as `Type (file:line)`, by uid, for the timeline's labels. */
+function nodeLabels(mapped: Mapped, document: vscode.TextDocument): Map<number, string> {
+  const own = document.uri.toString();
   const labels = new Map<number, string>();
-  for (const tag of xml.matchAll(/<([A-Za-z_][\w.:-]*)(\s[^>]*?)?\/?>/g)) {
-    const attrs = tag[2] ?? '';
-    const uid = /\s_uid="(\d+)"/.exec(attrs);
-    if (uid) {
-      const name = /\sname="([^"]*)"/.exec(attrs);
-      labels.set(Number(uid[1]), name && name[1] !== tag[1] ? `${tag[1]} "${name[1]}"` : tag[1]);
-    }
+  for (const node of mapped.nodes) {
+    const uri = vscode.Uri.parse(node.uri);
+    const { start, end } = node.range;
+    const type =
+      uri.toString() === own && start.line === end.line
+        ? document.lineAt(Math.min(start.line, document.lineCount - 1)).text.slice(start.character, end.character)
+        : '';
+    const file = uri.path.split('/').pop() ?? '';
+    labels.set(node.uid, `${type ? `${type} ` : ''}(${file}:${start.line + 1})`);
   }
   return labels;
 }
@@ -71,11 +78,12 @@ class ReplaySession {
     readonly name: string,
     private readonly timeline: Timeline,
     private readonly mapped: Mapped,
+    document: vscode.TextDocument,
     private readonly live: LiveView,
     private readonly post: (state: unknown) => void,
     private readonly onEnd: () => void,
   ) {
-    this.labels = nodeLabels(timeline.log.xml);
+    this.labels = nodeLabels(mapped, document);
     this.subscription = live.onDidEndReplay(() => this.end());
   }
 
@@ -116,7 +124,7 @@ class ReplaySession {
   /** To just after the `applied`-th transition (its moment on the clock). */
   private seekTo(applied: number): void {
     const n = Math.max(0, Math.min(Math.trunc(applied) || 0, this.timeline.count));
-    this.seek(n, n > 0 ? this.timeline.log.offsets[n - 1] : 0);
+    this.seek(n, n > 0 ? this.timeline.at(n - 1).offsetUs : 0);
   }
 
   private seek(applied: number, timeUs: number): void {
@@ -163,19 +171,18 @@ class ReplaySession {
     if (this.ended) {
       return;
     }
-    const log = this.timeline.log;
     const i = this.applied - 1;
-    const last =
-      i >= 0
-        ? `#${log.uids[i]} ${this.labels.get(log.uids[i]) ?? ''} → ${STATUS_NAMES[log.statuses[i]]}`
-        : 'every node IDLE';
+    const step = i >= 0 ? this.timeline.at(i) : undefined;
+    const last = step
+      ? `#${step.uid} ${this.labels.get(step.uid) ?? ''} → ${step.status.toUpperCase()}`
+      : 'every node IDLE';
     this.post({
       type: 'state',
       name: this.name,
       applied: this.applied,
       count: this.timeline.count,
       time: `${seconds(this.timeUs)} of ${seconds(this.timeline.durationUs)}`,
-      started: new Date(log.startUs / 1000).toISOString(),
+      started: new Date(this.mapped.startUs / 1000).toISOString(),
       last,
       playing: this.timer !== undefined,
     });
@@ -193,8 +200,6 @@ class ReplaySession {
     this.onEnd();
   }
 }
-
-const STATUS_NAMES = ['IDLE', 'RUNNING', 'SUCCESS', 'FAILURE', 'SKIPPED'];
 
 /** The timeline in the panel area (beside Terminal and Output), shown while a log replays. */
 class ReplayViewProvider implements vscode.WebviewViewProvider {
@@ -322,18 +327,18 @@ export function registerReplay(
       let timeline: Timeline;
       let mapped: Mapped;
       try {
-        const stat = await vscode.workspace.fs.stat(uri);
-        if (stat.size > MAX_LOG_BYTES) {
-          throw new BtLogError(`${stat.size} bytes is more than this replays (${MAX_LOG_BYTES})`);
-        }
-        const parsed = parseBtLog(await vscode.workspace.fs.readFile(uri));
-        timeline = new Timeline(parsed);
         mapped = (await client.sendRequest(ExecuteCommandRequest.type, {
-          command: MAP_COMMAND,
-          arguments: [{ uri: client.code2ProtocolConverter.asUri(document.uri), tree: parsed.xml }],
+          command: READ_LOG,
+          arguments: [{ uri: client.code2ProtocolConverter.asUri(document.uri), log: uri.toString() }],
         })) as Mapped;
-        if (parsed.partialBytes) {
-          log.info(`${name}: ends in a partial record (${parsed.partialBytes} bytes), left out`);
+        timeline = new Timeline(Array.isArray(mapped.transitions) ? mapped.transitions : []);
+        if (mapped.partialBytes) {
+          log.info(`${name}: ends in a partial record (${mapped.partialBytes} bytes), left out`);
+        }
+        if (mapped.truncated) {
+          void vscode.window.showWarningMessage(
+            `bt-lsp: ${name} is replayed up to its ${timeline.count}th transition (${mapped.truncated} more left out).`,
+          );
         }
       } catch (error) {
         const reason = error instanceof Error ? error.message : String(error);
@@ -352,6 +357,7 @@ export function registerReplay(
         name,
         timeline,
         mapped,
+        document,
         live,
         (state) => provider.post(state),
         () => {
