@@ -1,7 +1,10 @@
 // The webview of "bt-lsp: Show Tree": shows the SVG the server drew, pans and zooms it (mouse and
 // keyboard), opens each tree fitted to the view, keeps the zoom and scroll across updates of the
 // same tree (or the fit, until the user zooms or pans) and scrolls the node an edit made or
-// changed into view, highlights the node the extension names, and reports clicks. No eval, no
+// changed into view, highlights the node the extension names, colours each node with the status
+// of its running node while the server watches a running tree (classes live-running,
+// live-success, live-failure, live-idle, live-skipped; each picture comes with its nodes'
+// statuses, and 'live' messages update them), and reports clicks. No eval, no
 // remote content: the CSP allows this script and styles carrying the page's nonce only.
 (function () {
   'use strict';
@@ -20,6 +23,24 @@
   let selected = null;
   let size = { w: 0, h: 0 };
   let drag = null;
+  // The live status of each node drawn, by SVG id, from the extension's last 'live' message.
+  let live = {};
+  const LIVE = ['idle', 'running', 'success', 'failure', 'skipped'];
+  const LIVE_CLASSES = LIVE.map((s) => 'live-' + s);
+
+  function applyLive() {
+    let count = 0;
+    for (const g of canvas.querySelectorAll('g.node')) {
+      const status = Object.prototype.hasOwnProperty.call(live, g.id) ? live[g.id] : null;
+      g.classList.remove(...LIVE_CLASSES);
+      if (LIVE.includes(status)) {
+        g.classList.add('live-' + status);
+        count++;
+      }
+    }
+    document.body.dataset.live = String(count);
+    document.body.classList.toggle('live', count > 0);
+  }
 
   function apply() {
     canvas.style.transform = 'translate(' + state.x + 'px, ' + state.y + 'px) scale(' + state.k + ')';
@@ -126,6 +147,8 @@
       keepInView(message.changed);
     }
     select(message.selected, false);
+    live = message.live && typeof message.live === 'object' ? message.live : {};
+    applyLive();
     document.body.dataset.tree = message.tree;
     document.body.dataset.renders = String((parseInt(document.body.dataset.renders || '0', 10) || 0) + 1);
   }
@@ -134,6 +157,9 @@
     const message = event.data;
     if (message.type === 'render') {
       render(message);
+    } else if (message.type === 'live') {
+      live = message.statuses && typeof message.statuses === 'object' ? message.statuses : {};
+      applyLive();
     } else if (message.type === 'highlight') {
       select(message.id, true);
     } else if (message.type === 'message') {

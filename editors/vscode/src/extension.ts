@@ -13,6 +13,8 @@ import {
 } from 'vscode-languageclient/node';
 import { Bundle, findBundle } from './bundled';
 import { registerDebugAdapter } from './debugAdapter';
+import { LiveView } from './live';
+import { registerReplay } from './replay';
 import { resolveServerCommand } from './serverCommand';
 import { ServerStatus } from './status';
 import { registerTreeView } from './treeView';
@@ -23,6 +25,7 @@ const CLIENT_NAME = 'bt-lsp';
 let log: vscode.LogOutputChannel;
 let client: LanguageClient | undefined;
 let status: ServerStatus;
+let live: LiveView;
 let bundle: Bundle | undefined;
 /** The settings that decide which server runs: a change restarts it. */
 const SERVER_CHOICE = ['btLsp.server.command', 'btLsp.importStrategy', 'btLsp.interpreter'];
@@ -70,9 +73,11 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
   log = vscode.window.createOutputChannel(CLIENT_NAME, { log: true });
   bundle = findBundle(context);
   status = new ServerStatus();
+  live = new LiveView(context, log);
   context.subscriptions.push(
     log,
     status,
+    live,
     vscode.commands.registerCommand('btLsp.restartServer', () => restart()),
     vscode.commands.registerCommand('btLsp.showOutput', () => log.show()),
     vscode.workspace.onDidChangeConfiguration((event) => {
@@ -83,7 +88,8 @@ export function activate(context: vscode.ExtensionContext): Promise<void> {
       }
     }),
   );
-  registerTreeView(context, () => client, log);
+  registerTreeView(context, () => client, log, live);
+  registerReplay(context, () => client, log, live);
   registerDebugAdapter(context, log, () => bundle);
   return enqueue(startClient);
 }
@@ -184,10 +190,15 @@ async function startClient(): Promise<void> {
     await candidate.start();
     candidate.starting = false;
     client = candidate;
+    // A new client after each restart: its notifications need a listener of their own.
+    live.attach(candidate);
     log.info('The server is running.');
     status.running(server.origin);
     const running = candidate;
     running.onDidChangeState((event) => {
+      if (event.newState === State.Stopped && client === running) {
+        live.reset('the bt-lsp server stopped');
+      }
       // Stopped for good (it crashed too often), not stopped to restart.
       if (event.newState === State.Stopped && client === running) {
         status.notRunning('the bt-lsp server stopped', 'Run "bt-lsp: Restart server"; its messages are in the bt-lsp output.');
@@ -218,6 +229,7 @@ async function startClient(): Promise<void> {
 async function stopClient(): Promise<void> {
   const running = client;
   client = undefined;
+  live.detach();
   if (running) {
     try {
       await running.stop(2000);

@@ -3,10 +3,13 @@
 // (after the diagnostics' debounce), keeping the node the typing made or changed in view (the
 // server names it from the range the edits replaced), highlights the node under the cursor, and a
 // click on a node selects its element in the XML; a double click on a SubTree node opens the tree
-// it calls.
+// it calls. While the server watches a running tree (live.ts), each node drawn has the colour of
+// its running node's status.
 
 import * as vscode from 'vscode';
 import type { LanguageClient } from 'vscode-languageclient/node';
+import { LiveView, uriKey } from './live';
+import type { LiveNodeStatus } from './liveProtocol';
 
 const COMMAND = 'bt-lsp.renderTree';
 const VIEW_TYPE = 'btLsp.tree';
@@ -100,6 +103,7 @@ class TreePanel {
     private readonly extensionUri: vscode.Uri,
     private readonly getClient: () => LanguageClient | undefined,
     private readonly log: vscode.LogOutputChannel,
+    private readonly live: LiveView,
     private readonly onDispose: () => void,
   ) {
     this.panel = vscode.window.createWebviewPanel(
@@ -116,6 +120,7 @@ class TreePanel {
     this.disposables.push(
       this.panel.onDidDispose(() => this.dispose()),
       this.panel.webview.onDidReceiveMessage((m: FromWebview) => void this.onMessage(m)),
+      this.live.onDidChange(() => this.postLive()),
       vscode.workspace.onDidChangeTextDocument((e) => {
         if (e.document === this.document && e.contentChanges.length > 0) {
           for (const change of e.contentChanges) {
@@ -239,6 +244,9 @@ class TreePanel {
         // The cursor now, not when the request left: it may have moved while the server drew.
         selected: this.nodeAt(this.position ?? position)?.id ?? null,
         changed: result.changed ?? null,
+        // The statuses of these nodes come with them: none of the last picture's is shown on
+        // a node of another tree with the same id.
+        live: this.liveStatuses(),
       });
     } catch (error) {
       this.log.warn(`bt-lsp: drawing the tree: ${error instanceof Error ? error.message : String(error)}`);
@@ -246,14 +254,52 @@ class TreePanel {
     }
   }
 
+  /** Sends the statuses again when they change (the picture's nodes stay). */
+  private postLive(): void {
+    if (this.document && this.rendered) {
+      this.post({ type: 'live', statuses: this.liveStatuses() });
+    }
+  }
+
+  /**
+   * The live status of each node drawn, by its SVG id: a node drawn stands for the running node
+   * whose tag name starts where its element starts (the name follows the element's `<`), in the
+   * same file. Sent with each picture and on each change of the statuses.
+   */
+  private liveStatuses(): Record<string, LiveNodeStatus> {
+    const doc = this.document;
+    const nodes = this.rendered?.nodes;
+    const statuses: Record<string, LiveNodeStatus> = {};
+    if (!doc || !nodes) {
+      return statuses;
+    }
+    const own = uriKey(doc.uri);
+    if (this.live.active) {
+      for (const node of nodes) {
+        if (!node.range) {
+          continue;
+        }
+        const uri = node.uri ? uriKey(node.uri) : own;
+        const { line, character } = node.range.start;
+        const status = this.live.statusAt(uri, line, character) ?? this.live.statusAt(uri, line, character + 1);
+        if (status) {
+          statuses[node.id] = status;
+        }
+      }
+    }
+    return statuses;
+  }
+
   private post(message: unknown): void {
     if (this.ready) {
       void this.panel.webview.postMessage(message);
     } else {
-      this.pending = message;
+      // Until the page listens: the last picture or message, and the last statuses.
+      const live = (message as { type?: string }).type === 'live';
+      this.pending = [...this.pending.filter((m) => ((m as { type?: string }).type === 'live') !== live), message];
     }
   }
-  private pending: unknown;
+  private pending: unknown[] = [];
 
   /** The innermost node of the picture whose element holds ``pos`` (nodes of this document). */
   private nodeAt(pos: vscode.Position): TreeNode | undefined {
@@ -287,10 +333,8 @@ class TreePanel {
   private async onMessage(message: FromWebview): Promise<void> {
     if (message.type === 'ready') {
       this.ready = true;
-      if (this.pending !== undefined) {
-        void this.panel.webview.postMessage(this.pending);
-        this.pending = undefined;
-      }
+      this.pending.forEach((m) => void this.panel.webview.postMessage(m));
+      this.pending = [];
       return;
     }
     if (message.type === 'options') {
@@ -340,6 +384,7 @@ export function registerTreeView(
   context: vscode.ExtensionContext,
   getClient: () => LanguageClient | undefined,
   log: vscode.LogOutputChannel,
+  live: LiveView,
 ): void {
   let panel: TreePanel | undefined;
   context.subscriptions.push(
@@ -350,7 +395,7 @@ export function registerTreeView(
         return;
       }
       if (!panel) {
-        panel = new TreePanel(context.extensionUri, getClient, log, () => (panel = undefined));
+        panel = new TreePanel(context.extensionUri, getClient, log, live, () => (panel = undefined));
       } else {
         panel.reveal();
       }
