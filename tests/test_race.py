@@ -1,7 +1,7 @@
 """The core run by two threads at once, as the language server runs it: the event loop
 edits documents, takes snapshots and answers hover, definition and references on the open
 documents, while the worker thread analyses the snapshots (holding the document's
-history lock, as ``BtServer.compute_diagnostics`` does) and reads their sections' names.
+history lock, as ``DiagnosticsCache.compute`` does) and reads their sections' names.
 Nothing may raise, and every result must equal a single-threaded run on the same text.
 
 Bounded in time: ``BT_LSP_RACE_SECONDS`` (10 by default; 60 or more on demand).

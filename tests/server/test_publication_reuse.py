@@ -102,7 +102,7 @@ def test_a_pulled_report_reuses_the_unchanged_diagnostics_json() -> None:
     od = OpenDocument("untitled:pulled.xml", document(30), 1, "xml")
     od.refresh_kind()
     ls.docs[od.uri] = od
-    first = json.loads(ls.diagnostics_json(od))
+    first = json.loads(ls.diagnostics.as_json(od))
     assert first == fresh(od.doc)
     converted = od.published.converted
     assert converted > 0
@@ -110,6 +110,6 @@ def test_a_pulled_report_reuses_the_unchanged_diagnostics_json() -> None:
     od.doc.edit(at, at, "\n")  # every later diagnostic moves a line down
     od.version = 2
     ls.edits += 1
-    again = json.loads(ls.diagnostics_json(od))
+    again = json.loads(ls.diagnostics.as_json(od))
     assert again == fresh(od.doc) != first  # moved, and written anew where they moved to
     assert od.published.converted == converted

@@ -96,7 +96,7 @@ def _fix_all_edit(ls: BtServer, od: OpenDocument) -> types.WorkspaceEdit:
     """Every safe fix of the document, as ``check --fix`` makes them; a tree defined here
     is renamed in the other files that call it too (those edits need confirmation where
     the client can)."""
-    fixed = fix_document(od.doc, _context(ls, od), ls.diagnostics_of(od), _others(ls, od))
+    fixed = fix_document(od.doc, _context(ls, od), ls.diagnostics.of(od), _others(ls, od))
     return _workspace_edit(ls, od, fixed.edits, fixed.other_edits, FIX_ALL_TITLE)
 
 
@@ -113,7 +113,7 @@ def register(server: BtServer) -> None:
     ) -> list[types.CodeAction | types.Command] | None:
         od = ls.get(params.text_document.uri)
         if od is not None:
-            await ls.analysed(od)  # a large document on the worker thread
+            await ls.diagnostics.analysed(od)  # a large document on the worker thread
             od = ls.get(params.text_document.uri)
         if od is None or not od.is_bt:
             return []
@@ -121,7 +121,7 @@ def register(server: BtServer) -> None:
         lines = od.doc.lines
         start, end = to_offsets(lines, params.range, enc)
         only = params.context.only
-        diags = ls.diagnostics_of(od)
+        diags = ls.diagnostics.of(od)
         actions: list[types.CodeAction | types.Command] = []
         # A name that breaks several rules has one diagnostic per rule, all with the same
         # fixes: offer each fix once, listing every diagnostic it fixes.
@@ -174,14 +174,14 @@ def register(server: BtServer) -> None:
             return action
         od = ls.get(str(data.get("uri")))
         if od is not None:
-            await ls.analysed(od)  # a large document on the worker thread
+            await ls.diagnostics.analysed(od)  # a large document on the worker thread
             od = ls.get(str(data.get("uri")))
         if od is None or od.version != data.get("version"):
             return action  # the document changed; the client asks again
         if data.get("fixAll"):
             action.edit = _fix_all_edit(ls, od)
             return action
-        for d in ls.diagnostics_of(od):
+        for d in ls.diagnostics.of(od):
             if (d.start, d.end, d.code) == (data.get("start"), data.get("end"), data.get("code")):
                 fixes = _all_fixes(ls, od, d)
                 index = data.get("index")

@@ -1,17 +1,16 @@
-"""The bt-lsp language server: state, lifecycle and settings.
+"""The bt-lsp language server: its lifecycle (transport, initialize), the open documents,
+and the parts it owns, one concern each: the editor's settings (server/settings_state.py),
+the documents' diagnostics (server/diagnostics_cache.py) and their publication
+(server/publishing.py).
 
 Each LSP feature lives in its own module and only translates between LSP types and the
-core; this module owns the open documents and when diagnostics are published.
+core.
 """
 
 from __future__ import annotations
 
-import asyncio
-import json
 import logging
-import time
 import traceback
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
@@ -21,28 +20,18 @@ from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
 from bt_lsp import __version__
-from bt_lsp.ide.name_targets import with_targets
-from bt_lsp.project.config import CONFIG_NAMES
 from bt_lsp.project.index import ProjectIndex
-from bt_lsp.project.settings import Settings, shown
-from bt_lsp.rules.analysis import analyze
-from bt_lsp.rules.diagnostics import Diagnostic, size_limited, with_severities
 from bt_lsp.rules.registry import CODES
 from bt_lsp.server import transport
 from bt_lsp.server.background import Background
-from bt_lsp.server.convert import diagnostic_at
 from bt_lsp.server.cpp import WATCH_GLOBS as CPP_WATCH_GLOBS
 from bt_lsp.server.cpp import CppService
-from bt_lsp.server.project import (
-    WATCHED,
-    config_diagnostics,
-    is_project_file,
-    log_version,
-    sync_config_diagnostics,
-)
+from bt_lsp.server.diagnostics_cache import DiagnosticsCache
+from bt_lsp.server.project import WATCHED, is_project_file, sync_config_diagnostics
 from bt_lsp.server.protocol import BtProtocol
+from bt_lsp.server.publishing import Publisher
+from bt_lsp.server.settings_state import SECTION, SettingsState
 from bt_lsp.server.state import OpenDocument
-from bt_lsp.syntax.document import Document
 from bt_lsp.syntax.text import Encoding, normalize_encoding
 
 if TYPE_CHECKING:
@@ -50,19 +39,12 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-SECTION = "btLsp"
-
-# From this size (in characters) an opened document's name diagnostics are published
-# first, found by lxml in a fraction of the full analysis; smaller documents are analysed
-# in less time than an editor takes to notice.
-EARLY_NAMES_CHARS = 256 * 1024
-
-# How often, at most, files read from disk are compared with the disk again, for clients
-# that do not send workspace/didChangeWatchedFiles.
-DISK_CHECK_SECONDS = 1.0
-
 
 class BtServer(LanguageServer):
+    """The server as pygls runs it and handlers receive it: the connection, what the client
+    said in ``initialize``, the open documents, and one part per concern, each owning its
+    state (see docs/architecture.md)."""
+
     def __init__(self) -> None:
         super().__init__(
             "bt-lsp",
@@ -71,11 +53,8 @@ class BtServer(LanguageServer):
             text_document_sync_kind=types.TextDocumentSyncKind.Incremental,
         )
         self.docs: dict[str, OpenDocument] = {}
-        self.settings = Settings()
-        self.settings_in_use = self.settings  # what diagnostics were last computed with
-        self.init_options: object = None  # the client's initializationOptions
-        self._settings_stamps = 0  # counts settings sources, in the order they arrive
-        self._settings_in_force = 0  # the stamp of the settings in force
+        self.edits = 0  # bumped by every change of an open document
+        # What the client supports, from its initialize request.
         self.pull_diagnostics = False
         self.configuration_support = False
         self.refresh_support = False
@@ -83,18 +62,16 @@ class BtServer(LanguageServer):
         self.versioned_edits = False
         self.annotated_edits = False  # change annotations (confirm edits of other files)
         self.code_descriptions = False  # the client shows a diagnostic's codeDescription
-        self._fetching: asyncio.Future[None] | None = None  # a workspace/configuration
         self.watch_files = False
-        self.generation = 0  # bumped when settings change; part of every resultId
         self.project = ProjectIndex()
-        self.edits = 0  # bumped by every change of an open document
-        self._timers: dict[str, asyncio.TimerHandle] = {}
+        self.settings_state = SettingsState(self)  # the editor's btLsp settings
+        self.diagnostics = DiagnosticsCache(self)  # each document's, computed and kept
+        self.publisher = Publisher(self)  # when they are pushed (or re-pulled)
         self.cpp = CppService(self)
         # Configuration files' errors as published, by URI (see server/project.py).
         self.config_published: dict[str, tuple[int, int, str]] = {}
         # Package folder (or document) -> the BehaviorTree.CPP version logged for it.
         self.versions_logged: dict[Path, tuple[str | None, str]] = {}
-        self._disk_checked = -DISK_CHECK_SECONDS  # when check_disk last looked
         self.background = Background(self)  # large documents are analysed off the loop
         self.live: LiveMonitor | None = None  # a running tree watched (server/live_session.py)
 
@@ -115,8 +92,6 @@ class BtServer(LanguageServer):
             self.live.stop()
         super().shutdown()  # type: ignore[no-untyped-call]
 
-    # -- state ----------------------------------------------------------------------------
-
     @property
     def encoding(self) -> Encoding:
         try:
@@ -126,200 +101,6 @@ class BtServer(LanguageServer):
 
     def get(self, uri: str) -> OpenDocument | None:
         return self.docs.get(uri)
-
-    def check_disk(self) -> None:
-        """Without watched-file notifications, notice files changed on disk by their
-        modification time and size (at most once a second): they are read again, and
-        every document's diagnostics are due."""
-        if self.watch_files:
-            return
-        now = time.monotonic()
-        if now - self._disk_checked < DISK_CHECK_SECONDS:
-            return
-        self._disk_checked = now
-        if self.project.revalidate():
-            self.refresh_all()
-
-    def diagnostics_key(self, od: OpenDocument) -> tuple[int | None, int, int]:
-        """What ``od``'s diagnostics depend on: its version, the settings and the rest of
-        the workspace (every open document's edits included)."""
-        return (od.version, self.generation, self.project.generation + self.edits)
-
-    def diagnostics_of(self, od: OpenDocument) -> list[Diagnostic]:
-        """The document's diagnostics after severity settings, cached per version."""
-        self.check_disk()
-        key = self.diagnostics_key(od)
-        if od.cache_key == key:
-            return od.cached
-        self.diagnostics_computed(od, key, self.compute_diagnostics(od, od.doc))
-        return od.cached
-
-    def compute_diagnostics(self, od: OpenDocument, doc: Document) -> list[Diagnostic]:
-        """The diagnostics of ``doc`` (``od``'s document or a snapshot of it) after
-        severity settings.  Sends nothing, so the worker thread may call it."""
-        if not od.is_bt:
-            found = self.cpp.diagnostics(od, doc)
-            return shown(found, self._settings_of(od).min_severity) if found else found
-        with doc.history.lock:  # the caches it shares with the open document's snapshots
-            if doc.utf8_size > self.settings.max_document_bytes:
-                result = size_limited(doc, self.settings.max_document_bytes)
-            elif od.path is not None:
-                result = self.project.diagnostics(od.path, doc)
-            else:
-                result = with_targets(doc, analyze(doc))
-        settings = self._settings_of(od)
-        return shown(with_severities(result, settings.severity), settings.min_severity)
-
-    def _settings_of(self, od: OpenDocument) -> Settings:
-        """The settings of an open document: its file's, or the editor's if it is none."""
-        return self.settings if od.path is None else self.project.settings_for(od.path)
-
-    def diagnostics_computed(
-        self, od: OpenDocument, key: tuple[int | None, int, int], result: list[Diagnostic]
-    ) -> None:
-        """Keep ``od``'s diagnostics for ``key``, and say what computing them found."""
-        od.cache_key, od.cached = key, result
-        if od.is_bt and od.path is not None:
-            log_version(self, od.path)
-        sync_config_diagnostics(self)  # the files' settings were made: their errors known
-
-    async def analysed(self, od: OpenDocument) -> None:
-        """Wait, without holding the loop, until ``od``'s diagnostics are current: a
-        large document is analysed on the worker thread (:mod:`bt_lsp.server.background`),
-        others when :meth:`diagnostics_of` is called."""
-        while self.get(od.uri) is od and self.background.wants(od):
-            self.check_disk()
-            key = self.diagnostics_key(od)
-            if od.cache_key == key:
-                return
-            found = await asyncio.shield(self.background.analyse(od))
-            if found is None and self.diagnostics_key(od) == key:
-                return  # it failed (and was logged): the caller finds out for itself
-
-    def diagnostics_json(self, od: OpenDocument) -> str:
-        """The JSON array of ``od``'s diagnostics, for a pull client: written as a
-        publication is, reusing what its unchanged diagnostics wrote before
-        (:class:`~bt_lsp.server.convert.DiagnosticJson`)."""
-        array = od.published.array(
-            od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
-        )
-        config = config_diagnostics(self, od.uri) if not od.is_bt else []
-        if not config:
-            return array
-        extra = json.dumps(self.protocol._converter.unstructure(config))
-        return array[:-1] + (", " if array != "[]" else "") + extra[1:]
-
-    # -- publishing -------------------------------------------------------------------------
-
-    def wants_early_names(self, od: OpenDocument) -> bool:
-        """Whether the name diagnostics of ``od``, a large BT document being opened, are
-        pushed first, found without its full analysis (:mod:`bt_lsp.rules.early_names`)."""
-        return not self.pull_diagnostics and len(od.doc.text) >= EARLY_NAMES_CHARS
-
-    def early_names_json(
-        self, od: OpenDocument, found: list[Diagnostic], at: dict[int, tuple[int, int]]
-    ) -> str:
-        """The params of the publication of ``found``, the early name diagnostics of
-        ``od`` (with the positions ``at`` of their offsets), as JSON text: written on the
-        worker thread while ``od`` is prepared, published by the loop ahead of the
-        complete set."""
-        settings = self.settings if od.path is None else self.project.settings_for(od.path)
-        found = shown(with_severities(found, settings.severity), settings.min_severity)
-        params = types.PublishDiagnosticsParams(
-            uri=od.uri,
-            diagnostics=[
-                diagnostic_at(
-                    types.Range(types.Position(*at[d.start]), types.Position(*at[d.end])),
-                    d,
-                    self.code_descriptions,
-                )
-                for d in found
-            ],
-            version=od.version,
-        )
-        return json.dumps(self.protocol._converter.unstructure(params))
-
-    def schedule(self, uri: str) -> None:
-        """Diagnostics are due for ``uri``: push them after the debounce delay (clients
-        that pull are told nothing; they ask after each change)."""
-        if self.pull_diagnostics:
-            return
-        timer = self._timers.pop(uri, None)
-        if timer is not None:
-            timer.cancel()
-        delay = self.settings.debounce_ms / 1000
-        if delay <= 0:
-            self.publish(uri)
-            return
-        loop = asyncio.get_running_loop()
-        self._timers[uri] = loop.call_later(delay, self.publish, uri)
-
-    def schedule_all(self, uri: str) -> None:
-        """``uri`` changed: its diagnostics are due, and those of the other open BT
-        documents too, whose includes, trees and models it may provide."""
-        self.schedule(uri)
-        for other, od in self.docs.items():
-            if other != uri and od.is_bt:
-                self.schedule(other)
-
-    def publish(self, uri: str) -> None:
-        self._timers.pop(uri, None)
-        od = self.docs.get(uri)
-        if od is None:
-            return
-        if not od.is_bt and od.path is not None and od.path.name in CONFIG_NAMES:
-            sync_config_diagnostics(self)  # a configuration file's diagnostics are its error
-            return
-        if self.background.wants(od):
-            self.check_disk()
-            if od.cache_key != self.diagnostics_key(od):
-                if not self.background.busy(od):  # else its end publishes
-                    done = self.background.analyse(od)
-                    done.add_done_callback(lambda f: self._analysed(uri, f))
-                return
-        try:
-            array = od.published.array(
-                od.doc.lines, self.diagnostics_of(od), self.encoding, self.code_descriptions
-            )
-        except Exception:  # a bug must not stop the server; say so in its log
-            self.log_error(f"computing diagnostics for {uri}")
-            return
-        version = "" if od.version is None else f', "version": {int(od.version)}'
-        self.bt_protocol.notify_json(
-            types.TEXT_DOCUMENT_PUBLISH_DIAGNOSTICS,
-            f'{{"uri": {json.dumps(uri)}, "diagnostics": {array}{version}}}',
-        )
-
-    def _analysed(self, uri: str, done: asyncio.Future[list[Diagnostic] | None]) -> None:
-        if done.result() is not None:  # else what changed the document publishes
-            self.publish(uri)
-
-    def clear(self, uri: str) -> None:
-        self.background.forget(uri)
-        timer = self._timers.pop(uri, None)
-        if timer is not None:
-            timer.cancel()
-        if not self.pull_diagnostics:
-            self.text_document_publish_diagnostics(
-                types.PublishDiagnosticsParams(uri=uri, diagnostics=[])
-            )
-
-    def refresh_all(self) -> None:
-        """The workspace changed: re-publish (or ask pull clients to re-pull) everything."""
-        self.generation += 1
-        if self.pull_diagnostics:
-            if self.refresh_support:
-                self.workspace_diagnostic_refresh(None)
-        else:
-            for uri in list(self.docs):
-                self.schedule(uri)
-
-    def settings_changed(self) -> None:
-        if self.settings == self.settings_in_use:
-            return  # e.g. a didChangeConfiguration about other extensions' settings
-        self.settings_in_use = self.settings
-        self.project.set_settings(self.settings)
-        self.refresh_all()
 
     # -- logging ----------------------------------------------------------------------------
 
@@ -352,67 +133,6 @@ class BtServer(LanguageServer):
             f"bt-lsp: internal error ({getattr(source, '__name__', source)}): {error!r}",
             types.MessageType.Error,
         )
-
-    # -- settings ---------------------------------------------------------------------------
-
-    def apply_settings(self, raw: object, issued: int | None = None) -> None:
-        """Settings from the client's ``btLsp`` section over its initializationOptions: a
-        key the section leaves out keeps its initializationOptions value, and a missing
-        section (``null``) means the initializationOptions alone.
-
-        ``issued`` orders the sources: the answer to a workspace/configuration request is
-        dropped if settings that arrived after the request was sent are already in force."""
-        issued = self._next_settings_stamp() if issued is None else issued
-        if issued < self._settings_in_force:
-            return
-        self._settings_in_force = issued
-        problems: list[str] = []
-        if raw is not None and not isinstance(raw, Mapping):
-            problems.append("btLsp settings must be an object")
-        merged = {**_section(self.init_options), **_section(raw)}
-        self.settings = Settings.parse(merged, problems)
-        for p in problems:
-            self.log_message(f"bt-lsp settings: {p}", types.MessageType.Warning)
-
-    def _next_settings_stamp(self) -> int:
-        self._settings_stamps += 1
-        return self._settings_stamps
-
-    async def fetch_settings(self) -> None:
-        """Ask for the ``btLsp`` section.  While a request is on its way, a second one is
-        not sent (VS Code sends a didChangeConfiguration right after ``initialized``): the
-        answer to the first one is as new as the change, since the client sent the change
-        before answering it."""
-        if not self.configuration_support:
-            return
-        pending = self._fetching
-        if pending is not None and not pending.done():
-            await asyncio.shield(pending)
-            return
-        self._fetching = asyncio.get_running_loop().create_future()
-        try:
-            await self._fetch_settings()
-        finally:
-            self._fetching.set_result(None)
-
-    async def _fetch_settings(self) -> None:
-        issued = self._next_settings_stamp()
-        try:
-            result = await self.workspace_configuration_async(
-                types.ConfigurationParams(items=[types.ConfigurationItem(section=SECTION)])
-            )
-        except Exception:
-            self.log_error("reading workspace/configuration")
-            return
-        self.apply_settings(result[0] if result else None, issued)
-
-
-def _section(raw: object) -> Mapping[str, Any]:
-    """The ``btLsp`` settings in ``raw`` (the section itself, or an object holding it)."""
-    if not isinstance(raw, Mapping):
-        return {}
-    inner = raw.get(SECTION)
-    return inner if isinstance(inner, Mapping) else raw
 
 
 def create_server() -> BtServer:
@@ -447,14 +167,14 @@ def create_server() -> BtServer:
             ca and ca.resolve_support and "edit" in ca.resolve_support.properties
         )
         if params.initialization_options is not None:
-            ls.apply_settings(params.initialization_options)
-            ls.init_options = params.initialization_options
-        ls.settings_in_use = ls.settings
+            ls.settings_state.apply(params.initialization_options)
+            ls.settings_state.init_options = params.initialization_options
+        ls.settings_state.in_use = ls.settings_state.current
         roots = [f.uri for f in params.workspace_folders or []]
         if not roots and params.root_uri:
             roots = [params.root_uri]
         paths = [p for p in (to_fs_path(r) for r in roots) if p]
-        ls.project = ProjectIndex(paths, ls.settings)
+        ls.project = ProjectIndex(paths, ls.settings_state.current)
         ls.cpp.attach(params)
         ls.watch_files = bool(
             ws and ws.did_change_watched_files and ws.did_change_watched_files.dynamic_registration
@@ -490,8 +210,8 @@ def create_server() -> BtServer:
                 if ls.project.cpp is not None:
                     ls.project.cpp.watched = False  # changes on disk are not reported
         if ls.configuration_support:
-            await ls.fetch_settings()
-            ls.settings_changed()
+            await ls.settings_state.fetch()
+            ls.settings_state.changed()
         for root in ls.project.roots:  # a broken configuration is shown before any file
             ls.project.configs.for_path(root)
         sync_config_diagnostics(ls)
@@ -507,7 +227,7 @@ def create_server() -> BtServer:
                     project_files = project_files or is_project_file(Path(path))
             except Exception:
                 ls.log_error(f"reading the change of {change.uri}")
-        ls.refresh_all()
+        ls.publisher.refresh_all()
         if project_files:
             sync_config_diagnostics(ls)
 
@@ -517,10 +237,10 @@ def create_server() -> BtServer:
     ) -> None:
         raw = params.settings
         if isinstance(raw, dict) and isinstance(raw.get(SECTION), dict):
-            ls.apply_settings(raw[SECTION])
+            ls.settings_state.apply(raw[SECTION])
         elif ls.configuration_support:
-            await ls.fetch_settings()
-        ls.settings_changed()
+            await ls.settings_state.fetch()
+        ls.settings_state.changed()
 
     documents.register(server)
     actions.register(server)

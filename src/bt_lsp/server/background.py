@@ -6,9 +6,9 @@ document being typed in) for that long.  A document of at least :data:`WORKER_CH
 characters is therefore analysed by one worker thread, on a :meth:`Document.snapshot` taken
 on the loop: edits arriving meanwhile change the open document, never the snapshot.  The
 result is kept (and published) only if nothing it depends on changed while it ran (the
-same key as :meth:`BtServer.diagnostics_of`); else the analysis that the change scheduled
-follows.  Smaller documents are analysed on the loop as before: they take milliseconds and
-never queue behind a large one.
+same key as :meth:`bt_lsp.server.diagnostics_cache.DiagnosticsCache.of`); else the analysis
+that the change scheduled follows.  Smaller documents are analysed on the loop as before:
+they take milliseconds and never queue behind a large one.
 
 Python switches threads every few milliseconds (``sys.getswitchinterval``), so the loop
 keeps answering while the worker runs.  Requests on the document being analysed do not
@@ -202,14 +202,14 @@ class Background:
         od = held.od
         od.refresh_kind()
         server = self._server
-        if not od.is_bt or not server.wants_early_names(od):
+        if not od.is_bt or not server.publisher.wants_early_names(od):
             return
         text = od.doc.text
         found = early_name_diagnostics(text)
         if found is None:
             return
         at = positions_of(text, [o for d in found for o in (d.start, d.end)], server.encoding)
-        params = server.early_names_json(od, found, at)
+        params = server.publisher.early_names_json(od, found, at)
         written = threading.Event()
         loop.call_soon_threadsafe(self._early, held, params, written)
         written.wait(_EARLY_WAIT)
@@ -293,13 +293,13 @@ class Background:
         if od.uri in self._held:
             return True
         job = self._jobs.get(od.uri)
-        return job is not None and job.key == self._server.diagnostics_key(od)
+        return job is not None and job.key == self._server.diagnostics.key(od)
 
     def analyse(self, od: OpenDocument) -> asyncio.Future[list[Diagnostic] | None]:
         """Start analysing ``od`` as it is now (unless that is under way already); the
         future is done, on the loop, once its diagnostics are cached on ``od`` (its result)
         or are not wanted any more (``None``: the document changed or was closed)."""
-        key = self._server.diagnostics_key(od)
+        key = self._server.diagnostics.key(od)
         job = self._jobs.get(od.uri)
         if job is not None and job.key == key:
             return job.done
@@ -315,7 +315,7 @@ class Background:
         made this analysis useless before it started."""
         if self._jobs.get(od.uri) is not job:
             return None
-        return self._server.compute_diagnostics(od, job.snapshot)
+        return self._server.diagnostics.compute(od, job.snapshot)
 
     def _finished(
         self, od: OpenDocument, job: _Job, work: asyncio.Future[list[Diagnostic] | None]
@@ -332,11 +332,11 @@ class Background:
             server.log_message(f"bt-lsp: error computing diagnostics for {od.uri}: {exc!r}")
         else:
             result = work.result()
-        current = server.docs.get(od.uri) is od and server.diagnostics_key(od) == job.key
+        current = server.docs.get(od.uri) is od and server.diagnostics.key(od) == job.key
         if result is not None and current:
             if od.is_bt:  # (a C++ document has no model to hand on)
                 od.doc.adopt(job.snapshot)
-            server.diagnostics_computed(od, job.key, result)
+            server.diagnostics.computed(od, job.key, result)
         else:
             result = None
         if not job.done.done():

@@ -138,7 +138,7 @@ class CppService:
                 )
             self._task = None
         if changed:
-            self.ls.refresh_all()  # the documents' contexts now find the catalogs read
+            self.ls.publisher.refresh_all()  # the documents' contexts now find the catalogs read
 
     def _reporter(
         self, loop: asyncio.AbstractEventLoop, token: str | None
@@ -174,7 +174,7 @@ class CppService:
 
     def _refresh(self) -> None:
         self._rescan = None
-        self.ls.refresh_all()  # each document's context asks for its (now stale) catalog
+        self.ls.publisher.refresh_all()  # each document's context asks for its (now stale) catalog
 
     def diagnostics(self, od: OpenDocument, doc: Document | None = None) -> list[Diagnostic]:
         """The name-rule diagnostics of an open C++ document's string literals (of

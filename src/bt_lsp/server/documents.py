@@ -25,7 +25,7 @@ def _opened(ls: BtServer, od: OpenDocument) -> None:
         ls.project.open(od.path, od.doc)
     ls.cpp.document_changed(od)
     ls.edits += 1
-    ls.schedule_all(od.uri)
+    ls.publisher.schedule_all(od.uri)
     document_edited(ls, od, opened=True)
 
 
@@ -33,8 +33,8 @@ def _changed(ls: BtServer, od: OpenDocument, was_bt: bool) -> None:
     ls.cpp.document_changed(od)
     ls.edits += 1
     if was_bt and not od.is_bt:
-        ls.clear(od.uri)
-    ls.schedule_all(od.uri)
+        ls.publisher.clear(od.uri)
+    ls.publisher.schedule_all(od.uri)
     document_edited(ls, od)
 
 
@@ -86,9 +86,9 @@ def register(server: BtServer) -> None:
             if od.path is not None:
                 ls.project.close(od.path)  # from now on the file on disk counts
             ls.cpp.document_changed(od, closed=True)
-            ls.clear(uri)
+            ls.publisher.clear(uri)
             document_edited(ls, od, closed=True)
-            ls.schedule_all(uri)
+            ls.publisher.schedule_all(uri)
 
     @server.feature(types.TEXT_DOCUMENT_DID_SAVE)
     def did_save(ls: BtServer, params: types.DidSaveTextDocumentParams) -> None:
@@ -97,7 +97,7 @@ def register(server: BtServer) -> None:
         path = to_fs_path(params.text_document.uri)
         if path:
             ls.project.file_changed(path)
-        ls.refresh_all()
+        ls.publisher.refresh_all()
         if path and is_project_file(Path(path)):
             sync_config_diagnostics(ls)
 
@@ -112,15 +112,13 @@ def register(server: BtServer) -> None:
     ) -> types.DocumentDiagnosticReport | RawJson:
         od = ls.get(params.text_document.uri)
         if od is not None:
-            await ls.analysed(od)  # a large document on the worker thread
+            await ls.diagnostics.analysed(od)  # a large document on the worker thread
             od = ls.get(params.text_document.uri)
         if od is None:
             return types.RelatedFullDocumentDiagnosticReport(items=[], result_id=None)
-        # Everything the diagnostics depend on (see BtServer.diagnostics_of), other
-        # documents included: those can change this one's diagnostics.
-        result_id = f"{od.version}:{ls.generation}:{ls.project.generation + ls.edits}"
+        result_id = ls.diagnostics.result_id(od)
         if params.previous_result_id == result_id and od.cache_key is not None:
             return types.RelatedUnchangedDocumentDiagnosticReport(result_id=result_id)
         # A full report written as JSON, its items as a publication writes them.
-        items = ls.diagnostics_json(od)
+        items = ls.diagnostics.as_json(od)
         return RawJson(f'{{"kind": "full", "resultId": {json.dumps(result_id)}, "items": {items}}}')

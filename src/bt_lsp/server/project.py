@@ -127,7 +127,7 @@ def document_edited(
     if ls.project.config_edited(od.path, None if closed else od.doc.text):
         if closed:  # its diagnostics were cleared with the document's
             ls.config_published.pop(od.uri, None)
-        ls.refresh_all()
+        ls.publisher.refresh_all()
     elif opened:  # its configuration, read now: a pull client may not ask for a while
         ls.project.configs.for_path(od.path)
     else:

@@ -181,7 +181,7 @@ def render_tree(ls: BtServer, *args: Any) -> dict[str, Any] | None:
     fmt: Format = opts.get("format", "svg")
     ports = bool(opts.get("ports", False))
     expand = bool(opts.get("expandSubtrees", False))
-    diagnostics = ls.diagnostics_of(od) if od.is_bt else []
+    diagnostics = ls.diagnostics.of(od) if od.is_bt else []
     path = path_of(od)
     if path is not None:
         text, picture = draw(
