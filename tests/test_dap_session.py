@@ -302,6 +302,33 @@ def test_a_stop_its_frames_variables_and_continue(h: Harness) -> None:
     assert len(h.link.unlocks) == 1
 
 
+def test_each_stop_has_new_frame_ids(h: Harness) -> None:
+    # VS Code keeps the previous stop's lower frames on screen while it fetches them again,
+    # and does not redraw the Call Stack when they compare equal: with the same ids at the
+    # next stop at the same node, its "Load More Stack Frames" row stayed under them.
+    h.attached()
+    h.breakpoints(SLEEP)
+    h.link.notes = [UID["sleep1"]]
+    h.tick()
+    first = h.ok("stackTrace", threadId=1)["stackFrames"]
+    h.ok("continue", threadId=1)
+    h.link.notes = [UID["sleep1"]]
+    h.tick()
+    top = h.ok("stackTrace", threadId=1, startFrame=0, levels=1)["stackFrames"]
+    rest = h.ok("stackTrace", threadId=1, startFrame=1, levels=19)["stackFrames"]
+    second = top + rest
+    assert [f["name"] for f in second] == [f["name"] for f in first]
+    assert not {f["id"] for f in first} & {f["id"] for f in second}
+    assert len({f["id"] for f in second}) == len(second)
+    # The same frame asked for again keeps its id within the stop.
+    assert h.ok("stackTrace", threadId=1)["stackFrames"] == second
+    # A frame of this stop has its tree's blackboard; one of the previous stop does not.
+    scopes = h.ok("scopes", frameId=second[-1]["id"])["scopes"]
+    assert [s["name"] for s in scopes] == ["Blackboard Main", "All blackboards"]
+    stale = h.ok("scopes", frameId=first[-1]["id"])["scopes"]
+    assert [s["name"] for s in stale] == ["All blackboards"]
+
+
 @pytest.mark.parametrize(("command", "result"), [(SUCCEED, Resume.SUCCESS), (FAIL, Resume.FAILURE)])
 def test_succeed_and_fail_node(h: Harness, command: str, result: Resume) -> None:
     h.attached()

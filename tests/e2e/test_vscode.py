@@ -176,6 +176,12 @@ def _code_server(
     }
     user_settings.update(settings)
     (user_data / "User" / "settings.json").write_text(json.dumps(user_settings, indent=2))
+    # code-server's window is a remote one: VS Code ignores machine(-overridable) settings such
+    # as btLsp.server.command in the user settings once it knows their scope, and reads them
+    # from the machine's. Before, they may apply or not: with a .vscode folder (read after
+    # the extension started) the server was restarted without its command.
+    (user_data / "Machine").mkdir()
+    (user_data / "Machine" / "settings.json").write_text(json.dumps(user_settings, indent=2))
 
     env = dict(os.environ if environ is None else environ)
     env.update(

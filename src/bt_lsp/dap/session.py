@@ -202,6 +202,10 @@ class Session:
         self._stopped: int | None = None
         self._dump: dict[str, Any] | None = None
         self._refs = References()
+        # Stack frame ids, new at each stop (see _frame_id), and the node of each.
+        self._frame_ids: dict[int, int] = {}
+        self._frame_uids: dict[int, int] = {}
+        self._next_frame = 1
         self._handlers: dict[str, Callable[[Request], None]] = {
             "initialize": self._initialize,
             "attach": self._attach,
@@ -378,6 +382,7 @@ class Session:
         self._present = set()
         self._dump = None
         self._refs.clear()
+        self._forget_frames()
         self._parents = {}
         self._board_of = {}
         stack: list[tuple[LiveNode, str]] = [(tree.root, tree.tree_id)]
@@ -418,6 +423,7 @@ class Session:
         self._stopped = uid
         self._dump = None
         self._refs.clear()
+        self._forget_frames()
         hit = [
             bp.id
             for source in self._sources.values()
@@ -651,11 +657,27 @@ class Session:
         name = f"tree {self._tree.tree_id}" if self._tree is not None else "tree"
         self.out.respond(request, {"threads": [{"id": THREAD_ID, "name": name}]})
 
+    def _forget_frames(self) -> None:
+        self._frame_ids.clear()
+        self._frame_uids.clear()
+
+    def _frame_id(self, uid: int) -> int:
+        """The id of node ``uid``'s frame in this stop.  Ids are never reused in a session:
+        VS Code keeps the frames below the top one from the previous stop on screen while it
+        fetches them again, and when they compare equal (same ids, names and lines) it does
+        not redraw, leaving its "Load More Stack Frames" row under them."""
+        found = self._frame_ids.get(uid)
+        if found is None:
+            found = self._frame_ids[uid] = self._next_frame
+            self._frame_uids[found] = uid
+            self._next_frame += 1
+        return found
+
     def _frame(self, uid: int) -> dict[str, Any]:
         tree = self._tree
         node = tree.nodes.get(uid) if tree is not None else None
         name = f"{node.label} #{uid}" if node is not None else f"node #{uid}"
-        frame: dict[str, Any] = {"id": uid + 1, "name": name, "line": 0, "column": 0}
+        frame: dict[str, Any] = {"id": self._frame_id(uid), "name": name, "line": 0, "column": 0}
         for source in self._sources.values():
             place = source.map.place(uid) if source.map is not None else None
             if place is not None:
@@ -686,7 +708,8 @@ class Session:
         frame = request.arguments.integer("frameId")
         if frame is None:
             raise InvalidArguments("'frameId' is required")
-        board = self._board_of.get(frame - 1)
+        uid = self._frame_uids.get(frame)
+        board = self._board_of.get(uid) if uid is not None else None
         scopes = []
         if board is not None:
             scopes.append(
@@ -754,6 +777,7 @@ class Session:
         self._stopped = None
         self._dump = None
         self._refs.clear()
+        self._forget_frames()
         return self._tree.nodes.get(uid) if self._tree is not None else None
 
     def _continue(self, request: Request) -> None:
