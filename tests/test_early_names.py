@@ -3,7 +3,9 @@ analysis reports for the name rules, or it gives up."""
 
 from __future__ import annotations
 
+import operator
 import os
+import string
 from pathlib import Path
 
 import pytest
@@ -161,12 +163,27 @@ def test_corpus_files_match_the_full_analysis() -> None:
 
 # Names that are valid XML names (so the document stays well-formed) but may break the
 # BT rules, and attribute values of any kind.
-_XML_NAME = st.from_regex(r"[A-Za-z_][A-Za-z0-9_.\-é😀]{0,5}", fullmatch=True).filter(
-    lambda s: "xml" not in s.lower()
-)
+# (The strings of r"[A-Za-z_][A-Za-z0-9_.\-é😀]{0,5}", built from two plain strategies: drawn
+# through st.from_regex they took most of the generated-document test's time.)
+_NAME_START = string.ascii_letters + "_"
+_XML_NAME = st.builds(
+    operator.add,
+    st.sampled_from(_NAME_START),
+    st.text(alphabet=_NAME_START + string.digits + ".-é😀", max_size=5),
+).filter(lambda s: "xml" not in s.lower())
 _VALUE = st.text(alphabet="aZ_9. \t\n\r&<>\"'/\\*?|:\x7f😀é", max_size=6)
 _TAGS = st.sampled_from(["Sequence", "Fallback", "Action", "Condition", "SubTree", "Inverter"])
 _KEYS = st.sampled_from(["name", "ID", "_skipIf", "_autoremap", "port", "__shared_blackboard"])
+# The strategies the composites below draw from, made once: a strategy made inside a draw is
+# validated again at every draw, which took a good part of the generation time.
+_BOOLEANS = st.booleans()
+_ATTR_KEYS = st.lists(_KEYS | _XML_NAME, max_size=3, unique=True)
+_ASIDE_KINDS = st.sampled_from(["comment", "cdata", "pi", "text", "none"])
+_PORT_TAGS = st.sampled_from(["input_port", "output_port", "inout_port", "other"])
+_TAG = _TAGS | _XML_NAME
+_ID = _VALUE | _XML_NAME
+_PORT_NAME = _VALUE | _KEYS | _XML_NAME
+_UP_TO_3 = st.integers(0, 3)
 
 
 def _escape(value: str, draw: st.DrawFn) -> str:
@@ -174,7 +191,7 @@ def _escape(value: str, draw: st.DrawFn) -> str:
     for ch in value:
         if ch in "&<\"'":
             out.append({"&": "&amp;", "<": "&lt;", '"': "&quot;", "'": "&apos;"}[ch])
-        elif ch in "\t\n\r\x7f" and draw(st.booleans()):
+        elif ch in "\t\n\r\x7f" and draw(_BOOLEANS):
             out.append(f"&#{ord(ch)};")
         else:
             out.append(ch)
@@ -183,7 +200,7 @@ def _escape(value: str, draw: st.DrawFn) -> str:
 
 @st.composite
 def _attrs(draw: st.DrawFn) -> str:
-    keys = draw(st.lists(_KEYS | _XML_NAME, max_size=3, unique=True))
+    keys = draw(_ATTR_KEYS)
     return "".join(f' {k}="{_escape(draw(_VALUE), draw)}"' for k in keys)
 
 
@@ -191,7 +208,7 @@ def _attrs(draw: st.DrawFn) -> str:
 def _aside(draw: st.DrawFn) -> str:
     """Markup whose '<' does not start an element."""
     inner = f'<{draw(_XML_NAME).replace("-", "_")} a.b="1"/>'  # no "--" in a comment
-    kind = draw(st.sampled_from(["comment", "cdata", "pi", "text", "none"]))
+    kind = draw(_ASIDE_KINDS)
     return {
         "comment": f"<!-- {inner} -->",
         "cdata": f"<![CDATA[{inner}]]>",
@@ -203,41 +220,50 @@ def _aside(draw: st.DrawFn) -> str:
 
 @st.composite
 def _node(draw: st.DrawFn, depth: int = 0) -> str:
-    tag = draw(_TAGS | _XML_NAME)
-    attrs = draw(_attrs())
-    children = [] if depth >= 3 else draw(st.lists(_node(depth + 1), max_size=3))
-    aside = draw(_aside())
-    if not children and draw(st.booleans()):
+    tag = draw(_TAG)
+    attrs = draw(_ATTRS)
+    children = [] if depth >= 3 else draw(_CHILDREN[depth + 1])
+    aside = draw(_ASIDE)
+    if not children and draw(_BOOLEANS):
         return f"{aside}<{tag}{attrs}/>"
     return f"{aside}<{tag}{attrs}>\n{''.join(children)}</{tag}>"
+
+
+_ATTRS = _attrs()
+_ASIDE = _aside()
+# _CHILDREN[d]: up to three nodes at depth d (those at depth 3 have no children).
+_CHILDREN = [st.lists(_node(depth), max_size=3) for depth in range(4)]
 
 
 @st.composite
 def _model(draw: st.DrawFn) -> str:
     entries = []
-    for _ in range(draw(st.integers(0, 3))):
+    for _ in range(draw(_UP_TO_3)):
         tag = draw(_TAGS)
         ports = "".join(
-            f"<{draw(st.sampled_from(['input_port', 'output_port', 'inout_port', 'other']))}"
-            f' name="{_escape(draw(_VALUE | _KEYS | _XML_NAME), draw)}"/>'
-            for _ in range(draw(st.integers(0, 3)))
+            f'<{draw(_PORT_TAGS)} name="{_escape(draw(_PORT_NAME), draw)}"/>'
+            for _ in range(draw(_UP_TO_3))
         )
-        entries.append(f'<{tag} ID="{_escape(draw(_VALUE | _XML_NAME), draw)}">{ports}</{tag}>')
+        entries.append(f'<{tag} ID="{_escape(draw(_ID), draw)}">{ports}</{tag}>')
     return f"<TreeNodesModel>{''.join(entries)}</TreeNodesModel>"
+
+
+_MODEL = _model()
+_NEWLINES = st.sampled_from(["\n", "\r\n", "\r", ""])
 
 
 @st.composite
 def bt_documents(draw: st.DrawFn) -> str:
     parts = []
-    for _ in range(draw(st.integers(0, 3))):
-        tree_id = _escape(draw(_VALUE | _XML_NAME), draw)
-        nodes = "".join(draw(st.lists(_node(), max_size=3)))
+    for _ in range(draw(_UP_TO_3)):
+        tree_id = _escape(draw(_ID), draw)
+        nodes = "".join(draw(_CHILDREN[0]))
         parts.append(f'<BehaviorTree ID="{tree_id}">{nodes}</BehaviorTree>')
-    if draw(st.booleans()):
-        parts.insert(draw(st.integers(0, len(parts))), draw(_model()))
-    if draw(st.booleans()):
-        parts.append(f"<{draw(_XML_NAME)}{draw(_attrs())}/>")  # ignored by BehaviorTree.CPP
-    newline = draw(st.sampled_from(["\n", "\r\n", "\r", ""]))
+    if draw(_BOOLEANS):
+        parts.insert(draw(st.integers(0, len(parts))), draw(_MODEL))
+    if draw(_BOOLEANS):
+        parts.append(f"<{draw(_XML_NAME)}{draw(_ATTRS)}/>")  # ignored by BehaviorTree.CPP
+    newline = draw(_NEWLINES)
     return f'<root BTCPP_format="4">{newline}{newline.join(parts)}</root>{newline}'
 
 
