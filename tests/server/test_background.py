@@ -7,6 +7,7 @@ the test asserts that order, never a time."""
 
 from __future__ import annotations
 
+import functools
 import json
 import queue
 import time
@@ -39,6 +40,9 @@ SMALL = (
     '  <BehaviorTree ID="Main"><Sequence><AlwaysSuccess/></Sequence></BehaviorTree>\n'
     "</root>\n"
 )
+# What the tests that call the worker's functions directly give it: the smallest document it
+# takes (the tests through the server keep SIZE, so that its analysis lasts).
+AT_WORKER = WORKER_CHARS
 # A bad name only the edit of the small document brings.
 SMALL_EDITED = SMALL.replace("<AlwaysSuccess/>", '<AlwaysSuccess na.me="x"/>')
 TAGS = "<AlwaysSuccess/><Fallback><AlwaysFailure/></Fallback>"
@@ -46,19 +50,20 @@ LINE = '    <Sequence name="s{i}">' + TAGS + "</Sequence>\n"
 SIZE = 2 * 1024 * 1024
 
 
-def big_document(marker: str) -> str:
-    """About :data:`SIZE` bytes of valid trees, with one node type nobody registers
+@functools.cache
+def big_document(marker: str, size: int = SIZE) -> str:
+    """About ``size`` bytes of valid trees, with one node type nobody registers
     (``unknown-node`` is a semantic diagnostic: only the complete analysis finds it)."""
     head = '<root BTCPP_format="4" main_tree_to_execute="Main">\n  <BehaviorTree ID="Main">\n'
     head += f"    <{marker}/>\n"
     tail = "  </BehaviorTree>\n</root>\n"
     body = []
-    size = len(head) + len(tail)
+    length = len(head) + len(tail)
     i = 0
-    while size < SIZE:
+    while length < size:
         line = LINE.format(i=i)
         body.append(line)
-        size += len(line)
+        length += len(line)
         i += 1
     return head + "".join(body) + tail
 
@@ -369,12 +374,12 @@ def test_the_worker_prepares_what_the_first_requests_read() -> None:
     """A large document's declarations are made on the worker thread with its tokens and
     model, and its name index too when a request is waiting for it, so that the first
     hover or definition does not make it on the event loop."""
-    doc = Document(big_document("Frobnicate"), "big.xml", scanned=False)
+    doc = Document(big_document("Frobnicate", AT_WORKER), "big.xml", scanned=False)
     _prepare(doc, True)
     assert doc._model is not None and doc._model._by_symbol is None  # nobody asked
     cached = doc.history.memo.get("facts")
     assert cached is not None and cached[0] is doc._model
-    asked = Document(big_document("Frobnicate"), "big.xml", scanned=False)
+    asked = Document(big_document("Frobnicate", AT_WORKER), "big.xml", scanned=False)
     _prepare(asked, True, [hover(BIG_URI, 7)])
     assert asked._model is not None and asked._model._by_symbol is not None
     other = Document("int main() {}\n" * 20_000, "big.cpp", scanned=False)
@@ -395,7 +400,7 @@ def test_an_outline_asked_with_the_open_is_made_on_the_worker() -> None:
         ([outline], True, False),  # the name index is left for later
         ([hover_], False, True),
     ):
-        doc = Document(big_document("Frobnicate"), BIG_URI, scanned=False)
+        doc = Document(big_document("Frobnicate", AT_WORKER), BIG_URI, scanned=False)
         od = OpenDocument(BIG_URI, doc, 1, "xml")
         od.refresh_kind()
         background._prepare_for(_Held(od, list(waiting)))
@@ -413,7 +418,7 @@ def test_folding_ranges_asked_with_the_open_are_made_on_the_worker() -> None:
     """Held with the open, folding ranges are made by the worker as JSON, kept for the
     document's version, which the request then answers with."""
     background = Background(cast("BtServer", SimpleNamespace(encoding="utf-16")))
-    doc = Document(big_document("Frobnicate"), BIG_URI, scanned=False)
+    doc = Document(big_document("Frobnicate", AT_WORKER), BIG_URI, scanned=False)
     od = OpenDocument(BIG_URI, doc, 1, "xml")
     od.refresh_kind()
     background._prepare_for(_Held(od, [SimpleNamespace(method="textDocument/foldingRange")]))
