@@ -8,7 +8,6 @@ nothing here imports the checkout's sources into the new environment.
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import sys
@@ -19,6 +18,7 @@ from pathlib import Path
 import pytest
 
 import bt_lsp
+from tests.conftest import Built, clean_env
 
 # On the worker that builds the VS Code packages (pytest -n): they share editors/vscode/.
 pytestmark = pytest.mark.xdist_group("vscode-bundle")
@@ -40,13 +40,6 @@ def _run(
     )
 
 
-def _clean_env() -> dict[str, str]:
-    """The environment without what would make the new venv import this checkout."""
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
-    env["PYTHONDONTWRITEBYTECODE"] = "1"
-    return env
-
-
 def test_the_version_is_written_once() -> None:
     """``bt-lsp --version``, SARIF and the C++ catalog cache key read ``__version__``; the
     package metadata must take it from there, not repeat it."""
@@ -61,11 +54,11 @@ def test_the_version_is_written_once() -> None:
 
 
 @pytest.mark.slow
-def test_build_check_install_and_run(tmp_path: Path) -> None:
-    env = _clean_env()
-    dist = tmp_path / "dist"
+def test_build_check_install_and_run(tmp_path: Path, built_package: Built) -> None:
+    env = clean_env()
+    dist = built_package.dist
     # The sdist, then the wheel built from it: a file missing from the sdist breaks the wheel.
-    built = _run([sys.executable, "-m", "build", "--outdir", dist, ROOT], tmp_path, env)
+    built = built_package.run
     assert built.returncode == 0, built.stdout + built.stderr
     output = built.stdout + built.stderr
     assert "deprecat" not in output.lower(), output
@@ -80,9 +73,13 @@ def test_build_check_install_and_run(tmp_path: Path) -> None:
     assert twine.returncode == 0, twine.stdout + twine.stderr
 
     env_dir = tmp_path / "venv"
-    venv.EnvBuilder(with_pip=True).create(env_dir)
+    # Without a pip of its own (ensurepip took a quarter of the test): this pip installs
+    # into it.
+    venv.EnvBuilder(with_pip=False).create(env_dir)
     python = env_dir / "bin" / "python"
-    installed = _run([python, "-m", "pip", "install", "--quiet", wheels[0]], tmp_path, env)
+    pip: list[str | Path] = [sys.executable, "-m", "pip", "--python", python, "install"]
+    pip += ["--quiet", wheels[0]]
+    installed = _run(pip, tmp_path, env)
     assert installed.returncode == 0, installed.stdout + installed.stderr
 
     # Run from elsewhere, so the checkout cannot be imported by accident.

@@ -22,6 +22,7 @@ import pytest
 from packaging.requirements import Requirement
 
 import bt_lsp
+from tests.conftest import Built
 
 # The packages are built into editors/vscode/bundled/ and the wheel in the source tree's
 # build/: slow, and on one worker under pytest -n.
@@ -175,15 +176,19 @@ def test_bootstrap_refuses_a_wheel_that_writes_outside(tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def packages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+def packages(tmp_path_factory: pytest.TempPathFactory, built_package: Built) -> dict[str, Path]:
     if not (EXT / "node_modules" / "@vscode" / "vsce").is_dir():
         pytest.fail(
             "editors/vscode has no node_modules: run `bash editors/vscode/e2e/setup.sh`",
             pytrace=False,
         )
     out = tmp_path_factory.mktemp("vsix")
+    # bt-lsp's wheel is the one the packaging test checks, built once for both.
+    assert built_package.run.returncode == 0, built_package.run.stderr[-3000:]
+    (wheel,) = built_package.dist.glob("bt_lsp-*.whl")
+    script = [sys.executable, str(ROOT / "scripts" / "vscode_bundle.py")]
     run = subprocess.run(
-        [sys.executable, str(ROOT / "scripts" / "vscode_bundle.py"), "--out", str(out)],
+        [*script, "--out", str(out), "--wheel", str(wheel)],
         capture_output=True,
         text=True,
         timeout=900,
