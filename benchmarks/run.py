@@ -392,7 +392,7 @@ def open_publications(text: str) -> int:
     the name diagnostics first (unless that pass gives up on the text), then the complete
     set."""
     from bt_lsp.rules.early_names import early_name_diagnostics
-    from bt_lsp.server.app import EARLY_NAMES_CHARS
+    from bt_lsp.server.publishing import EARLY_NAMES_CHARS
 
     early = len(text) >= EARLY_NAMES_CHARS and early_name_diagnostics(text) is not None
     return 2 if early else 1
