@@ -136,6 +136,47 @@ class CodeServer:
     env: dict[str, str]
 
 
+def run_driver(
+    code_server: CodeServer,
+    driver: Path,
+    config: Mapping[str, Any],
+    name: str,
+    timeout_s: float,
+    keep: int = 6000,
+) -> tuple[dict[str, Any], str]:
+    """Run a playwright driver against ``code_server`` with ``config`` (its ``shotDir``'s
+    screenshots copied to the artifacts): its last printed line as JSON, written to
+    ``<name>-result.json``, and a failure context (the result's last ``keep`` characters,
+    the driver's stderr, the logs).  The driver must end well and report no error."""
+    shots = Path(config["shotDir"])
+    try:
+        run = subprocess.run(
+            ["node", str(driver), json.dumps(config)],
+            env=code_server.env,
+            capture_output=True,
+            text=True,
+            timeout=timeout_s,
+        )
+    except subprocess.TimeoutExpired as e:
+        logs = _logs(code_server.user_data, code_server.log)
+        pytest.fail(f"the driver took more than {timeout_s}s\n{e.stderr!r}\n{logs}")
+    finally:
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        for shot in shots.glob("*.png"):
+            shutil.copy(shot, ARTIFACTS / shot.name)
+    lines = run.stdout.strip().splitlines()
+    logs = _logs(code_server.user_data, code_server.log)
+    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
+    result: dict[str, Any] = json.loads(lines[-1])
+    (ARTIFACTS / f"{name}-result.json").write_text(json.dumps(result, indent=1))
+    context = (
+        f"\ndriver result: {json.dumps(result, indent=1)[-keep:]}\n"
+        f"driver stderr:\n{run.stderr[-2000:]}\n{logs}\nscreenshots: {ARTIFACTS}"
+    )
+    assert run.returncode == 0 and "error" not in result, context
+    return result, context
+
+
 @contextmanager
 def _code_server(
     tmp_path: Path,

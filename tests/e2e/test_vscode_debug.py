@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 from typing import Any
@@ -30,8 +29,8 @@ from tests.e2e.test_vscode import (
     SETUP,
     CodeServer,
     _code_server,
-    _logs,
     _missing_setup,
+    run_driver,
 )
 
 pytest.importorskip("behaviortreepy")
@@ -120,32 +119,7 @@ def _drive(code_server: CodeServer, tmp_path: Path, port: int) -> tuple[dict[str
         "stepTimeoutMs": 60000,
         "serverTimeoutMs": 120000,
     }
-    try:
-        run = subprocess.run(
-            ["node", str(DRIVER), json.dumps(config)],
-            env=code_server.env,
-            capture_output=True,
-            text=True,
-            timeout=DRIVER_TIMEOUT_S,
-        )
-    except subprocess.TimeoutExpired as e:
-        logs = _logs(code_server.user_data, code_server.log)
-        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr!r}\n{logs}")
-    finally:
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        for shot in shots.glob("*.png"):
-            shutil.copy(shot, ARTIFACTS / shot.name)
-    lines = run.stdout.strip().splitlines()
-    logs = _logs(code_server.user_data, code_server.log)
-    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
-    result: dict[str, Any] = json.loads(lines[-1])
-    (ARTIFACTS / "debug-result.json").write_text(json.dumps(result, indent=1))
-    context = (
-        f"\ndriver result: {json.dumps(result, indent=1)[-8000:]}\n"
-        f"driver stderr:\n{run.stderr[-2000:]}\n{logs}\nscreenshots: {ARTIFACTS}"
-    )
-    assert run.returncode == 0 and "error" not in result, context
-    return result, context
+    return run_driver(code_server, DRIVER, config, "debug", DRIVER_TIMEOUT_S, keep=8000)
 
 
 def _check_stop(stop: dict[str, Any], context: str) -> int:

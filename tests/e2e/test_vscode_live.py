@@ -13,10 +13,8 @@ to `.e2e-artifacts/vscode/live.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -29,8 +27,8 @@ from tests.e2e.test_vscode import (
     SETUP,
     CodeServer,
     _code_server,
-    _logs,
     _missing_setup,
+    run_driver,
 )
 
 pytest.importorskip("behaviortreepy")
@@ -116,32 +114,7 @@ def _drive(
         "shotDir": str(shots),
         "chromium": shutil.which("chromium"),
     }
-    try:
-        run = subprocess.run(
-            ["node", str(DRIVER), json.dumps(config)],
-            env=code_server.env,
-            capture_output=True,
-            text=True,
-            timeout=DRIVER_TIMEOUT_S,
-        )
-    except subprocess.TimeoutExpired as e:
-        logs = _logs(code_server.user_data, code_server.log)
-        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr!r}\n{logs}")
-    finally:
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        for shot in shots.glob("*.png"):
-            shutil.copy(shot, ARTIFACTS / shot.name)
-    lines = run.stdout.strip().splitlines()
-    logs = _logs(code_server.user_data, code_server.log)
-    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
-    result: dict[str, object] = json.loads(lines[-1])
-    (ARTIFACTS / "live-result.json").write_text(json.dumps(result, indent=1))
-    context = (
-        f"\ndriver result: {json.dumps(result, indent=1)[-6000:]}\n"
-        f"driver stderr:\n{run.stderr[-2000:]}\n{logs}\nscreenshots: {ARTIFACTS}"
-    )
-    assert run.returncode == 0 and "error" not in result, context
-    return result, context
+    return run_driver(code_server, DRIVER, config, "live", DRIVER_TIMEOUT_S)
 
 
 def _classes(snapshot: object) -> dict[str, str]:

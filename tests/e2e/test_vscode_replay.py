@@ -12,9 +12,7 @@ to `.e2e-artifacts/vscode/replay.png`.
 from __future__ import annotations
 
 import gc
-import json
 import shutil
-import subprocess
 from collections import Counter
 from pathlib import Path
 
@@ -23,12 +21,11 @@ import pytest
 from bt_lsp.live.btlog import BtLog
 from bt_lsp.live.protocol import NodeStatus
 from tests.e2e.test_vscode import (
-    ARTIFACTS,
     EXT_DIR,
     SETUP,
     _code_server,
-    _logs,
     _missing_setup,
+    run_driver,
 )
 from tests.e2e.test_vscode_live import MISSION
 
@@ -112,28 +109,7 @@ def test_vscode_replay(tmp_path: Path) -> None:
             "shotDir": str(shots),
             "chromium": shutil.which("chromium"),
         }
-        try:
-            run = subprocess.run(
-                ["node", str(DRIVER), json.dumps(config)],
-                env=code_server.env,
-                capture_output=True,
-                text=True,
-                timeout=DRIVER_TIMEOUT_S,
-            )
-        finally:
-            ARTIFACTS.mkdir(parents=True, exist_ok=True)
-            for shot in shots.glob("*.png"):
-                shutil.copy(shot, ARTIFACTS / shot.name)
-        logs = _logs(code_server.user_data, code_server.log)
-    lines = run.stdout.strip().splitlines()
-    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
-    result = json.loads(lines[-1])
-    (ARTIFACTS / "replay-result.json").write_text(json.dumps(result, indent=1))
-    context = (
-        f"\ndriver result: {json.dumps(result, indent=1)[-6000:]}\n"
-        f"driver stderr:\n{run.stderr[-2000:]}\n{logs}\nscreenshots: {ARTIFACTS}"
-    )
-    assert run.returncode == 0 and "error" not in result, context
+        result, context = run_driver(code_server, DRIVER, config, "replay", DRIVER_TIMEOUT_S)
 
     # Opened at the start: every node idle, the timeline over every transition.
     opened = result["opened"]

@@ -11,11 +11,9 @@ to `.e2e-artifacts/vscode/tree.png`; with BT_LSP_E2E_UPDATE_IMAGES=1 also into
 from __future__ import annotations
 
 import importlib.util
-import json
 import os
 import re
 import shutil
-import subprocess
 from pathlib import Path
 from types import ModuleType
 
@@ -28,8 +26,8 @@ from tests.e2e.test_vscode import (
     SETUP,
     CodeServer,
     _code_server,
-    _logs,
     _missing_setup,
+    run_driver,
 )
 
 pytestmark = pytest.mark.e2e
@@ -105,6 +103,7 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
         "insert": "<Stop/>",
         "expectType": "Stop",
         "clickType": "Fallback",
+        "selectionAt": f"Ln {fallback_line}, Col {fallback_col}",
         "cursorAt": [charge_line, LINES[charge_line - 1].index("Charge") + 3],
         "cursorType": "Charge",
         "addAt": [inverter_line, len(LINES[inverter_line - 1]) + 1],  # after </Inverter>
@@ -117,32 +116,7 @@ def _drive_and_check(code_server: CodeServer, tmp_path: Path) -> None:
         "shotDir": str(shots),
         "chromium": shutil.which("chromium"),
     }
-    try:
-        run = subprocess.run(
-            ["node", str(DRIVER), json.dumps(config)],
-            env=code_server.env,
-            capture_output=True,
-            text=True,
-            timeout=DRIVER_TIMEOUT_S,
-        )
-    except subprocess.TimeoutExpired as e:
-        logs = _logs(code_server.user_data, code_server.log)
-        pytest.fail(f"the driver took more than {DRIVER_TIMEOUT_S}s\n{e.stderr!r}\n{logs}")
-    finally:
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        for shot in shots.glob("*.png"):
-            shutil.copy(shot, ARTIFACTS / shot.name)
-
-    lines = run.stdout.strip().splitlines()
-    logs = _logs(code_server.user_data, code_server.log)
-    assert lines, f"no output from the driver (exit {run.returncode}):\n{run.stderr}\n{logs}"
-    result = json.loads(lines[-1])
-    (ARTIFACTS / "tree-result.json").write_text(json.dumps(result, indent=1))
-    context = (
-        f"\ndriver result: {json.dumps(result, indent=1)}\ndriver stderr:\n{run.stderr[-2000:]}\n"
-        f"{logs}\nscreenshots: {ARTIFACTS}"
-    )
-    assert run.returncode == 0 and "error" not in result, context
+    result, context = run_driver(code_server, DRIVER, config, "tree", DRIVER_TIMEOUT_S, keep=10**9)
 
     # The picture appears, with the kinds the models give and the Inverter's error as a badge.
     first = result["first"]

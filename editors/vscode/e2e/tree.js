@@ -130,9 +130,10 @@ async function main(page) {
 
   mark('click a node');
   await frame.click(`#canvas g.node[data-type="${config.clickType}"]`);
+  // The status bar may first show an older selection: wait for the clicked node's.
   result.selection = await until(async () => {
     const s = await selectionStatus(page);
-    return /selected/.test(s) ? s : null;
+    return /selected/.test(s) && (!config.selectionAt || s.includes(config.selectionAt)) ? s : null;
   }, STEP_TIMEOUT) || (await selectionStatus(page));
   await new Promise((resolve) => setTimeout(resolve, 500));
   await page.screenshot({ path: path.join(config.shotDir, 'tree.png') });
